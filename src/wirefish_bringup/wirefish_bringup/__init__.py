@@ -1,0 +1,1 @@
+"""Launch files, default parameters and the wirefish command-line tool."""

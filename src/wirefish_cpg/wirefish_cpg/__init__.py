@@ -1,0 +1,1 @@
+"""Ijspeert CPG node and PSO gait tuner service for the wire-driven elastic robotic fish."""

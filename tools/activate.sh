@@ -1,0 +1,32 @@
+# Source this file (bash) to get a shell in which the wirefish executables work:
+#   source tools/activate.sh
+# It activates the project's virtual environment and the colcon workspace (install/setup.bash).
+# On a full ROS 2 Jazzy install, source /opt/ros/jazzy/setup.bash first.
+
+_wf_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+_wf_venv="${WIREFISH_VENV:-$_wf_root/.venv}"
+
+if [ ! -x "$_wf_venv/bin/python" ] || [ ! -f "$_wf_root/install/setup.bash" ]; then
+  echo "wirefish: not set up yet: run 'make setup' in $_wf_root first" >&2
+  return 1 2>/dev/null || exit 1
+fi
+
+# shellcheck disable=SC1091
+source "$_wf_venv/bin/activate"
+if [ -f "$_wf_venv/.wirefish-wheels" ]; then
+  # ROS 2 from PyPI wheels: the venv prefix is the underlay (ament index, CMake configs).
+  case ":${AMENT_PREFIX_PATH:-}:" in
+    *":$_wf_venv:"*) ;;
+    *) export AMENT_PREFIX_PATH="$_wf_venv${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}" ;;
+  esac
+  case ":${CMAKE_PREFIX_PATH:-}:" in
+    *":$_wf_venv:"*) ;;
+    *) export CMAKE_PREFIX_PATH="$_wf_venv${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}" ;;
+  esac
+fi
+# colcon's setup scripts read unset variables; relax nounset while sourcing them.
+case $- in *u*) _wf_nounset=1; set +u ;; *) _wf_nounset= ;; esac
+# shellcheck disable=SC1091
+source "$_wf_root/install/setup.bash"
+[ -n "$_wf_nounset" ] && set -u
+unset _wf_root _wf_venv _wf_nounset

