@@ -1,1 +1,1 @@
-"""Wire-coupled arc kinematics of the elastic tail, Lighthill body wave and swimming-speed estimate."""
+"""Wire-coupled arc kinematics of the elastic tail and the Lighthill swimming-speed model."""
