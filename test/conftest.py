@@ -17,9 +17,9 @@ import pytest
 
 WORKSPACE = Path(__file__).resolve().parents[1]
 # Fast DDS maps a domain to UDP ports; 0..101 is the portable range. Each test takes the next
-# id in a window of 40, so a test never shares a domain with the one before it.
-_DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '50'))
-_domains = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 40))
+# id in a window of 20, so a test never shares a domain with the one before it.
+_DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21'))
+_domains = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 20))
 
 
 @pytest.fixture

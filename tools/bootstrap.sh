@@ -11,6 +11,10 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="${WIREFISH_VENV:-$ROOT/.venv}"
 cd "$ROOT"
 
+# One bootstrap at a time per workspace (parallel make targets, several shells).
+exec 9>"$ROOT/.wirefish-setup.lock"
+flock 9
+
 die() { echo "wirefish setup: $*" >&2; exit 1; }
 need() {  # need COMMAND PACKAGE
   command -v "$1" >/dev/null 2>&1 || die "'$1' not found: install it (Debian/Ubuntu: apt-get install $2)"
