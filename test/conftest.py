@@ -1,4 +1,5 @@
-"""Fixtures shared by the workspace-level tests: ROS isolation and child processes.
+"""
+Fixtures shared by the workspace-level tests: ROS isolation and child processes.
 
 Every test that touches ROS gets its own ``ROS_DOMAIN_ID`` (and its own rclpy context), so
 tests never hear each other's traffic, and every child process is started in its own process
@@ -12,8 +13,8 @@ from pathlib import Path
 import subprocess
 import sys
 
-from ros_utils import stop_process
 import pytest
+from ros_utils import stop_process
 
 WORKSPACE = Path(__file__).resolve().parents[1]
 # Fast DDS maps a domain to UDP ports; 0..101 is the portable range. Each test takes the next
@@ -56,7 +57,8 @@ def ros_context(ros_domain_id: int, monkeypatch: pytest.MonkeyPatch) -> Iterator
 
 @pytest.fixture
 def spawn(ros_env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen]]:
-    """Start child processes on this test's domain; every one is stopped when the test ends.
+    """
+    Start child processes on this test's domain; every one is stopped when the test ends.
 
     ``spawn(args, **popen_kwargs)`` returns the ``Popen``; stdout and stderr go to a pipe
     (merged) unless overridden.

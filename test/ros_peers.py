@@ -1,4 +1,5 @@
-"""Small ROS peers that the cross-process tests start as separate processes.
+"""
+Small ROS peers that the cross-process tests start as separate processes.
 
 Usage: ``python ros_peers.py body_wave_talker`` or ``python ros_peers.py retune_server``.
 """

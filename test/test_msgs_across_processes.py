@@ -2,10 +2,10 @@
 
 from pathlib import Path
 
-from ros_utils import spin_until
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
+from ros_utils import spin_until
 from wirefish_msgs.msg import BodyWave
 from wirefish_msgs.srv import RetuneGait
 

@@ -29,4 +29,9 @@ case $- in *u*) _wf_nounset=1; set +u ;; *) _wf_nounset= ;; esac
 # shellcheck disable=SC1091
 source "$_wf_root/install/setup.bash"
 [ -n "$_wf_nounset" ] && set -u
+# The `wirefish` command (installed the ament way, under lib/wirefish_bringup) on PATH.
+case ":$PATH:" in
+  *":$_wf_root/install/wirefish_bringup/lib/wirefish_bringup:"*) ;;
+  *) export PATH="$_wf_root/install/wirefish_bringup/lib/wirefish_bringup:$PATH" ;;
+esac
 unset _wf_root _wf_venv _wf_nounset

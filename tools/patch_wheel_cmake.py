@@ -1,4 +1,5 @@
-"""Point the ROS 2 wheels' exported CMake targets at this machine's include directories.
+"""
+Point the ROS 2 wheels' exported CMake targets at this machine's include directories.
 
 The PyPI wheels of ROS 2 Jazzy were built in a manylinux container; every exported
 ``*__rosidl_generator_py`` target names that container's Python and numpy include directories
@@ -37,7 +38,7 @@ def main(prefix: str) -> int:
             text = text.replace(old, new)
         path.write_text(text)
         patched += 1
-    print(f'wirefish setup: pointed {patched} CMake export files at this machine\'s includes')
+    print(f"wirefish setup: pointed {patched} CMake export files at this machine's includes")
     return 0
 
 

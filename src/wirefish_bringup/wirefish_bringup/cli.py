@@ -1,0 +1,47 @@
+"""
+The `wirefish` command: run, retune, record and inspect the fish without ros2cli.
+
+Every subcommand is also reachable on a full install (`ros2 run wirefish_bringup wirefish ...`),
+beside the standard tools it stands in for on pip-only machines.
+"""
+
+import argparse
+import importlib
+import sys
+
+# subcommand -> (module, one-line help); modules are imported only when their command runs,
+# so `wirefish --help` stays fast and a plotting dependency never slows `wirefish up`.
+SUBCOMMANDS = {
+    'up': ('wirefish_bringup.launcher', 'start the whole graph (virtual fish by default)'),
+    'record': ('wirefish_bringup.record', 'record the graph into a rosbag2 (MCAP) bag'),
+    'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait service)'),
+    'report': ('wirefish_bringup.report', 'plots and a summary table from a recorded bag'),
+    'sweep': ('wirefish_bringup.sweep', "model and virtual-fish speed over the paper's grid"),
+}
+
+
+def build_parser(argv: list[str]) -> argparse.ArgumentParser:
+    """Return the parser; only the chosen subcommand's module is imported."""
+    parser = argparse.ArgumentParser(prog='wirefish', description=__doc__.strip().splitlines()[0])
+    commands = parser.add_subparsers(dest='command', required=True, metavar='COMMAND')
+    for name, (module_name, help_text) in SUBCOMMANDS.items():
+        sub = commands.add_parser(name, help=help_text, description=help_text)
+        if name in argv:
+            module = importlib.import_module(module_name)
+            module.add_arguments(sub)
+            sub.set_defaults(run=module.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `wirefish` executable."""
+    argv = sys.argv[1:] if argv is None else argv
+    # Arguments after --ros-args belong to ROS, not to us (ros2 run passes them through).
+    if '--ros-args' in argv:
+        argv = argv[:argv.index('--ros-args')]
+    args = build_parser(argv).parse_args(argv)
+    return args.run(args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,132 @@
+"""
+`wirefish up`: start one fish's whole graph, show its status, run until Ctrl-C, stop cleanly.
+
+The launcher for machines without `ros2 launch`; `launch/wirefish.launch.py` starts the same
+graph (see `wirefish_bringup.graph`) on a full install.
+"""
+
+import argparse
+from datetime import datetime
+from pathlib import Path
+import signal
+import sys
+import time
+
+from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, sim_tty_link,
+                                    validate_namespace)
+from wirefish_bringup.supervisor import Supervisor, wait_for_path
+
+STATUS_WINDOW_S = 3.0
+DEVICE_TIMEOUT_S = 15.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish up`."""
+    target = parser.add_mutually_exclusive_group()
+    target.add_argument('--sim', action='store_true', default=True,
+                        help='drive the virtual fish on a pseudo-terminal (default)')
+    target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('--duration', type=float, default=None,
+                        help='run this many seconds, record a bag and write a report')
+    parser.add_argument('--params-file', type=Path, default=None,
+                        help='parameter YAML (default: the installed config/wirefish.yaml)')
+    parser.add_argument('--out', type=Path, default=Path('out'),
+                        help='where run logs, bags and reports go (default: ./out)')
+    parser.add_argument('--no-status', action='store_true', help='skip the topic-rate table')
+
+
+def _status_table(namespace: str) -> str:
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
+
+    from wirefish_bringup.monitor import measure_rates
+
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node('wirefish_status', namespace=namespace)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        time.sleep(1.0)  # discovery
+        rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S)
+        nodes = sorted(f'{ns.rstrip("/")}/{name}' for name, ns in
+                       node.get_node_names_and_namespaces() if name != 'wirefish_status')
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    lines = [f'nodes: {", ".join(nodes)}', f'{"topic":<40} {"type":<38} {"rate":>9}']
+    for topic, (type_name, rate) in rates.items():
+        shown = f'{rate:7.1f} Hz' if rate > 0 else '  latched' if rate == 0 else ''
+        lines.append(f'{topic:<40} {type_name:<38} {shown:>9}')
+    return '\n'.join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish up`; return the process exit code."""
+    try:
+        namespace = validate_namespace(args.namespace)
+        sim = args.port is None
+        specs = fish_graph(namespace, sim=sim, port=args.port, params_file=args.params_file)
+    except ValueError as error:
+        print(f'wirefish up: {error}', file=sys.stderr)
+        return 2
+    stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
+    run_dir = (args.out / f'run_{stamp}').resolve()
+    supervisor = Supervisor(run_dir / 'logs')
+    stop_requested = []
+
+    def request_stop(signum, _frame) -> None:
+        stop_requested.append(signum)
+
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
+    bag_path = run_dir / 'bag' if args.duration else None
+    code = 0
+    try:
+        for spec in specs:
+            proc = supervisor.start(spec)
+            if spec.executable == 'fish_sim':
+                link = sim_tty_link(namespace)
+                if not wait_for_path(link, [proc], DEVICE_TIMEOUT_S):
+                    raise RuntimeError('the virtual fish did not open its pseudo-terminal:\n'
+                                       + supervisor.log_tail(spec.name))
+                print(f'virtual fish on {link} -> {link.resolve()}')
+        if bag_path is not None:
+            supervisor.start(NodeSpec('wirefish_bringup', 'wirefish', 'recorder', (
+                'record', '-o', str(bag_path), '--namespace', namespace)))
+        print(f'started {len(supervisor.processes)} processes in {namespace}; '
+              f'logs in {run_dir / "logs"}')
+        if not args.no_status and not stop_requested:
+            print(_status_table(namespace))
+        if bag_path is not None:
+            print(f'recording to {bag_path}; stopping after {args.duration:g} s')
+        else:
+            print('running: Ctrl-C stops everything')
+        started = time.monotonic()
+        while not stop_requested:
+            exited = supervisor.exited()
+            if exited:
+                name, rc = next(iter(exited.items()))
+                raise RuntimeError(f'{name} exited with code {rc}:\n'
+                                   + supervisor.log_tail(name))
+            if args.duration is not None and time.monotonic() - started >= args.duration:
+                break
+            time.sleep(0.1)
+    except (RuntimeError, FileNotFoundError) as error:
+        print(f'wirefish up: {error}', file=sys.stderr)
+        code = 1
+    finally:
+        codes = supervisor.stop()
+    unclean = {name: rc for name, rc in codes.items() if rc not in (0, -signal.SIGINT)}
+    if unclean:
+        print(f'wirefish up: processes that did not exit cleanly: {unclean}', file=sys.stderr)
+        code = code or 1
+    print(f'stopped {len(codes)} processes')
+    if bag_path is not None and bag_path.exists() and code == 0:
+        from wirefish_bringup.report import write_report
+        report_dir = run_dir / 'report'
+        write_report(bag_path, report_dir)
+        print(f'bag: {bag_path}\nreport: {report_dir}')
+    return code

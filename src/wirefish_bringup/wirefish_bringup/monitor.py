@@ -1,0 +1,37 @@
+"""Measure the rate of every topic of the graph (what `ros2 topic hz` shows, for all at once)."""
+
+import time
+
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+
+from wirefish_bringup.topics import graph_topics, matching_qos, message_class
+
+
+def measure_rates(node: Node, executor: SingleThreadedExecutor, namespace: str,
+                  window_s: float) -> dict[str, tuple[str, float]]:
+    """Return {topic: (type, messages per second)} received over ``window_s`` seconds."""
+    topics = graph_topics(node, namespace)
+    counts = dict.fromkeys(topics, 0)
+    subscriptions = []
+    for topic, type_name in topics.items():
+        def count(_data: bytes, topic: str = topic) -> None:
+            counts[topic] += 1
+        try:
+            msg_class = message_class(type_name)
+        except (ImportError, AttributeError, ValueError):
+            continue
+        subscriptions.append(node.create_subscription(
+            msg_class, topic, count, matching_qos(node, topic, 100), raw=True))
+    # Let the subscriptions match their publishers (and latched samples arrive) before counting.
+    settle_until = time.monotonic() + 0.5
+    while time.monotonic() < settle_until:
+        executor.spin_once(timeout_sec=0.05)
+    counts = dict.fromkeys(topics, 0)
+    start = time.monotonic()
+    while time.monotonic() - start < window_s:
+        executor.spin_once(timeout_sec=0.05)
+    elapsed = time.monotonic() - start
+    for subscription in subscriptions:
+        node.destroy_subscription(subscription)
+    return {topic: (topics[topic], counts[topic] / elapsed) for topic in sorted(topics)}

@@ -1,0 +1,55 @@
+"""`wirefish record`: record every wirefish topic and /diagnostics into a rosbag2 (MCAP) bag."""
+
+import argparse
+from datetime import datetime
+from pathlib import Path
+import sys
+
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish record`."""
+    parser.add_argument('-o', '--output', type=Path, default=None,
+                        help='bag directory (default: out/bags/wirefish_<time>); must not exist')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('--duration', type=float, default=None,
+                        help='stop after this many seconds (default: until Ctrl-C)')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish record`; return the process exit code."""
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+
+    from wirefish_bringup.recorder import BagRecorder
+
+    try:
+        namespace = validate_namespace(args.namespace)
+    except ValueError as error:
+        print(f'wirefish record: {error}', file=sys.stderr)
+        return 2
+    bag_path = args.output or Path('out', 'bags',
+                                   datetime.now().strftime('wirefish_%Y%m%d_%H%M%S'))
+    if bag_path.exists():
+        print(f'wirefish record: {bag_path} exists; choose a new -o', file=sys.stderr)
+        return 2
+    bag_path.parent.mkdir(parents=True, exist_ok=True)
+    rclpy.init()
+    recorder = BagRecorder(bag_path, namespace)
+    if args.duration is not None:
+        recorder.create_timer(args.duration, lambda: rclpy.try_shutdown())
+    try:
+        rclpy.spin(recorder)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        recorder.close()
+        counts = dict(recorder.counts)
+        recorder.destroy_node()
+        rclpy.try_shutdown()
+    total = sum(counts.values())
+    print(f'wrote {total} messages on {len(counts)} topics to {bag_path}')
+    for topic, count in sorted(counts.items()):
+        print(f'  {topic:<40} {count:>7}')
+    return 0

@@ -1,0 +1,117 @@
+"""
+Start the graph's processes, watch them, and stop every one of them cleanly.
+
+What `ros2 launch` does for a full install, in plain subprocess calls: each node is a child in
+its own session (so a terminal's Ctrl-C reaches only the supervisor, which then sends exactly one
+SIGINT to each child, in reverse start order), with a parent-death signal (so no child outlives
+a supervisor that was killed), its output in a log file of its own.
+"""
+
+from collections.abc import Sequence
+import ctypes
+import os
+from pathlib import Path
+import signal
+import subprocess
+import time
+
+from wirefish_bringup.graph import NodeSpec
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:  # runs in the child between fork and exec
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+
+
+class ProcessExitedError(RuntimeError):
+    """A process of the graph exited while the graph was supposed to run."""
+
+
+class Supervisor:
+    """Owns the graph's child processes from start to clean stop."""
+
+    def __init__(self, log_dir: Path, env: dict[str, str] | None = None) -> None:
+        self._log_dir = log_dir
+        self._env = dict(os.environ if env is None else env)
+        self._env.setdefault('PYTHONUNBUFFERED', '1')
+        self._env.setdefault('RCUTILS_COLORIZED_OUTPUT', '0')
+        self.processes: dict[str, subprocess.Popen] = {}
+        self._logs: list = []
+
+    def start(self, spec: NodeSpec) -> subprocess.Popen:
+        """Start one process of the graph; its output goes to ``<log_dir>/<name>.log``."""
+        self._log_dir.mkdir(parents=True, exist_ok=True)
+        executable = spec.executable_path()
+        if not executable.is_file():
+            raise FileNotFoundError(f'{spec.package}/{spec.executable} is not installed at '
+                                    f'{executable}: run `make setup`')
+        log = open(self._log_dir / f'{spec.name}.log', 'w', buffering=1)
+        self._logs.append(log)
+        proc = subprocess.Popen([str(executable), *spec.arguments], env=self._env,
+                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                start_new_session=True, preexec_fn=_die_with_parent)
+        self.processes[spec.name] = proc
+        return proc
+
+    def exited(self) -> dict[str, int]:
+        """Return the processes that have exited, with their exit codes."""
+        return {name: proc.returncode for name, proc in self.processes.items()
+                if proc.poll() is not None}
+
+    def log_tail(self, name: str, lines: int = 15) -> str:
+        """Return the last lines of one process's log (for error messages)."""
+        path = self._log_dir / f'{name}.log'
+        try:
+            return '\n'.join(path.read_text(errors='replace').splitlines()[-lines:])
+        except OSError:
+            return ''
+
+    def stop(self, timeout_s: float = 5.0) -> dict[str, int | None]:
+        """
+        SIGINT every process (reverse start order), escalate after ``timeout_s``.
+
+        Returns each process's exit code; None for one that had to be killed.
+        """
+        procs = list(self.processes.items())[::-1]
+        for _, proc in procs:
+            self._signal(proc, signal.SIGINT)
+        deadline = time.monotonic() + timeout_s
+        codes: dict[str, int | None] = {}
+        for name, proc in procs:
+            try:
+                codes[name] = proc.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                self._signal(proc, signal.SIGTERM)
+                try:
+                    proc.wait(timeout=2.0)
+                    codes[name] = None
+                except subprocess.TimeoutExpired:
+                    self._signal(proc, signal.SIGKILL)
+                    proc.wait()
+                    codes[name] = None
+        for log in self._logs:
+            log.close()
+        self._logs.clear()
+        return codes
+
+    @staticmethod
+    def _signal(proc: subprocess.Popen, signum: int) -> None:
+        if proc.poll() is None:
+            try:
+                os.killpg(proc.pid, signum)
+            except ProcessLookupError:
+                pass
+
+
+def wait_for_path(path: Path, procs: Sequence[subprocess.Popen], timeout_s: float) -> bool:
+    """Wait until ``path`` exists, giving up early if any of ``procs`` exits."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if path.exists():
+            return True
+        if any(proc.poll() is not None for proc in procs):
+            return False
+        time.sleep(0.05)
+    return path.exists()
