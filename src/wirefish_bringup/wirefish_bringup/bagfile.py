@@ -1,8 +1,10 @@
 """rosbag2 files through `rosbags` (pure Python): the type store that knows wirefish_msgs."""
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
+from rosbags.highlevel import AnyReader
 from rosbags.typesys import get_types_from_msg, get_typestore, Stores
 from rosbags.typesys.store import Typestore
 
@@ -23,3 +25,28 @@ def wirefish_typestore() -> Typestore:
             types.update(get_types_from_msg(path.read_text(), f'{package}/msg/{path.stem}'))
     store.register(types)
     return store
+
+
+@dataclass
+class Bag:
+    """All messages of a bag, decoded: {topic: [(receive time s, message), ...]}."""
+
+    path: Path
+    types: dict[str, str]
+    messages: dict[str, list]
+    start_s: float
+    duration_s: float
+
+
+def read_bag(path: Path, topics: list[str] | None = None) -> Bag:
+    """Read and decode every message (optionally only ``topics``) of a rosbag2 bag."""
+    store = wirefish_typestore()
+    with AnyReader([Path(path)], default_typestore=store) as reader:
+        connections = [c for c in reader.connections if topics is None or c.topic in topics]
+        types = {c.topic: c.msgtype for c in connections}
+        messages: dict[str, list] = {topic: [] for topic in types}
+        for connection, timestamp, raw in reader.messages(connections=connections):
+            messages[connection.topic].append(
+                (timestamp * 1e-9, reader.deserialize(raw, connection.msgtype)))
+        return Bag(Path(path), types, messages, reader.start_time * 1e-9,
+                   (reader.end_time - reader.start_time) * 1e-9)

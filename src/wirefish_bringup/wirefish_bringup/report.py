@@ -1,0 +1,168 @@
+"""
+`wirefish report BAG`: plots and a summary table from a recorded run.
+
+PNGs: the CPG outputs, a body-wave snapshot against the desired wave, the estimated speed
+against the virtual fish's ground truth, the IMU attitude. The table: per topic, the message
+count, the mean rate and the gaps between consecutive header stamps (a gap over 1.5 median
+periods counts as a drop), and the bridge's link counters from /diagnostics.
+"""
+
+import argparse
+from dataclasses import dataclass
+from pathlib import Path
+import sys
+
+import numpy as np
+
+from wirefish_bringup.bagfile import read_bag
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish report`."""
+    parser.add_argument('bag', type=Path, help='rosbag2 directory (wirefish record / up)')
+    parser.add_argument('-o', '--output', type=Path, default=None,
+                        help='where the PNGs and summary go (default: <bag>_report)')
+
+
+@dataclass(frozen=True)
+class TopicStats:
+    """Counts and timing of one topic in a bag."""
+
+    topic: str
+    type_name: str
+    count: int
+    rate_hz: float
+    median_period_s: float
+    max_gap_s: float
+    drops: int
+
+
+def topic_stats(topic: str, type_name: str, stamps_s: np.ndarray) -> TopicStats:
+    """Summarise one topic from its message stamps (s), header stamps where it has them."""
+    count = len(stamps_s)
+    if count < 2:
+        return TopicStats(topic, type_name, count, 0.0, float('nan'), float('nan'), 0)
+    periods = np.diff(np.sort(stamps_s))
+    median = float(np.median(periods))
+    span = float(stamps_s.max() - stamps_s.min())
+    drops = int(np.sum(np.round(periods[periods > 1.5 * median] / median) - 1)) \
+        if median > 0 else 0
+    return TopicStats(topic, type_name, count, (count - 1) / span if span > 0 else 0.0,
+                      median, float(periods.max()), drops)
+
+
+def _series(bag, topic: str) -> list:
+    return bag.messages.get(topic, [])
+
+
+def _stamp(msg) -> float:
+    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+
+
+def write_report(bag_path: Path, out_dir: Path) -> list[TopicStats]:
+    """Write the PNGs and summary.txt of ``bag_path`` into ``out_dir``; return the stats."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    bag = read_bag(bag_path)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stats = []
+    for topic, type_name in sorted(bag.types.items()):
+        msgs = _series(bag, topic)
+        if msgs and hasattr(msgs[0][1], 'header'):
+            stamps = np.array([_stamp(m) for _, m in msgs])
+        else:
+            stamps = np.array([t for t, _ in msgs])
+        stats.append(topic_stats(topic, type_name, stamps))
+    t0 = bag.start_s
+
+    def find(suffix: str) -> str | None:
+        return next((t for t in bag.types if t.endswith(suffix)), None)
+
+    servo = find('/servo_cmd')
+    if servo:
+        msgs = _series(bag, servo)
+        t = np.array([_stamp(m) for _, m in msgs]) - t0
+        pos = np.array([list(m.position) for _, m in msgs])
+        fig, ax = plt.subplots(figsize=(8, 3.5))
+        for i in range(pos.shape[1]):
+            ax.plot(t, pos[:, i], label=f'servo_{i + 1}')
+        ax.set(xlabel='time (s)', ylabel='angle (rad)', title='CPG outputs (servo_cmd)')
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out_dir / 'cpg_outputs.png', dpi=110)
+        plt.close(fig)
+    wave = find('/body_wave')
+    if wave and _series(bag, wave):
+        msg = _series(bag, wave)[-1][1]
+        fig, ax = plt.subplots(figsize=(7, 3.5))
+        ax.plot(msg.x, msg.y, '-', label='tail (kinematics)')
+        if len(msg.y_desired):
+            ax.plot(msg.x, msg.y_desired, ':', label='desired (eq 23)')
+        ax.set(xlabel='x in tail_base (m)', ylabel='y (m)', title='Body wave, last snapshot')
+        ax.axis('equal')
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out_dir / 'body_wave.png', dpi=110)
+        plt.close(fig)
+    speed = find('/speed_estimate')
+    truth = find('/sim/ground_truth')
+    if speed or truth:
+        fig, ax = plt.subplots(figsize=(8, 3.5))
+        if speed:
+            msgs = _series(bag, speed)
+            ax.plot([_stamp(m) - t0 for _, m in msgs], [m.speed for _, m in msgs], '.-',
+                    label='Lighthill estimate (eq 18)')
+        if truth:
+            msgs = _series(bag, truth)
+            ax.plot([_stamp(m) - t0 for _, m in msgs], [m.twist.twist.linear.x for _, m in msgs],
+                    label='virtual fish (ground truth)')
+        ax.set(xlabel='time (s)', ylabel='surge speed (m/s)', title='Swimming speed')
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out_dir / 'speed.png', dpi=110)
+        plt.close(fig)
+    attitude = find('/attitude')
+    if attitude:
+        msgs = _series(bag, attitude)
+        t = np.array([_stamp(m) for _, m in msgs]) - t0
+        fig, ax = plt.subplots(figsize=(8, 3.5))
+        for name in ('x', 'y', 'z'):
+            ax.plot(t, np.degrees([getattr(m.vector, name) for _, m in msgs]),
+                    label={'x': 'roll', 'y': 'pitch', 'z': 'yaw'}[name])
+        ax.set(xlabel='time (s)', ylabel='angle (deg)', title='IMU attitude')
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out_dir / 'attitude.png', dpi=110)
+        plt.close(fig)
+    (out_dir / 'summary.txt').write_text(summary_table(stats, bag) + '\n')
+    return stats
+
+
+def summary_table(stats: list[TopicStats], bag) -> str:
+    """Return the per-topic table and the bridge's last diagnostic counters as text."""
+    lines = [f'bag: {bag.path}  duration {bag.duration_s:.1f} s',
+             f'{"topic":<34} {"count":>7} {"rate Hz":>8} {"max gap s":>9} {"drops":>6}']
+    for s in stats:
+        lines.append(f'{s.topic:<34} {s.count:>7} {s.rate_hz:>8.1f} {s.max_gap_s:>9.3f} '
+                     f'{s.drops:>6}')
+    diagnostics = _series(bag, '/diagnostics')
+    if diagnostics:
+        lines.append('last /diagnostics:')
+        for status in diagnostics[-1][1].status:
+            values = ', '.join(f'{kv.key}={kv.value}' for kv in status.values)
+            lines.append(f'  {status.name}: {status.message} ({values})')
+    return '\n'.join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish report`; return the process exit code."""
+    if not (args.bag / 'metadata.yaml').is_file():
+        print(f'wirefish report: {args.bag} is not a rosbag2 directory', file=sys.stderr)
+        return 2
+    out_dir = args.output or args.bag.with_name(args.bag.name + '_report')
+    stats = write_report(args.bag, out_dir)
+    print((out_dir / 'summary.txt').read_text(), end='')
+    print(f'PNGs in {out_dir}: {", ".join(sorted(p.name for p in out_dir.glob("*.png")))}')
+    return 0 if stats else 1
