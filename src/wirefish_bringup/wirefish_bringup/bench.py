@@ -1,0 +1,114 @@
+"""
+`make bench`: run every benchmark once and rewrite BENCHMARKS.md (+ out/bench/results.json).
+
+Figures are medians (and p99 where latency) from one run on this machine; goals come from the
+project's issues. A benchmark that fails is reported as such, never left out.
+"""
+
+import argparse
+from datetime import datetime, timezone
+import json
+import os
+from pathlib import Path
+import platform
+import subprocess
+import sys
+import tempfile
+import traceback
+
+import numpy as np
+
+WORKSPACE = Path(__file__).resolve().parents[3] if (
+    Path(__file__).resolve().parents[3] / 'Makefile').is_file() else Path.cwd()
+DOMAIN = int(os.environ.get('WIREFISH_BENCH_DOMAIN', '101'))
+
+
+def machine() -> dict:
+    """Describe the machine the figures come from."""
+    cpu = platform.processor() or 'unknown CPU'
+    try:
+        for line in Path('/proc/cpuinfo').read_text().splitlines():
+            if line.startswith('model name'):
+                cpu = line.split(':', 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {'cpu': cpu, 'cores': os.cpu_count(), 'python': platform.python_version(),
+            'numpy': np.__version__, 'kernel': platform.release(),
+            'date': datetime.now(timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}
+
+
+def recording(duration_s: float, domain_id: int) -> dict:
+    """Run the whole graph with `wirefish up --duration`, then count what reached the bag."""
+    from wirefish_bringup.report import write_report
+
+    out = Path(tempfile.mkdtemp(prefix='wirefish_bench_rec_'))
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    subprocess.run([sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+                    '--duration', str(duration_s), '--out', str(out), '--namespace',
+                    '/bench_rec'], env=env, check=True, capture_output=True,
+                   timeout=duration_s + 120)
+    bag = next(out.glob('run_*/bag'))
+    stats = write_report(bag, bag.parent / 'report')
+    return {'duration_s': duration_s,
+            'topics': {s.topic: {'count': s.count, 'rate_hz': s.rate_hz, 'drops': s.drops}
+                       for s in stats},
+            'messages': sum(s.count for s in stats),
+            'drops': sum(s.drops for s in stats)}
+
+
+def _run(name: str, func, *args, **kwargs):
+    print(f'bench: {name} ...', flush=True)
+    try:
+        return func(*args, **kwargs)
+    except Exception as error:  # a failed benchmark is a figure too: say what failed
+        traceback.print_exc()
+        return {'error': f'{type(error).__name__}: {error}'}
+
+
+def run_all(quick: bool = False) -> dict:
+    """Run every benchmark; ``quick`` shortens the windows (for trying the harness)."""
+    from wirefish_bringup import bench_graph
+
+    scale = 0.2 if quick else 1.0
+    results: dict = {'machine': machine()}
+    results['cpg_rate'] = [_run(f'cpg at {r} Hz', bench_graph.cpg_rate, r, 10.0 * scale, DOMAIN)
+                           for r in (200.0, 500.0, 1000.0)]
+    try:
+        from wirefish_bringup import bench_links
+        results['links'] = _run('command/telemetry latency', bench_links.run)
+    except ImportError as error:
+        results['links'] = {'error': f'not available: {error}'}
+    try:
+        from wirefish_bringup import bench_retune
+        results['retune'] = _run('retune', bench_retune.run)
+    except ImportError as error:
+        results['retune'] = {'error': f'not available: {error}'}
+    results['kinematics_cpu'] = [
+        _run(f'kinematics {s} x {r}', bench_graph.kinematics_cpu, s, r, 10.0 * scale, DOMAIN)
+        for s, r in ((50, 50.0), (500, 200.0))]
+    results['recording'] = _run('recording', recording, 60.0 * scale, DOMAIN)
+    results['fleet'] = [_run(f'{n} fish', bench_graph.fleet, n, 10.0 * scale, DOMAIN)
+                        for n in (1, 2, 4, 8)]
+    return results
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmarks, write the JSON and BENCHMARKS.md."""
+    from wirefish_bringup.bench_report import render_markdown
+
+    parser = argparse.ArgumentParser(prog='wirefish-bench', description=__doc__.strip())
+    parser.add_argument('--quick', action='store_true', help='short windows (harness check)')
+    parser.add_argument('--out', type=Path, default=WORKSPACE / 'out' / 'bench')
+    parser.add_argument('--markdown', type=Path, default=WORKSPACE / 'BENCHMARKS.md')
+    args = parser.parse_args(argv)
+    results = run_all(quick=args.quick)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / 'results.json').write_text(json.dumps(results, indent=2, default=str))
+    args.markdown.write_text(render_markdown(results))
+    print(f'wrote {args.markdown} and {args.out / "results.json"}')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,164 @@
+"""
+Benchmarks of the running graph: publish-rate jitter, node CPU, recording loss, many fish.
+
+Each function starts real node processes (own ROS domain), measures from the receiving side
+and returns plain figures; `wirefish_bringup.bench` runs them all and writes BENCHMARKS.md.
+Nothing here asserts: these are measurements, not tests.
+"""
+
+from contextlib import contextmanager
+import os
+from pathlib import Path
+import tempfile
+import time
+
+import numpy as np
+import psutil
+
+from wirefish_bringup.graph import fish_graph, NodeSpec
+from wirefish_bringup.supervisor import Supervisor, wait_for_path
+
+
+def percentiles_ms(values_s: np.ndarray) -> dict[str, float]:
+    """Return p50, p99 and max of ``values_s`` in milliseconds."""
+    if len(values_s) == 0:
+        return {'p50_ms': float('nan'), 'p99_ms': float('nan'), 'max_ms': float('nan')}
+    return {'p50_ms': float(np.percentile(values_s, 50) * 1e3),
+            'p99_ms': float(np.percentile(values_s, 99) * 1e3),
+            'max_ms': float(np.max(values_s) * 1e3)}
+
+
+@contextmanager
+def ros_session(domain_id: int):
+    """Yield (node, executor) of a benchmark-side rclpy context on ``domain_id``."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+
+    context = Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    node = rclpy.create_node('wirefish_bench', context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    try:
+        yield node, executor
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+@contextmanager
+def processes(specs: list[NodeSpec], domain_id: int, log_dir: Path | None = None):
+    """Start ``specs`` on ``domain_id``; yield the Supervisor; stop them all afterwards."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    log_dir = log_dir or Path(tempfile.mkdtemp(prefix='wirefish_bench_'))
+    supervisor = Supervisor(log_dir, env=env)
+    try:
+        for spec in specs:
+            proc = supervisor.start(spec)
+            if spec.executable == 'fish_sim':
+                link = Path(spec.arguments[spec.arguments.index('--link') + 1])
+                wait_for_path(link, [proc], 15.0)
+        yield supervisor
+    finally:
+        supervisor.stop()
+
+
+def cpu_percent(pids: list[int], window_s: float) -> dict[int, float]:
+    """Return each process's CPU use over ``window_s`` seconds, in % of one core."""
+    procs = {pid: psutil.Process(pid) for pid in pids}
+    start = {pid: p.cpu_times() for pid, p in procs.items()}
+    time.sleep(window_s)
+    result = {}
+    for pid, p in procs.items():
+        end = p.cpu_times()
+        used = (end.user + end.system) - (start[pid].user + start[pid].system)
+        result[pid] = 100.0 * used / window_s
+    return result
+
+
+def spin_for(executor, seconds: float) -> None:
+    """Spin ``executor`` for ``seconds`` of wall time."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+
+
+def cpg_rate(rate_hz: float, duration_s: float, domain_id: int) -> dict:
+    """CPG node at ``rate_hz``: achieved rate, receive-period error, the node's CPU."""
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+
+    spec = NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node',
+                    ('--ros-args', '-p', f'publish_rate_hz:={rate_hz}'))
+    arrivals: list[int] = []
+    with processes([spec], domain_id) as supervisor, ros_session(domain_id) as (node, executor):
+        node.create_subscription(JointState, 'servo_cmd',
+                                 lambda _msg: arrivals.append(time.perf_counter_ns()),
+                                 qos_profile_sensor_data)
+        spin_for(executor, 2.0)  # discovery and warm-up
+        arrivals.clear()
+        pid = supervisor.processes['cpg_node'].pid
+        start_cpu = psutil.Process(pid).cpu_times()
+        started = time.monotonic()
+        spin_for(executor, duration_s)
+        elapsed = time.monotonic() - started
+        end_cpu = psutil.Process(pid).cpu_times()
+    periods = np.diff(np.array(arrivals)) * 1e-9
+    error = np.abs(periods - 1.0 / rate_hz)
+    cpu = 100.0 * ((end_cpu.user + end_cpu.system) - (start_cpu.user + start_cpu.system)) / elapsed
+    return {'rate_hz': rate_hz, 'achieved_hz': len(arrivals) / elapsed,
+            **{f'period_error_{k}': v for k, v in percentiles_ms(error).items()},
+            'cpu_percent': cpu}
+
+
+def kinematics_cpu(stations: int, rate_hz: float, duration_s: float, domain_id: int) -> dict:
+    """Kinematics node CPU with ``stations`` stations published at ``rate_hz``."""
+    specs = [NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node', ()),
+             NodeSpec('wirefish_kinematics', 'kinematics_node', 'kinematics_node', (
+                 '--ros-args', '-p', f'station_count:={stations}',
+                 '-p', f'publish_rate_hz:={rate_hz}'))]
+    with processes(specs, domain_id) as supervisor:
+        time.sleep(3.0)
+        pid = supervisor.processes['kinematics_node'].pid
+        cpu = cpu_percent([pid], duration_s)[pid]
+        alive = not supervisor.exited()
+    return {'stations': stations, 'rate_hz': rate_hz, 'cpu_percent': cpu, 'ran': alive}
+
+
+def fleet(fish: int, duration_s: float, domain_id: int) -> dict:
+    """``fish`` whole graphs (namespaces /fish_1..) at default rates: rates and total CPU."""
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import Imu, JointState
+
+    specs: list[NodeSpec] = []
+    for i in range(1, fish + 1):
+        specs += fish_graph(f'/bench_fish_{i}', sim=True)
+    counts = {('servo_cmd', i): 0 for i in range(1, fish + 1)}
+    counts.update({('imu/data', i): 0 for i in range(1, fish + 1)})
+    with processes(specs, domain_id) as supervisor, ros_session(domain_id) as (node, executor):
+        for i in range(1, fish + 1):
+            for topic, msg_type in (('servo_cmd', JointState), ('imu/data', Imu)):
+                def count(_m, key=(topic, i)) -> None:
+                    counts[key] += 1
+                node.create_subscription(msg_type, f'/bench_fish_{i}/{topic}', count,
+                                         qos_profile_sensor_data)
+        spin_for(executor, 5.0)
+        for key in counts:
+            counts[key] = 0
+        pids = [p.pid for p in supervisor.processes.values()]
+        procs = [psutil.Process(pid) for pid in pids]
+        cpu_start = sum(p.cpu_times().user + p.cpu_times().system for p in procs)
+        started = time.monotonic()
+        spin_for(executor, duration_s)
+        elapsed = time.monotonic() - started
+        cpu_end = sum(p.cpu_times().user + p.cpu_times().system for p in procs)
+        crashed = sorted(supervisor.exited())
+    servo = [counts[('servo_cmd', i)] / elapsed for i in range(1, fish + 1)]
+    imu = [counts[('imu/data', i)] / elapsed for i in range(1, fish + 1)]
+    return {'fish': fish, 'processes': len(specs),
+            'servo_cmd_hz_min': min(servo), 'servo_cmd_hz_median': float(np.median(servo)),
+            'imu_hz_min': min(imu), 'imu_hz_median': float(np.median(imu)),
+            'cpu_percent_total': 100.0 * (cpu_end - cpu_start) / elapsed,
+            'crashed': crashed}
