@@ -1,0 +1,245 @@
+"""
+Ijspeert's coupled phase oscillators (paper eq 1), integrated with a fixed-step RK4.
+
+Per oscillator i the state is the phase xi_i, the amplitude r_i and its rate, and the offset
+b_i and its rate::
+
+    d xi_i / dt = 2 pi v_i + sum_j r_j w_ij sin(xi_j - xi_i - phi_ij)
+    r_i''      = alpha (alpha / 4 (R_i - r_i) - r_i')
+    b_i''      = alpha (alpha / 4 (B_i - b_i) - b_i')      (offset: same law as r, see below)
+    Theta_i    = r_i cos(xi_i) + b_i
+
+The paper sets the offset b_i directly; here it converges to its target B_i by the same
+critically damped law as the amplitude, so a turning command is as smooth as a change of
+amplitude. The state persists across parameter changes, so no change produces a step in the
+output angle or its rate (only its second derivative jumps).
+
+Everything is vectorised: arrays of shape (..., N) hold one network per leading index, so the
+same code integrates one network or a whole PSO swarm (``NetworkArrays`` with shape (P, N)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+
+# Layout of the state array (..., 5, N): one row per state variable.
+PHASE, AMPLITUDE, AMPLITUDE_RATE, OFFSET, OFFSET_RATE = range(5)
+STATE_ROWS = 5
+NUM_SERVOS = 2
+
+
+def _finite(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f'{name} must be finite, got {value}')
+    return value
+
+
+@dataclass(frozen=True)
+class CpgParameters:
+    """
+    Parameters of the fish's two-oscillator network (eq 1); SI units and radians.
+
+    ``amplitude`` = (R_1, R_2) rad, ``offset`` = (B_1, B_2) rad (targets of r_i and b_i),
+    ``w12``/``w21`` the coupling weights omega_12 (of oscillator 2 on 1) and omega_21 (1/s),
+    ``phi12``/``phi21`` the phase biases (rad), ``alpha`` the convergence gain (1/s), and
+    ``frequency_hz`` the intrinsic frequency v shared by both oscillators (Hz). Defaults are
+    Table 1 of the paper with v = 1 Hz, alpha = 20, b = 0. Raises ``ValueError`` if invalid.
+    """
+
+    frequency_hz: float = 1.0
+    amplitude: tuple[float, float] = (0.38, 0.47)
+    offset: tuple[float, float] = (0.0, 0.0)
+    w12: float = -0.41
+    w21: float = 0.64
+    phi12: float = 1.76
+    phi21: float = 1.06
+    alpha: float = 20.0
+
+    def __post_init__(self) -> None:
+        for name in ('frequency_hz', 'w12', 'w21', 'phi12', 'phi21', 'alpha'):
+            object.__setattr__(self, name, _finite(name, getattr(self, name)))
+        for name in ('amplitude', 'offset'):
+            values = tuple(_finite(name, v) for v in np.ravel(getattr(self, name)))
+            if len(values) != NUM_SERVOS:
+                raise ValueError(f'{name} needs {NUM_SERVOS} values, got {len(values)}')
+            object.__setattr__(self, name, values)
+        if self.frequency_hz <= 0.0:
+            raise ValueError(f'frequency_hz must be > 0, got {self.frequency_hz}')
+        if self.alpha <= 0.0:
+            raise ValueError(f'alpha must be > 0, got {self.alpha}')
+
+    def coupling_weights(self) -> np.ndarray:
+        """Return W (2, 2) with W[i, j] = omega_ij (1/s) and a zero diagonal."""
+        return np.array([[0.0, self.w12], [self.w21, 0.0]])
+
+    def phase_biases(self) -> np.ndarray:
+        """Return Phi (2, 2) with Phi[i, j] = phi_ij (rad) and a zero diagonal."""
+        return np.array([[0.0, self.phi12], [self.phi21, 0.0]])
+
+
+@dataclass(frozen=True)
+class NetworkArrays:
+    """
+    Eq 1's parameters as arrays for vectorised integration of many networks at once.
+
+    Shapes: ``frequency_hz``, ``amplitude``, ``offset``, ``alpha`` (..., N);
+    ``weights`` and ``biases`` (..., N, N) with [i, j] the influence of j on i.
+    """
+
+    frequency_hz: np.ndarray
+    amplitude: np.ndarray
+    offset: np.ndarray
+    weights: np.ndarray
+    biases: np.ndarray
+    alpha: np.ndarray = field(default_factory=lambda: np.array(20.0))
+
+    @classmethod
+    def from_parameters(cls, params: CpgParameters) -> NetworkArrays:
+        """Return the arrays (shape (2,) and (2, 2)) of one fish network."""
+        return cls(frequency_hz=np.full(NUM_SERVOS, params.frequency_hz),
+                   amplitude=np.asarray(params.amplitude),
+                   offset=np.asarray(params.offset),
+                   weights=params.coupling_weights(),
+                   biases=params.phase_biases(),
+                   alpha=np.full(NUM_SERVOS, params.alpha))
+
+    @classmethod
+    def stack(cls, params: list[CpgParameters]) -> NetworkArrays:
+        """Return the arrays of P fish networks, shapes (P, 2) and (P, 2, 2)."""
+        singles = [cls.from_parameters(p) for p in params]
+        return cls(**{name: np.stack([getattr(s, name) for s in singles])
+                      for name in ('frequency_hz', 'amplitude', 'offset', 'weights',
+                                   'biases', 'alpha')})
+
+
+def initial_state(shape: tuple[int, ...] = (), oscillators: int = NUM_SERVOS) -> np.ndarray:
+    """Return the state at rest (all phases, amplitudes, offsets and rates 0), (*shape, 5, N)."""
+    return np.zeros(shape + (STATE_ROWS, oscillators))
+
+
+def eq1_derivative(state: np.ndarray, net: NetworkArrays) -> np.ndarray:
+    """
+    Return d(state)/dt of the oscillator network, eq 1 (plus the offset law), (..., 5, N).
+
+    ``state`` (..., 5, N) rows: phase (rad), amplitude (rad), amplitude rate (rad/s),
+    offset (rad), offset rate (rad/s).
+    """
+    xi = state[..., PHASE, :]
+    r = state[..., AMPLITUDE, :]
+    alpha = net.alpha
+    # sin(xi_j - xi_i - phi_ij): rows i, columns j.
+    pair = np.sin(xi[..., None, :] - xi[..., :, None] - net.biases)
+    d = np.empty_like(state)
+    d[..., PHASE, :] = 2.0 * np.pi * net.frequency_hz + np.sum(
+        net.weights * r[..., None, :] * pair, axis=-1)
+    d[..., AMPLITUDE, :] = state[..., AMPLITUDE_RATE, :]
+    d[..., AMPLITUDE_RATE, :] = alpha * (
+        0.25 * alpha * (net.amplitude - r) - state[..., AMPLITUDE_RATE, :])
+    d[..., OFFSET, :] = state[..., OFFSET_RATE, :]
+    d[..., OFFSET_RATE, :] = alpha * (
+        0.25 * alpha * (net.offset - state[..., OFFSET, :]) - state[..., OFFSET_RATE, :])
+    return d
+
+
+def rk4_step(state: np.ndarray, step_s: float, net: NetworkArrays) -> np.ndarray:
+    """Return the state one classical Runge-Kutta step of ``step_s`` seconds later."""
+    k1 = eq1_derivative(state, net)
+    k2 = eq1_derivative(state + 0.5 * step_s * k1, net)
+    k3 = eq1_derivative(state + 0.5 * step_s * k2, net)
+    k4 = eq1_derivative(state + step_s * k3, net)
+    return state + (step_s / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+def output_angles(state: np.ndarray, net: NetworkArrays) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the outputs Theta_i = r_i cos(xi_i) + b_i (rad) and their rates (rad/s), eq 1.
+
+    Both (..., N). The rate is the exact time derivative of the output along the flow.
+    """
+    xi = state[..., PHASE, :]
+    r = state[..., AMPLITUDE, :]
+    xi_rate = eq1_derivative(state, net)[..., PHASE, :]
+    angle = r * np.cos(xi) + state[..., OFFSET, :]
+    rate = (state[..., AMPLITUDE_RATE, :] * np.cos(xi) - r * xi_rate * np.sin(xi)
+            + state[..., OFFSET_RATE, :])
+    return angle, rate
+
+
+def simulate(net: NetworkArrays, duration_s: float, step_s: float,
+             state: np.ndarray | None = None, record_every: int = 1
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Integrate eq 1 from ``state`` (default: at rest) for ``duration_s`` in fixed RK4 steps.
+
+    Works for one network (arrays (N,)) or a batch (arrays (P, N)). Returns
+    ``(t (T,), angles (T, ..., N), rates (T, ..., N), final_state (..., 5, N))`` sampled every
+    ``record_every`` steps, starting with the initial state at t = 0.
+    """
+    steps = int(round(duration_s / step_s))
+    if state is None:
+        batch_shape = np.broadcast_shapes(np.shape(net.amplitude), np.shape(net.frequency_hz))
+        state = initial_state(batch_shape[:-1], batch_shape[-1])
+    times, angles, rates = [], [], []
+    for n in range(steps + 1):
+        if n % record_every == 0:
+            angle, rate = output_angles(state, net)
+            times.append(n * step_s)
+            angles.append(angle)
+            rates.append(rate)
+        if n < steps:
+            state = rk4_step(state, step_s, net)
+    return np.array(times), np.array(angles), np.array(rates), state
+
+
+class CpgIntegrator:
+    """
+    A running fish CPG: fixed-step RK4 on an internal clock, independent of the output rate.
+
+    ``advance(t)`` integrates whole steps up to time ``t``; ``output(t)`` evaluates the outputs
+    exactly at ``t`` by a partial step that is not committed, so the publish rate never changes
+    the trajectory. ``set_parameters`` swaps the targets and keeps the state (no output step).
+    """
+
+    def __init__(self, params: CpgParameters, step_s: float = 1e-3, time_s: float = 0.0,
+                 state: np.ndarray | None = None) -> None:
+        """Start at rest (or at ``state`` (5, 2)) at time ``time_s`` with RK4 step ``step_s``."""
+        self._net = NetworkArrays.from_parameters(params)
+        self._params = params
+        self.step_s = float(step_s)
+        self.time_s = float(time_s)
+        self.state = initial_state() if state is None else np.array(state, dtype=float)
+
+    @property
+    def parameters(self) -> CpgParameters:
+        """Return the parameters currently driving the network."""
+        return self._params
+
+    def set_parameters(self, params: CpgParameters) -> None:
+        """Change the targets; state and time persist, so outputs stay continuous."""
+        self._params = params
+        self._net = NetworkArrays.from_parameters(params)
+
+    def advance(self, time_s: float, max_steps: int = 100_000) -> None:
+        """
+        Integrate whole steps while they end at or before ``time_s`` (s).
+
+        A clock that jumps backwards or far ahead (more than ``max_steps`` steps) re-bases the
+        internal clock instead of integrating, keeping the state: outputs stay continuous.
+        """
+        steps = math.floor((time_s - self.time_s) / self.step_s + 1e-9)
+        if steps < 0 or steps > max_steps:
+            self.time_s = float(time_s)
+            return
+        for _ in range(steps):
+            self.state = rk4_step(self.state, self.step_s, self._net)
+        self.time_s += steps * self.step_s
+
+    def output(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Return (angles (2,) rad, rates (2,) rad/s) at ``time_s`` (within a step of now)."""
+        lead = min(max(time_s - self.time_s, 0.0), self.step_s)
+        state = self.state if lead == 0.0 else rk4_step(self.state, lead, self._net)
+        return output_angles(state, self._net)
