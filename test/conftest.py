@@ -17,10 +17,11 @@ import pytest
 from ros_utils import stop_process
 
 WORKSPACE = Path(__file__).resolve().parents[1]
-# Fast DDS maps a domain to UDP ports; 0..101 is the portable range. Each test takes the next
-# id in a window of 20, so a test never shares a domain with the one before it.
+# Fast DDS maps a domain to UDP ports; 0..101 is the portable range. A test run owns the window
+# [base, base + 20): each test takes the next of the first 19 ids (so a test never shares a
+# domain with the one before it); base + 19 is kept for module-scoped graphs (test/e2e).
 _DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21'))
-_domains = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 20))
+_domains = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 19))
 
 
 @pytest.fixture

@@ -119,11 +119,12 @@ def run(args: argparse.Namespace) -> int:
         code = 1
     finally:
         codes = supervisor.stop()
-    unclean = {name: rc for name, rc in codes.items() if rc not in (0, -signal.SIGINT)}
+    unclean = {name: rc for name, rc in codes.items() if rc != 0}
     if unclean:
         print(f'wirefish up: processes that did not exit cleanly: {unclean}', file=sys.stderr)
         code = code or 1
-    print(f'stopped {len(codes)} processes')
+    print(f'stopped {len(codes)} processes: '
+          + ', '.join(f'{name}={rc}' for name, rc in codes.items()))
     if bag_path is not None and bag_path.exists() and code == 0:
         from wirefish_bringup.report import write_report
         report_dir = run_dir / 'report'

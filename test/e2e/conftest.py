@@ -1,0 +1,44 @@
+"""Fixtures of the end-to-end tests: one whole graph shared by a module's tests."""
+
+from collections.abc import Iterator
+import os
+
+from e2e_utils import descendants, RunningGraph, start_graph
+import pytest
+from ros_utils import stop_process
+
+
+@pytest.fixture(scope='module')
+def e2e_domain_id() -> int:
+    """Return the ROS domain of this module's graph (outside the per-test window)."""
+    return int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21')) + 19
+
+
+@pytest.fixture(scope='module')
+def running_graph(e2e_domain_id: int, tmp_path_factory) -> Iterator[RunningGraph]:
+    """Yield one whole graph shared by the module's observation tests; stop it afterwards."""
+    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'))
+    children = descendants(graph.launcher.pid)
+    try:
+        yield graph
+    finally:
+        stop_process(graph.launcher, timeout_s=10.0)
+        for child in children:
+            if child.is_running():
+                child.kill()
+        graph.launcher.stdout.close()
+
+
+@pytest.fixture
+def graph_context(running_graph: RunningGraph, monkeypatch: pytest.MonkeyPatch):
+    """Yield an rclpy context of this test's own, on the shared graph's domain."""
+    import rclpy
+    from rclpy.context import Context
+
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    context = Context()
+    rclpy.init(context=context, domain_id=running_graph.domain_id)
+    try:
+        yield context
+    finally:
+        rclpy.try_shutdown(context=context)

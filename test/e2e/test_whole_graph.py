@@ -1,0 +1,136 @@
+"""
+The whole graph, started exactly as `make run` starts it, behaves as one robot.
+
+Every topic at its rate; a retune with apply changes the servo commands without a step; a
+10 s recording loses nothing; SIGINT stops every process with exit code 0 and leaves none.
+"""
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import qos_profile_sensor_data
+from ros_utils import spin_until
+from sensor_msgs.msg import JointState
+from wirefish_bringup.bagfile import read_bag
+from wirefish_bringup.monitor import measure_rates
+from wirefish_bringup.report import topic_stats
+from wirefish_msgs.srv import RetuneGait
+
+pytestmark = pytest.mark.ros
+
+# topic (relative to the namespace) -> nominal rate (Hz) at the default parameters.
+EXPECTED_RATES_HZ = {
+    'servo_cmd': 200.0,
+    'body_wave': 50.0,
+    'body_wave_markers': 50.0,
+    'imu/data': 100.0,
+    'attitude': 100.0,
+    'servo_state': 100.0,
+    'sim/ground_truth': 100.0,
+}
+# Slow topics: present, at least this often.
+EXPECTED_MIN_RATES_HZ = {'/diagnostics': 0.5, 'speed_estimate': 0.5, 'battery': 0.5}
+RATE_TOLERANCE = 0.10  # rates measured over 5 s on a shared 2-core machine
+
+
+def _full(namespace: str, topic: str) -> str:
+    return topic if topic.startswith('/') else f'{namespace}/{topic}'
+
+
+@pytest.fixture
+def graph_node(graph_context):
+    node = rclpy.create_node('e2e_probe', context=graph_context)
+    executor = SingleThreadedExecutor(context=graph_context)
+    executor.add_node(node)
+    yield node, executor
+    executor.shutdown()
+    node.destroy_node()
+
+
+def test_every_topic_arrives_at_its_rate(running_graph, graph_node):
+    node, executor = graph_node
+    wanted = [_full(running_graph.namespace, t)
+              for t in [*EXPECTED_RATES_HZ, *EXPECTED_MIN_RATES_HZ]]
+
+    def all_discovered() -> bool:
+        names = {name for name, _ in node.get_topic_names_and_types()}
+        return all(t in names and node.count_publishers(t) > 0 for t in wanted)
+
+    assert spin_until(executor, all_discovered, timeout_s=30.0), 'topics missing'
+    rates = measure_rates(node, executor, running_graph.namespace, window_s=5.0)
+    for topic, nominal in EXPECTED_RATES_HZ.items():
+        measured = rates[_full(running_graph.namespace, topic)][1]
+        assert measured == pytest.approx(nominal, rel=RATE_TOLERANCE), topic
+    for topic, minimum in EXPECTED_MIN_RATES_HZ.items():
+        assert rates[_full(running_graph.namespace, topic)][1] >= minimum, topic
+
+
+def test_retune_with_apply_changes_servo_cmd_without_a_step(running_graph, graph_node):
+    node, executor = graph_node
+    samples: list[tuple[float, float, float, float]] = []  # t, theta1, theta2, max |rate|
+
+    def on_servo(msg: JointState) -> None:
+        t = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        samples.append((t, msg.position[0], msg.position[1],
+                        max(abs(v) for v in msg.velocity)))
+
+    node.create_subscription(JointState, 'e2e/servo_cmd', on_servo, qos_profile_sensor_data)
+    client = node.create_client(RetuneGait, 'e2e/retune_gait')
+    assert spin_until(executor, client.service_is_ready, timeout_s=30.0)
+    assert spin_until(executor, lambda: len(samples) > 200, timeout_s=10.0)
+    before = np.array(samples)
+    request = RetuneGait.Request()
+    # A different wave from the defaults, so applying it visibly changes the gait.
+    request.wave.c1, request.wave.c2, request.wave.k = 0.10, 0.8, 6.0
+    request.wave.frequency_hz = 1.5
+    request.apply = True
+    request.seed = 3
+    future = client.call_async(request)
+    assert spin_until(executor, future.done, timeout_s=120.0)
+    response = future.result()
+    assert response.success, response.message
+    applied_at = samples[-1][0]
+    spin_until(executor, lambda: samples[-1][0] > applied_at + 3.0, timeout_s=20.0)
+    trace = np.array(samples)
+    dt = np.diff(trace[:, 0])
+    steps = np.abs(np.diff(trace[:, 1:3], axis=0)).max(axis=1)
+    # No output step beyond what the fastest motion can cover in one sample period.
+    bound = 1.5 * trace[:, 3].max() * np.maximum(dt, 1e-4)
+    assert np.all(steps <= bound + 1e-9)
+    # And the gait did change: the dominant frequency moved from 1 Hz towards 1.5 Hz.
+    after = trace[trace[:, 0] > applied_at + 1.5]
+    assert _zero_crossing_hz(after) > _zero_crossing_hz(before) + 0.25
+
+
+def _zero_crossing_hz(trace: np.ndarray) -> float:
+    theta = trace[:, 1] - trace[:, 1].mean()
+    crossings = np.sum(np.diff(np.signbit(theta).astype(int)) != 0)
+    return crossings / 2.0 / (trace[-1, 0] - trace[0, 0])
+
+
+def test_ten_second_recording_loses_nothing(running_graph, tmp_path):
+    bag_path = tmp_path / 'bag'
+    result = subprocess.run(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'record', '-o', str(bag_path),
+         '--namespace', running_graph.namespace, '--duration', '10'],
+        env=running_graph.env, capture_output=True, text=True, timeout=90)
+    assert result.returncode == 0, result.stderr
+    bag = read_bag(bag_path)
+    for topic, nominal in EXPECTED_RATES_HZ.items():
+        full = _full(running_graph.namespace, topic)
+        msgs = bag.messages[full]
+        if hasattr(msgs[0][1], 'header'):
+            stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec
+                               for _, m in msgs])
+        else:  # MarkerArray: the stamps of its markers
+            stamps = np.array([m.markers[0].header.stamp.sec
+                               + 1e-9 * m.markers[0].header.stamp.nanosec for _, m in msgs])
+        stats = topic_stats(full, bag.types[full], stamps)
+        assert stats.drops == 0, f'{full}: {stats}'
+        assert len(msgs) == pytest.approx(10.0 * nominal, rel=0.1), full
+    assert math.isclose(bag.duration_s, 10.0, abs_tol=1.5)
