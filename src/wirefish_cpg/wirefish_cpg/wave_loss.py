@@ -1,0 +1,191 @@
+"""
+The point-optimisation loss of paper eqs 24-25, evaluated exactly on the locked steady state.
+
+The six tuned values form a position vector ``(w12, w21, phi12, phi21, R1, R2)`` (the order of
+Fig 6(b)); a swarm is an array (P, 6). For each particle the stable phase difference and the
+locked frequency come in closed form (``steady_state``), so the outputs over the stabilised
+window [t_s, t_o] are known without integrating eq 1. Two decisions make the loss well posed:
+
+* Frequency. Coupling shifts the locked frequency away from 2 pi v (eq 1). The tuner therefore
+  chooses v so that the locked frequency equals the wave's (``intrinsic_frequency_for``; the
+  paper says v "can be determined by swing period T"). The loss is then a function of the
+  waveform only, and any window of whole periods gives the same loss per period. Particles whose
+  required v falls outside (0, ``max_frequency_hz``] are penalised.
+* Absolute phase. The CPG's phase after start-up is arbitrary, so the desired wave is referenced
+  to oscillator 1: oscillator 1's phase is set to the phase of the desired wave's fundamental at
+  q1 (shifted by pi when R1 < 0). y(q1) is an odd, increasing function of Theta_1 alone (eqs 3,
+  7), so this is the best alignment for q1; the optimiser only places q2 through Delta* and R2.
+
+The window is ``window_periods`` whole periods of the desired wave (default 1), sampled at
+``samples_per_period`` instants; the rectangle rule is the natural quadrature of a periodic
+integrand. The loss is in m*s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+from wirefish_kinematics.body_wave import body_positions, swing_angles
+from wirefish_kinematics.desired_wave import desired_lateral_position
+from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.wire_coupling import bend_angles
+
+from wirefish_cpg.oscillator import CpgParameters
+from wirefish_cpg.steady_state import intrinsic_frequency_for, stable_phase_difference
+
+PARAMETER_NAMES = ('w12', 'w21', 'phi12', 'phi21', 'amplitude_1', 'amplitude_2')
+# Paper section 4.2: w_ij in [-10, 10], phi_ij in [-pi, pi] rad, R_i in [-pi/2, pi/2] rad.
+PAPER_LOWER = np.array([-10.0, -10.0, -np.pi, -np.pi, -np.pi / 2, -np.pi / 2])
+PAPER_UPPER = -PAPER_LOWER
+# Loss added (m*s) when the locked frequency cannot be reached with an admissible v: far above
+# any real fit (a perfect miss of the section 5.2 wave costs about 0.08 m*s per period).
+FREQUENCY_PENALTY = 10.0
+
+
+@dataclass(frozen=True)
+class WaveSpec:
+    """
+    A desired Lighthill body wave (eq 23): envelope c1 (m/m), c2 (1/m), k (rad/m), f (Hz).
+
+    Raises ``ValueError`` unless all are finite, k > 0 and f in (0, 10].
+    """
+
+    c1: float = 0.15
+    c2: float = 1.0
+    k: float = 8.0
+    frequency_hz: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ('c1', 'c2', 'k', 'frequency_hz'):
+            value = float(getattr(self, name))
+            if not math.isfinite(value):
+                raise ValueError(f'{name} must be finite, got {value}')
+            object.__setattr__(self, name, value)
+        if self.k <= 0.0:
+            raise ValueError(f'k must be > 0, got {self.k}')
+        if not 0.0 < self.frequency_hz <= 10.0:
+            raise ValueError(f'frequency_hz must be in (0, 10] Hz, got {self.frequency_hz}')
+
+
+@dataclass(frozen=True)
+class WaveFitProblem:
+    """
+    Everything the loss needs besides the swarm: the wave, the fish, and the quadrature.
+
+    ``reverse_wave`` evaluates the desired wave at -t, i.e. travelling the other way than the
+    project's convention (used only to compare the two readings of eq 23).
+    """
+
+    wave: WaveSpec = field(default_factory=WaveSpec)
+    geometry: FishGeometry = field(default_factory=FishGeometry)
+    samples_per_period: int = 96
+    window_periods: int = 1
+    max_frequency_hz: float = 10.0
+    reverse_wave: bool = False
+
+    def stations(self) -> np.ndarray:
+        """Return q1 = l1 and q2 = l1 + l2 (m), the link ends O1 and O2 of eq 25, (2,)."""
+        g = self.geometry
+        return np.array([g.l1, g.l1 + g.l2])
+
+    def times(self) -> np.ndarray:
+        """Return the sample instants of one period, (N,) s, starting at 0."""
+        n = self.samples_per_period
+        return np.arange(n) / (n * self.wave.frequency_hz)
+
+    def desired(self) -> np.ndarray:
+        """Return y_body(q_i, t_n) of eq 23 at the stations, (N, 2) m."""
+        t = self.times()
+        t = -t if self.reverse_wave else t
+        w = self.wave
+        return np.asarray(desired_lateral_position(self.stations()[None, :], t[:, None],
+                                                   w.c1, w.c2, w.k, w.frequency_hz))
+
+
+@dataclass(frozen=True)
+class SwarmWaveforms:
+    """Locked outputs of a swarm: angles (P, N, 2) rad, Delta* (P,) rad, v (P,) Hz."""
+
+    angles: np.ndarray
+    delta: np.ndarray
+    intrinsic_hz: np.ndarray
+
+
+def swarm_waveforms(positions: np.ndarray, problem: WaveFitProblem,
+                    desired: np.ndarray | None = None) -> SwarmWaveforms:
+    """
+    Return the steady-state servo angles of every particle over one period (eq 1 locked).
+
+    ``positions`` (P, 6) in ``PARAMETER_NAMES`` order; the phase is referenced to oscillator 1
+    as described in the module docstring; offsets are 0 (paper section 4.1, straight motion).
+    """
+    w12, w21, phi12, phi21, r1, r2 = np.moveaxis(np.atleast_2d(positions), -1, 0)
+    delta = stable_phase_difference(r1, r2, w12, w21, phi12, phi21)
+    intrinsic = intrinsic_frequency_for(problem.wave.frequency_hz, r2, w12, phi12, delta)
+    desired = problem.desired() if desired is None else desired
+    omega_t = 2.0 * np.pi * problem.wave.frequency_hz * problem.times()
+    reference = np.angle(np.sum(desired[:, 0] * np.exp(-1j * omega_t)))
+    phase1 = reference + np.where(r1 < 0.0, np.pi, 0.0)
+    xi1 = omega_t[None, :] + phase1[:, None]
+    angles = np.stack([r1[:, None] * np.cos(xi1),
+                       r2[:, None] * np.cos(xi1 + delta[:, None])], axis=-1)
+    return SwarmWaveforms(angles=angles, delta=delta, intrinsic_hz=intrinsic)
+
+
+def lateral_positions(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """Return y(q_i, t) at the two link ends from servo angles (..., 2) (eqs 3-4, 7-11), m."""
+    beta1, beta2 = bend_angles(angles[..., 0], angles[..., 1], problem.geometry)
+    _, y = body_positions(problem.stations(), beta1, beta2, problem.geometry)
+    return np.asarray(y)
+
+
+def body_wave_loss(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """
+    Return eq 24's integral of eq 25's error for every particle, (P,) m*s.
+
+    e(t) = sum_i |y_body(q_i, t) - y(q_i, t)|, integrated over ``window_periods`` periods of
+    the locked steady state, plus ``FREQUENCY_PENALTY`` where no admissible v locks to the wave.
+    """
+    desired = problem.desired()
+    forms = swarm_waveforms(positions, problem, desired)
+    error = np.abs(desired[None] - lateral_positions(forms.angles, problem)).sum(axis=-1)
+    period = 1.0 / problem.wave.frequency_hz
+    loss = error.mean(axis=-1) * period * problem.window_periods
+    admissible = (forms.intrinsic_hz > 0.0) & (forms.intrinsic_hz <= problem.max_frequency_hz)
+    return np.where(admissible, loss, loss + FREQUENCY_PENALTY)
+
+
+def desired_swing_angles(problem: WaveFitProblem) -> np.ndarray:
+    """
+    Return the expected swing angles theta-bar_i (N, 2) rad of section 5.2, from eq 23.
+
+    The desired wave gives the lateral position y_body(q_i, t) of a station at axial
+    position q_i, so theta-bar_i = atan2(y_body(q_i, t), q_i).
+    """
+    return np.arctan2(problem.desired(), problem.stations()[None, :])
+
+
+def swing_angle_rmse_deg(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """Return the RMSE of theta_1, theta_2 against theta-bar over one period, (P, 2) degrees."""
+    forms = swarm_waveforms(positions, problem)
+    beta1, beta2 = bend_angles(forms.angles[..., 0], forms.angles[..., 1], problem.geometry)
+    theta = np.stack(swing_angles(beta1, beta2, problem.geometry), axis=-1)
+    error = theta - desired_swing_angles(problem)[None]
+    return np.degrees(np.sqrt(np.mean(error ** 2, axis=-2)))
+
+
+def position_of(params: CpgParameters) -> np.ndarray:
+    """Return the six tuned values of ``params`` as a position (6,)."""
+    return np.array([params.w12, params.w21, params.phi12, params.phi21, *params.amplitude])
+
+
+def parameters_at(position: np.ndarray, problem: WaveFitProblem, alpha: float = 20.0,
+                  offset: tuple[float, float] = (0.0, 0.0)) -> CpgParameters:
+    """Return the CPG parameters of a position, with v chosen to lock to the wave's frequency."""
+    forms = swarm_waveforms(np.asarray(position)[None, :], problem)
+    w12, w21, phi12, phi21, r1, r2 = (float(v) for v in position)
+    return CpgParameters(frequency_hz=float(forms.intrinsic_hz[0]), amplitude=(r1, r2),
+                         offset=offset, w12=w12, w21=w21, phi12=phi12, phi21=phi21,
+                         alpha=alpha)
