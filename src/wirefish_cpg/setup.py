@@ -19,6 +19,8 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
+            'cpg_node = wirefish_cpg.cpg_node:main',
+            'tuner_node = wirefish_cpg.tuner_node:main',
         ],
     },
 )

@@ -27,13 +27,12 @@ from dataclasses import dataclass, field
 import math
 
 import numpy as np
+from wirefish_cpg.oscillator import CpgParameters
+from wirefish_cpg.steady_state import intrinsic_frequency_for, stable_phase_difference
 from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.wire_coupling import bend_angles
-
-from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.steady_state import intrinsic_frequency_for, stable_phase_difference
 
 PARAMETER_NAMES = ('w12', 'w21', 'phi12', 'phi21', 'amplitude_1', 'amplitude_2')
 # Paper section 4.2: w_ij in [-10, 10], phi_ij in [-pi, pi] rad, R_i in [-pi/2, pi/2] rad.

@@ -1,0 +1,203 @@
+"""
+cpg_node: the fish's two-oscillator CPG (paper eq 1) driving the servos.
+
+Publishes
+    ``servo_cmd`` (sensor_msgs/JointState, sensor-data QoS) at ``publish_rate_hz``: names
+    ``servo_1``, ``servo_2``; position (rad) and velocity (rad/s), stamped with the node clock
+    (so ``use_sim_time`` works).
+    ``cpg_params`` (wirefish_msgs/CpgParams, reliable, transient local, depth 1): the current
+    parameters, re-published whenever they change.
+Services
+    ``start``, ``stop`` (std_srvs/Trigger): stop sends the amplitude and offset targets to 0,
+    so the tail comes to rest along eq 1's convergence law, never by a jump; start restores
+    the parameters. Parameter changes while stopped are kept and apply at start.
+Parameters (flat scalars, each with a range; invalid updates are rejected with a reason):
+    see ``CPG_PARAMETERS``. Valid updates apply smoothly: the oscillator state persists, the
+    amplitudes and offsets converge to their new targets, a new frequency only changes the
+    phase velocity. Outputs beyond ``servo_limit_rad`` are clamped (rate 0) with a warning.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rcl_interfaces.msg import SetParametersResult
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
+                       ReliabilityPolicy)
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Trigger
+from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
+from wirefish_cpg.parameter_specs import check_value, declare, ParameterSpec
+from wirefish_msgs.msg import CpgParams
+
+HALF_PI = math.pi / 2
+CPG_PARAMETERS = (
+    ParameterSpec('frequency_hz', 1.0, 'Intrinsic oscillator frequency v (Hz), eq 1', 0.0,
+                  10.0, low_exclusive=True),
+    ParameterSpec('amplitude_1', 0.38, 'Target amplitude R_1 of servo 1 (rad)', -HALF_PI,
+                  HALF_PI),
+    ParameterSpec('amplitude_2', 0.47, 'Target amplitude R_2 of servo 2 (rad)', -HALF_PI,
+                  HALF_PI),
+    ParameterSpec('offset_1', 0.0, 'Target offset b_1 of servo 1 (rad); turning', -HALF_PI,
+                  HALF_PI),
+    ParameterSpec('offset_2', 0.0, 'Target offset b_2 of servo 2 (rad); turning', -HALF_PI,
+                  HALF_PI),
+    ParameterSpec('w12', -0.41, 'Coupling weight omega_12 of oscillator 2 on 1 (1/s)', -10.0,
+                  10.0),
+    ParameterSpec('w21', 0.64, 'Coupling weight omega_21 of oscillator 1 on 2 (1/s)', -10.0,
+                  10.0),
+    ParameterSpec('phi12', 1.76, 'Phase bias phi_12 (rad)', -math.pi, math.pi),
+    ParameterSpec('phi21', 1.06, 'Phase bias phi_21 (rad)', -math.pi, math.pi),
+    ParameterSpec('alpha', 20.0, 'Convergence gain alpha of amplitude and offset (1/s)', 0.0,
+                  200.0, low_exclusive=True),
+)
+NODE_PARAMETERS = CPG_PARAMETERS + (
+    ParameterSpec('publish_rate_hz', 200.0, 'Rate of servo_cmd (Hz)', 1.0, 1000.0),
+    ParameterSpec('integration_step_s', 0.001,
+                  'Fixed RK4 step of eq 1 (s), independent of the publish rate', 1e-5, 0.01),
+    ParameterSpec('servo_limit_rad', HALF_PI, 'Servo angle limit; outputs are clamped (rad)',
+                  0.0, math.pi, low_exclusive=True),
+    ParameterSpec('autostart', True, 'Start oscillating at launch (else wait for start)'),
+)
+SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# Longest clock gap integrated step by step (s); a longer jump re-bases the clock instead.
+MAX_CATCH_UP_S = 0.5
+
+
+def parameters_from(values: dict[str, object]) -> CpgParameters:
+    """Return the CpgParameters of a flat name -> value mapping (the node's parameters)."""
+    return CpgParameters(
+        frequency_hz=values['frequency_hz'],
+        amplitude=(values['amplitude_1'], values['amplitude_2']),
+        offset=(values['offset_1'], values['offset_2']), w12=values['w12'],
+        w21=values['w21'], phi12=values['phi12'], phi21=values['phi21'],
+        alpha=values['alpha'])
+
+
+def at_rest(params: CpgParameters) -> CpgParameters:
+    """Return ``params`` with amplitude and offset targets 0 (what stop converges to)."""
+    return CpgParameters(frequency_hz=params.frequency_hz, amplitude=(0.0, 0.0),
+                         offset=(0.0, 0.0), w12=params.w12, w21=params.w21,
+                         phi12=params.phi12, phi21=params.phi21, alpha=params.alpha)
+
+
+def to_message(params: CpgParameters) -> CpgParams:
+    """Return ``params`` as a wirefish_msgs/CpgParams."""
+    return CpgParams(frequency_hz=params.frequency_hz, amplitude=list(params.amplitude),
+                     offset=list(params.offset), w12=params.w12, w21=params.w21,
+                     phi12=params.phi12, phi21=params.phi21, alpha=params.alpha)
+
+
+class CpgNode(Node):
+    """Integrates eq 1 on the node clock and publishes the servo commands."""
+
+    def __init__(self, **kwargs) -> None:
+        """Declare the parameters, wire the topics, services and the publish timer."""
+        super().__init__('cpg_node', **kwargs)
+        declare(self, NODE_PARAMETERS)
+        self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
+        params = parameters_from(self._values)
+        self._running = bool(self._values['autostart'])
+        self._cpg = CpgIntegrator(params if self._running else at_rest(params),
+                                  step_s=self._values['integration_step_s'],
+                                  time_s=self._now_s())
+        self._servo_pub = self.create_publisher(JointState, 'servo_cmd',
+                                                qos_profile_sensor_data)
+        self._params_pub = self.create_publisher(CpgParams, 'cpg_params', LATCHED)
+        self.create_service(Trigger, 'start', self._on_start)
+        self.create_service(Trigger, 'stop', self._on_stop)
+        self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'], self._on_tick)
+        self.add_on_set_parameters_callback(self._validate)
+        self.add_post_set_parameters_callback(self._apply)
+        self._params_pub.publish(to_message(params))
+
+    def _now_s(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
+        # Check every value and the combination; reject the whole set with the first reason.
+        merged = dict(self._values)
+        for parameter in parameters:
+            spec = SPECS.get(parameter.name)
+            if spec is None:
+                continue
+            reason = check_value(spec, parameter.value)
+            if reason is not None:
+                return SetParametersResult(successful=False, reason=reason)
+            merged[parameter.name] = parameter.value
+        try:
+            parameters_from(merged)
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _apply(self, parameters: list[Parameter]) -> None:
+        names = {p.name for p in parameters if p.name in SPECS}
+        for name in names:
+            self._values[name] = self.get_parameter(name).value
+        if 'integration_step_s' in names:
+            self._cpg.step_s = float(self._values['integration_step_s'])
+        if 'publish_rate_hz' in names:
+            self.destroy_timer(self._timer)
+            self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'],
+                                            self._on_tick)
+        if names & {s.name for s in CPG_PARAMETERS}:
+            params = parameters_from(self._values)
+            self._cpg.set_parameters(params if self._running else at_rest(params))
+            self._params_pub.publish(to_message(params))
+
+    def _on_start(self, request: Trigger.Request, response: Trigger.Response
+                  ) -> Trigger.Response:
+        response.success = True
+        response.message = 'already running' if self._running else 'started'
+        self._running = True
+        self._cpg.set_parameters(parameters_from(self._values))
+        return response
+
+    def _on_stop(self, request: Trigger.Request, response: Trigger.Response
+                 ) -> Trigger.Response:
+        response.success = True
+        response.message = ('stopping: amplitudes and offsets converge to 0'
+                            if self._running else 'already stopped')
+        self._running = False
+        self._cpg.set_parameters(at_rest(parameters_from(self._values)))
+        return response
+
+    def _on_tick(self) -> None:
+        now = self.get_clock().now()
+        t = now.nanoseconds * 1e-9
+        self._cpg.advance(t, max_steps=int(MAX_CATCH_UP_S / self._cpg.step_s))
+        angles, rates = self._cpg.output(t)
+        limit = self._values['servo_limit_rad']
+        clamped = abs(angles) > limit
+        if clamped.any():
+            self.get_logger().warn(
+                f'CPG output {angles.round(3).tolist()} rad beyond servo_limit_rad = {limit:g};'
+                ' clamped', throttle_duration_sec=2.0)
+            angles = angles.clip(-limit, limit)
+            rates = rates * ~clamped
+        msg = JointState()
+        msg.header.stamp = now.to_msg()
+        msg.name = ['servo_1', 'servo_2']
+        msg.position = angles.tolist()
+        msg.velocity = rates.tolist()
+        self._servo_pub.publish(msg)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the CPG node until shutdown."""
+    rclpy.init(args=args)
+    node = CpgNode()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()

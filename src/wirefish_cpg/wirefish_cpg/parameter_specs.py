@@ -1,0 +1,64 @@
+"""
+Declarations and validation of ROS parameters from one table (no rclpy import at module level).
+
+Each ``ParameterSpec`` is a name, default, description and (for numbers) an inclusive range
+plus optional strict lower bound. ``check_value`` is the pure validation the nodes run in their
+``add_on_set_parameters_callback``; ``declare`` builds the ``ParameterDescriptor`` with the
+matching ``FloatingPointRange``/``IntegerRange``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """A parameter: default (float, int, bool or str), description, range [low, high]."""
+
+    name: str
+    default: float | int | bool | str
+    description: str
+    low: float | None = None
+    high: float | None = None
+    low_exclusive: bool = False
+
+
+def check_value(spec: ParameterSpec, value: object) -> str | None:
+    """Return why ``value`` is not acceptable for ``spec``, or None if it is."""
+    kind = type(spec.default)
+    if kind is bool or kind is str:
+        return None if type(value) is kind else f'{spec.name} must be a {kind.__name__}'
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f'{spec.name} must be a number, got {value!r}'
+    if kind is int and not isinstance(value, int):
+        return f'{spec.name} must be an integer, got {value!r}'
+    if not math.isfinite(value):
+        return f'{spec.name} must be finite, got {value}'
+    if spec.low is not None:
+        if spec.low_exclusive and value <= spec.low:
+            return f'{spec.name} must be > {spec.low:g}, got {value:g}'
+        if value < spec.low:
+            return f'{spec.name} must be >= {spec.low:g}, got {value:g}'
+    if spec.high is not None and value > spec.high:
+        return f'{spec.name} must be <= {spec.high:g}, got {value:g}'
+    return None
+
+
+def declare(node, specs: tuple[ParameterSpec, ...]) -> None:
+    """Declare every spec on ``node`` with a descriptor carrying its description and range."""
+    from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+
+    for spec in specs:
+        descriptor = ParameterDescriptor(description=spec.description)
+        if spec.low is not None and spec.high is not None:
+            if type(spec.default) is float:
+                descriptor.floating_point_range = [FloatingPointRange(
+                    from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
+            elif type(spec.default) is int:
+                descriptor.integer_range = [IntegerRange(
+                    from_value=int(spec.low), to_value=int(spec.high), step=1)]
+        if spec.low_exclusive:
+            descriptor.additional_constraints = f'> {spec.low:g}'
+        node.declare_parameter(spec.name, spec.default, descriptor)
