@@ -1,0 +1,29 @@
+"""Fixtures of the CPG/tuner cross-process tests (helpers live in cpg_probe.py)."""
+
+from collections.abc import Iterator
+from pathlib import Path
+import sys
+
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import JointState
+from wirefish_msgs.msg import CpgParams
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from cpg_probe import LATCHED, Probe  # noqa: E402
+
+
+@pytest.fixture
+def probe(ros_context) -> Iterator[Probe]:
+    """Yield a probe subscribed to servo_cmd and the latched cpg_params."""
+    node = rclpy.create_node('cpg_probe', context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    p = Probe(node, executor)
+    node.create_subscription(JointState, 'servo_cmd', p.servo.append, qos_profile_sensor_data)
+    node.create_subscription(CpgParams, 'cpg_params', p.cpg_params.append, LATCHED)
+    yield p
+    executor.shutdown()
+    node.destroy_node()
