@@ -12,7 +12,7 @@ from sensor_msgs.msg import JointState
 from wirefish_msgs.msg import CpgParams
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cpg_probe import LATCHED, Probe  # noqa: E402
+from cpg_probe import LATCHED, Probe  # noqa: E402, I100 (needs the path above)
 
 
 @pytest.fixture

@@ -6,14 +6,10 @@ import os
 from ament_index_python.packages import get_package_prefix
 from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.srv import GetParameters, SetParametersAtomically
-import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
-from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
-                       ReliabilityPolicy)
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_utils import spin_until
-from sensor_msgs.msg import JointState
-from wirefish_msgs.msg import CpgParams
 
 PREFIX = get_package_prefix('wirefish_cpg')
 CPG_NODE = os.path.join(PREFIX, 'lib', 'wirefish_cpg', 'cpg_node')

@@ -2,9 +2,9 @@
 
 import math
 
+from cpg_probe import CPG_NODE, max_step_ratio, WAIT_S
 import numpy as np
 import pytest
-from cpg_probe import CPG_NODE, max_step_ratio, WAIT_S
 from ros_utils import spin_until, stop_process
 from std_srvs.srv import Trigger
 
