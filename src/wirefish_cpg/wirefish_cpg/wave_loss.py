@@ -123,14 +123,24 @@ def swarm_waveforms(positions: np.ndarray, problem: WaveFitProblem,
     w12, w21, phi12, phi21, r1, r2 = np.moveaxis(np.atleast_2d(positions), -1, 0)
     delta = stable_phase_difference(r1, r2, w12, w21, phi12, phi21)
     intrinsic = intrinsic_frequency_for(problem.wave.frequency_hz, r2, w12, phi12, delta)
-    desired = problem.desired() if desired is None else desired
     omega_t = 2.0 * np.pi * problem.wave.frequency_hz * problem.times()
-    reference = np.angle(np.sum(desired[:, 0] * np.exp(-1j * omega_t)))
-    phase1 = reference + np.where(r1 < 0.0, np.pi, 0.0)
+    phase1 = oscillator1_phase(problem, desired) + np.where(r1 < 0.0, np.pi, 0.0)
     xi1 = omega_t[None, :] + phase1[:, None]
     angles = np.stack([r1[:, None] * np.cos(xi1),
                        r2[:, None] * np.cos(xi1 + delta[:, None])], axis=-1)
     return SwarmWaveforms(angles=angles, delta=delta, intrinsic_hz=intrinsic)
+
+
+def oscillator1_phase(problem: WaveFitProblem, desired: np.ndarray | None = None) -> float:
+    """
+    Return the phase (rad) oscillator 1 is given at t = 0 when R_1 > 0.
+
+    It is the phase of the fundamental of y_body(q1, t), so that
+    Theta_1 = R_1 cos(omega t + phase) peaks together with the desired wave at q1.
+    """
+    desired = problem.desired() if desired is None else desired
+    omega_t = 2.0 * np.pi * problem.wave.frequency_hz * problem.times()
+    return float(np.angle(np.sum(desired[:, 0] * np.exp(-1j * omega_t))))
 
 
 def lateral_positions(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
@@ -140,20 +150,36 @@ def lateral_positions(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray
     return np.asarray(y)
 
 
+def waveform_loss(angles: np.ndarray, problem: WaveFitProblem,
+                  desired: np.ndarray | None = None) -> np.ndarray:
+    """
+    Return eq 24's integral of eq 25's error for servo angles (P, N, 2) over one period, (P,).
+
+    e(t) = sum_i |y_body(q_i, t) - y(q_i, t)| at the sample instants ``problem.times()``,
+    integrated by the rectangle rule over ``window_periods`` periods, m*s.
+    """
+    desired = problem.desired() if desired is None else desired
+    error = np.abs(desired[None] - lateral_positions(angles, problem)).sum(axis=-1)
+    period = 1.0 / problem.wave.frequency_hz
+    return error.mean(axis=-1) * period * problem.window_periods
+
+
 def body_wave_loss(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
     """
-    Return eq 24's integral of eq 25's error for every particle, (P,) m*s.
+    Return the loss of eqs 24-25 for every particle (P, 6) on its locked steady state, (P,).
 
-    e(t) = sum_i |y_body(q_i, t) - y(q_i, t)|, integrated over ``window_periods`` periods of
-    the locked steady state, plus ``FREQUENCY_PENALTY`` where no admissible v locks to the wave.
+    Adds ``FREQUENCY_PENALTY`` where no admissible v locks the network to the wave.
     """
     desired = problem.desired()
     forms = swarm_waveforms(positions, problem, desired)
-    error = np.abs(desired[None] - lateral_positions(forms.angles, problem)).sum(axis=-1)
-    period = 1.0 / problem.wave.frequency_hz
-    loss = error.mean(axis=-1) * period * problem.window_periods
-    admissible = (forms.intrinsic_hz > 0.0) & (forms.intrinsic_hz <= problem.max_frequency_hz)
-    return np.where(admissible, loss, loss + FREQUENCY_PENALTY)
+    loss = waveform_loss(forms.angles, problem, desired)
+    return np.where(admissible_frequency(forms.intrinsic_hz, problem), loss,
+                    loss + FREQUENCY_PENALTY)
+
+
+def admissible_frequency(intrinsic_hz: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """Return whether the intrinsic frequencies (Hz) are in (0, max_frequency_hz], bool."""
+    return (intrinsic_hz > 0.0) & (intrinsic_hz <= problem.max_frequency_hz)
 
 
 def desired_swing_angles(problem: WaveFitProblem) -> np.ndarray:
@@ -168,8 +194,12 @@ def desired_swing_angles(problem: WaveFitProblem) -> np.ndarray:
 
 def swing_angle_rmse_deg(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
     """Return the RMSE of theta_1, theta_2 against theta-bar over one period, (P, 2) degrees."""
-    forms = swarm_waveforms(positions, problem)
-    beta1, beta2 = bend_angles(forms.angles[..., 0], forms.angles[..., 1], problem.geometry)
+    return waveform_swing_rmse_deg(swarm_waveforms(positions, problem).angles, problem)
+
+
+def waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """Return the swing-angle RMSE (P, 2) degrees of servo angles (P, N, 2) (section 5.2)."""
+    beta1, beta2 = bend_angles(angles[..., 0], angles[..., 1], problem.geometry)
     theta = np.stack(swing_angles(beta1, beta2, problem.geometry), axis=-1)
     error = theta - desired_swing_angles(problem)[None]
     return np.degrees(np.sqrt(np.mean(error ** 2, axis=-2)))
