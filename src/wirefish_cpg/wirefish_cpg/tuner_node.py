@@ -123,7 +123,7 @@ class TunerNode(Node):
                                                    RELIABLE)
         self._wave_pub = self.create_publisher(BodyWaveSpec, 'target_wave', LATCHED)
         self._client_group = MutuallyExclusiveCallbackGroup()
-        self._clients: dict[str, object] = {}
+        self._param_clients: dict[str, object] = {}
         self.create_service(RetuneGait, 'retune_gait', self._on_retune,
                             callback_group=ReentrantCallbackGroup())
 
@@ -140,10 +140,10 @@ class TunerNode(Node):
 
     def _parameter_client(self):
         service = f'{self._value("cpg_node_name")}/set_parameters_atomically'
-        if service not in self._clients:
-            self._clients[service] = self.create_client(
+        if service not in self._param_clients:
+            self._param_clients[service] = self.create_client(
                 SetParametersAtomically, service, callback_group=self._client_group)
-        return self._clients[service]
+        return self._param_clients[service]
 
     def _on_retune(self, request: RetuneGait.Request, response: RetuneGait.Response
                    ) -> RetuneGait.Response:

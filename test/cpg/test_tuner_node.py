@@ -1,0 +1,135 @@
+"""tuner_node as a separate process: fits, refusals, progress, and applying to cpg_node."""
+
+import math
+
+from cpg_probe import CPG_NODE, LATCHED, max_step_ratio, TUNER_NODE, WAIT_S
+import numpy as np
+import pytest
+from ros_utils import spin_until
+from std_msgs.msg import Float64MultiArray
+from wirefish_msgs.msg import BodyWaveSpec
+from wirefish_msgs.srv import RetuneGait
+
+pytestmark = pytest.mark.ros
+PAPER_RMSE_DEG = (1.7165, 1.2817)
+CPG_NAMES = ['frequency_hz', 'amplitude_1', 'amplitude_2', 'offset_1', 'offset_2', 'w12',
+             'w21', 'phi12', 'phi21', 'alpha']
+
+
+def retune_request(c1=0.15, c2=1.0, k=8.0, frequency_hz=1.0, apply=False, seed=0,
+                   max_iterations=0, swarm_size=0) -> RetuneGait.Request:
+    request = RetuneGait.Request(apply=apply, seed=seed, max_iterations=max_iterations,
+                                 swarm_size=swarm_size)
+    request.wave = BodyWaveSpec(c1=c1, c2=c2, k=k, frequency_hz=frequency_hz)
+    return request
+
+
+def test_retune_returns_success_with_the_fitted_parameters(spawn, probe):
+    spawn([TUNER_NODE])
+    client = probe.node.create_client(RetuneGait, 'retune_gait')
+    response = probe.call(client, retune_request())
+    assert response.success, response.message
+    assert response.iterations >= 1 and response.elapsed_s > 0.0
+    assert 0.0 < response.loss < 0.01
+    assert response.rmse_theta_deg[0] <= PAPER_RMSE_DEG[0]
+    assert response.rmse_theta_deg[1] <= PAPER_RMSE_DEG[1]
+    assert 0.0 < response.params.frequency_hz <= 10.0
+    assert response.params.alpha == 20.0
+
+
+BAD_REQUESTS = [
+    ({'frequency_hz': 0.0}, 'frequency_hz'),
+    ({'frequency_hz': 12.0}, 'frequency_hz'),
+    ({'frequency_hz': math.nan}, 'frequency_hz'),
+    ({'k': 0.0}, 'k'),
+    ({'k': -3.0}, 'k'),
+    ({'c1': math.inf}, 'c1'),
+    ({'c2': math.nan}, 'c2'),
+    ({'swarm_size': 1}, 'swarm_size'),
+    ({'max_iterations': 100000}, 'max_iterations'),
+]
+
+
+def test_bad_requests_are_refused_with_reasons_and_leave_the_cpg_untouched(spawn, probe):
+    spawn([CPG_NODE])
+    spawn([TUNER_NODE])
+    probe.wait_samples(20)
+    before = probe.get_parameters(CPG_NAMES)
+    announced = len(probe.cpg_params)
+    client = probe.node.create_client(RetuneGait, 'retune_gait')
+    for fields, culprit in BAD_REQUESTS:
+        response = probe.call(client, retune_request(apply=True, **fields))
+        assert not response.success, fields
+        assert culprit in response.message, (fields, response.message)
+    assert probe.get_parameters(CPG_NAMES) == before
+    assert len(probe.cpg_params) == announced
+
+
+def test_apply_sets_the_cpg_parameters_and_the_output_converges_without_a_step(spawn, probe):
+    spawn([CPG_NODE])
+    spawn([TUNER_NODE])
+    probe.wait_samples(200)
+    start = len(probe.servo)
+    client = probe.node.create_client(RetuneGait, 'retune_gait')
+    response = probe.call(client, retune_request(c1=0.10, c2=0.8, k=6.0, frequency_hz=1.5,
+                                                 apply=True, seed=3))
+    assert response.success, response.message
+    applied = probe.get_parameters(CPG_NAMES)
+    fitted = response.params
+    assert applied['frequency_hz'] == fitted.frequency_hz
+    assert (applied['amplitude_1'], applied['amplitude_2']) == tuple(fitted.amplitude)
+    assert (applied['w12'], applied['w21'], applied['phi12'], applied['phi21']) == (
+        fitted.w12, fitted.w21, fitted.phi12, fitted.phi21)
+    probe.wait_samples(500)
+    t, positions, velocities = probe.trace(start)
+    assert max_step_ratio(t, positions, velocities) <= 1.0
+    last_period = positions[t > t[-1] - 1.0 / 1.5]
+    np.testing.assert_allclose(np.abs(last_period).max(axis=0), np.abs(fitted.amplitude),
+                               rtol=0.03)
+    assert spin_until(probe.executor,
+                      lambda: probe.cpg_params[-1].frequency_hz == fitted.frequency_hz, WAIT_S)
+
+
+def test_progress_and_the_latched_target_wave_are_published(spawn, probe):
+    spawn([TUNER_NODE])
+    progress, waves = [], []
+    probe.node.create_subscription(Float64MultiArray, 'retune_progress',
+                                   lambda m: progress.append(list(m.data)), 100)
+    client = probe.node.create_client(RetuneGait, 'retune_gait')
+    assert spin_until(probe.executor, client.service_is_ready, WAIT_S)
+    spin_until(probe.executor, lambda: probe.node.count_publishers('retune_progress') > 0,
+               WAIT_S)
+    response = probe.call(client, retune_request(c2=0.9, max_iterations=30, swarm_size=20))
+    assert response.success, response.message
+    assert spin_until(probe.executor, lambda: len(progress) == response.iterations + 1, WAIT_S)
+    data = np.array(progress)
+    assert list(data[:, 0]) == list(range(response.iterations + 1))
+    assert np.all(np.diff(data[:, 1]) <= 0.0) and data[-1, 1] == response.loss
+    assert np.all(data[:, 2] == 30)
+    probe.node.create_subscription(BodyWaveSpec, 'target_wave', waves.append, LATCHED)
+    assert spin_until(probe.executor, lambda: waves, WAIT_S)  # latched: arrives late
+    assert (waves[-1].c1, waves[-1].c2, waves[-1].k, waves[-1].frequency_hz) == (
+        0.15, 0.9, 8.0, 1.0)
+
+
+def test_a_second_request_while_one_runs_is_refused_as_busy(spawn, probe):
+    spawn([TUNER_NODE, '--ros-args', '-p', 'stall_iterations:=5000'])
+    client = probe.node.create_client(RetuneGait, 'retune_gait')
+    assert spin_until(probe.executor, client.service_is_ready, WAIT_S)
+    progress = []
+    probe.node.create_subscription(Float64MultiArray, 'retune_progress', progress.append, 10)
+    long_run = client.call_async(retune_request(max_iterations=5000, swarm_size=2000))
+    assert spin_until(probe.executor, lambda: progress, WAIT_S)  # the long fit is running
+    response = probe.call(client, retune_request())
+    assert not response.success
+    assert 'busy' in response.message
+    assert not long_run.done()
+
+
+def test_apply_without_a_cpg_node_fails_with_a_reason(spawn, probe):
+    spawn([TUNER_NODE, '--ros-args', '-p', 'apply_timeout_s:=1.0'])
+    client = probe.node.create_client(RetuneGait, 'retune_gait')
+    response = probe.call(client, retune_request(apply=True, max_iterations=5))
+    assert not response.success
+    assert 'cpg_node/set_parameters_atomically' in response.message
+    assert response.iterations == 5  # the fit itself is still reported
