@@ -88,8 +88,9 @@ def run_all(quick: bool = False) -> dict:
         _run(f'kinematics {s} x {r}', bench_graph.kinematics_cpu, s, r, 10.0 * scale, DOMAIN)
         for s, r in ((50, 50.0), (500, 200.0))]
     results['recording'] = _run('recording', recording, 60.0 * scale, DOMAIN)
-    results['fleet'] = [_run(f'{n} fish', bench_graph.fleet, n, 10.0 * scale, DOMAIN)
-                        for n in (1, 2, 4, 8)]
+    results['fleet'] = [
+        _run(f'{n} fish ({mode})', bench_graph.fleet, n, 10.0 * scale, DOMAIN, mode == 'single')
+        for mode in ('per-node', 'single') for n in (1, 2, 4, 8)]
     return results
 
 

@@ -127,14 +127,18 @@ def kinematics_cpu(stations: int, rate_hz: float, duration_s: float, domain_id: 
     return {'stations': stations, 'rate_hz': rate_hz, 'cpu_percent': cpu, 'ran': alive}
 
 
-def fleet(fish: int, duration_s: float, domain_id: int) -> dict:
-    """``fish`` whole graphs (namespaces /fish_1..) at default rates: rates and total CPU."""
+def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = False) -> dict:
+    """
+    ``fish`` whole graphs (namespaces /bench_fish_N) at default rates: rates and total CPU.
+
+    ``single_process`` runs each fish's four ROS nodes in one process (`wirefish compose`).
+    """
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import Imu, JointState
 
     specs: list[NodeSpec] = []
     for i in range(1, fish + 1):
-        specs += fish_graph(f'/bench_fish_{i}', sim=True)
+        specs += fish_graph(f'/bench_fish_{i}', sim=True, single_process=single_process)
     counts = {('servo_cmd', i): 0 for i in range(1, fish + 1)}
     counts.update({('imu/data', i): 0 for i in range(1, fish + 1)})
     with processes(specs, domain_id) as supervisor, ros_session(domain_id) as (node, executor):
@@ -157,7 +161,7 @@ def fleet(fish: int, duration_s: float, domain_id: int) -> dict:
         crashed = sorted(supervisor.exited())
     servo = [counts[('servo_cmd', i)] / elapsed for i in range(1, fish + 1)]
     imu = [counts[('imu/data', i)] / elapsed for i in range(1, fish + 1)]
-    return {'fish': fish, 'processes': len(specs),
+    return {'fish': fish, 'single_process': single_process, 'processes': len(specs),
             'servo_cmd_hz_min': min(servo), 'servo_cmd_hz_median': float(np.median(servo)),
             'imu_hz_min': min(imu), 'imu_hz_median': float(np.median(imu)),
             'cpu_percent_total': 100.0 * (cpu_end - cpu_start) / elapsed,

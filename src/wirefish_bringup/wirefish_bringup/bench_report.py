@@ -89,7 +89,8 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
             continue
         ok = (not r['crashed'] and r['servo_cmd_hz_min'] >= 0.95 * 200
               and r['imu_hz_min'] >= 0.95 * 100)
-        table.append((f'{r["fish"]} fish graph(s), {r["processes"]} processes',
+        mode = 'one process per fish' if r.get('single_process') else 'one process per node'
+        table.append((f'{r["fish"]} fish graph(s), {mode}, {r["processes"]} processes',
                       '8 at default rates' if r['fish'] == 8 else '—',
                       f'servo_cmd min {r["servo_cmd_hz_min"]:.1f} Hz, imu min '
                       f'{r["imu_hz_min"]:.1f} Hz, CPU {r["cpu_percent_total"]:.0f} % '

@@ -16,6 +16,7 @@ SUBCOMMANDS = {
     'record': ('wirefish_bringup.record', 'record the graph into a rosbag2 (MCAP) bag'),
     'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait service)'),
     'report': ('wirefish_bringup.report', 'plots and a summary table from a recorded bag'),
+    'compose': ('wirefish_bringup.compose', "one fish's ROS nodes in a single process"),
     'sweep': ('wirefish_bringup.sweep', "model and virtual-fish speed over the paper's grid"),
 }
 

@@ -54,13 +54,15 @@ def sim_tty_link(namespace: str) -> Path:
 
 
 def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
-               port: str | None = None, params_file: Path | None = None) -> list[NodeSpec]:
+               port: str | None = None, params_file: Path | None = None,
+               single_process: bool = False) -> list[NodeSpec]:
     """
     Return the processes of one fish's graph, in start order (the virtual fish first).
 
     ``namespace`` holds every node and (relative) topic; ``sim`` starts the virtual fish and
     points the bridge at its pseudo-terminal, otherwise ``port`` names the real fish's serial
-    device; ``params_file`` is the parameter YAML (the installed default when None).
+    device; ``params_file`` is the parameter YAML (the installed default when None);
+    ``single_process`` runs the four ROS nodes in one process (`wirefish compose`).
 
     """
     namespace = validate_namespace(namespace)
@@ -76,6 +78,10 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     if sim:
         specs.append(NodeSpec('wirefish_bridge', 'fish_sim', 'fish_sim',
                               ('--link', tty, '--ros', *ros_args())))
+    if single_process:
+        specs.append(NodeSpec('wirefish_bringup', 'wirefish', 'fish_nodes', (
+            'compose', '--namespace', namespace, '--port', tty, '--params-file', params)))
+        return specs
     specs += [
         NodeSpec('wirefish_bridge', 'bridge_node', 'bridge_node',
                  ros_args('-p', f'port:={tty}')),

@@ -33,6 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='parameter YAML (default: the installed config/wirefish.yaml)')
     parser.add_argument('--out', type=Path, default=Path('out'),
                         help='where run logs, bags and reports go (default: ./out)')
+    parser.add_argument('--single-process', action='store_true',
+                        help="run the fish's four ROS nodes in one process (wirefish compose)")
     parser.add_argument('--no-status', action='store_true', help='skip the topic-rate table')
 
 
@@ -68,7 +70,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         namespace = validate_namespace(args.namespace)
         sim = args.port is None
-        specs = fish_graph(namespace, sim=sim, port=args.port, params_file=args.params_file)
+        specs = fish_graph(namespace, sim=sim, port=args.port, params_file=args.params_file,
+                           single_process=args.single_process)
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2

@@ -1,0 +1,68 @@
+"""
+`wirefish compose`: all of one fish's ROS nodes in one process, on one executor.
+
+The single-process mode of `wirefish up --single-process`: the same node classes, names,
+namespace and parameter file as the one-process-per-node graph, but one Python interpreter and
+one DDS participant instead of four, which is what limits how many fish fit on one machine.
+"""
+
+import argparse
+import importlib
+import sys
+
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, default_params_file, validate_namespace
+
+# node name -> 'module:Class'; each class takes rclpy Node keyword arguments.
+NODE_CLASSES = {
+    'bridge_node': 'wirefish_bridge.bridge_node:BridgeNode',
+    'cpg_node': 'wirefish_cpg.cpg_node:CpgNode',
+    'kinematics_node': 'wirefish_kinematics.kinematics_node:KinematicsNode',
+    'tuner_node': 'wirefish_cpg.tuner_node:TunerNode',
+}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish compose`."""
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('--port', required=True, help='serial device for the bridge')
+    parser.add_argument('--params-file', default=None, help='parameter YAML')
+    parser.add_argument('--threads', type=int, default=4, help='executor threads')
+
+
+def node_class(path: str) -> type:
+    """Return the class named by ``'module:Class'``."""
+    module_name, class_name = path.split(':')
+    return getattr(importlib.import_module(module_name), class_name)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish compose` until SIGINT/SIGTERM; return the exit code."""
+    import rclpy
+    from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+
+    try:
+        namespace = validate_namespace(args.namespace)
+    except ValueError as error:
+        print(f'wirefish compose: {error}', file=sys.stderr)
+        return 2
+    params = str(args.params_file or default_params_file())
+    rclpy.init()
+    nodes = []
+    executor = MultiThreadedExecutor(num_threads=args.threads)
+    try:
+        for name, path in NODE_CLASSES.items():
+            cli_args = ['--ros-args', '-r', f'__ns:={namespace}', '--params-file', params]
+            if name == 'bridge_node':
+                cli_args += ['-p', f'port:={args.port}']
+            node = node_class(path)(cli_args=cli_args)
+            nodes.append(node)
+            executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        executor.shutdown()
+        for node in reversed(nodes):
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
