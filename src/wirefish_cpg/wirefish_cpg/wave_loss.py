@@ -79,7 +79,7 @@ class WaveFitProblem:
 
     wave: WaveSpec = field(default_factory=WaveSpec)
     geometry: FishGeometry = field(default_factory=FishGeometry)
-    samples_per_period: int = 96
+    samples_per_period: int = 48
     window_periods: int = 1
     max_frequency_hz: float = 10.0
     reverse_wave: bool = False
