@@ -24,8 +24,8 @@ from wirefish_cpg.reference_loss import simulated_body_wave_loss, simulated_swin
 from wirefish_cpg.steady_state import steady_state_phases
 from wirefish_cpg.tuning import fit_gait
 from wirefish_cpg.wave_loss import (body_wave_loss, desired_swing_angles, PARAMETER_NAMES,
-                                    parameters_at, position_of, swarm_waveforms,
-                                    swing_angle_rmse_deg, WaveFitProblem)
+                                    position_of, swarm_waveforms, swing_angle_rmse_deg,
+                                    WaveFitProblem)
 from wirefish_kinematics.body_wave import swing_angles
 from wirefish_kinematics.wire_coupling import bend_angles
 
