@@ -111,3 +111,15 @@ def test_clock_jump_rebases_without_changing_the_state():
 def test_invalid_parameters_are_rejected(kwargs):
     with pytest.raises(ValueError):
         CpgParameters(**kwargs)
+
+
+def test_node_integrator_follows_the_array_integrator():
+    params = CpgParameters(offset=(0.2, -0.1), w12=3.0, w21=-2.0)
+    t, angles, rates, _ = simulate(NetworkArrays.from_parameters(params), 2.0, 1e-3,
+                                   record_every=10)
+    cpg = CpgIntegrator(params, step_s=1e-3)
+    for ti, angle, rate in zip(t, angles, rates):
+        cpg.advance(ti)
+        got_angle, got_rate = cpg.output(ti)
+        np.testing.assert_allclose(got_angle, angle, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(got_rate, rate, rtol=0, atol=1e-10)
