@@ -112,3 +112,21 @@ def test_autostart_false_holds_still_until_start(spawn, probe):
     assert probe.call(begin, Trigger.Request()).success
     probe.wait_samples(400)
     assert np.abs(probe.trace()[1][-100:]).max() > 0.3
+
+
+def test_servo_cmd_is_stamped_with_simulated_time_when_use_sim_time(spawn, probe):
+    from builtin_interfaces.msg import Time
+    from rosgraph_msgs.msg import Clock
+    spawn([CPG_NODE, '--ros-args', '-p', 'use_sim_time:=true'])
+    clock_pub = probe.node.create_publisher(Clock, '/clock', 10)
+    sim_ns = [1000 * 10**9]
+
+    def tick() -> None:
+        sim_ns[0] += 5_000_000  # 5 ms of simulated time per tick
+        clock_pub.publish(Clock(clock=Time(sec=sim_ns[0] // 10**9,
+                                           nanosec=sim_ns[0] % 10**9)))
+    probe.node.create_timer(0.005, tick)
+    probe.wait_samples(200)
+    t, positions, _ = probe.trace()
+    assert t.min() >= 1000.0 and t.max() <= sim_ns[0] * 1e-9
+    assert np.abs(positions).max() > 0.1  # it oscillates on simulated time
