@@ -36,36 +36,40 @@ def simulated_cycle(position: np.ndarray, problem: WaveFitProblem, alpha: float 
     Integrate eq 1 for one particle (6,) and return its last cycle on the loss grid.
 
     Returns (angles (N, 2) rad on ``problem.times()`` with oscillator 1 phase-referenced as in
-    ``wave_loss``, the intrinsic frequency v (Hz) that would lock the network to the wave).
+    ``wave_loss``, the intrinsic frequency v (Hz) that would lock the network to the wave;
+    NaN, and zero angles, when oscillator 1 did not complete a cycle within 10 periods).
     """
     w12, w21, phi12, phi21, r1, r2 = (float(v) for v in position)
     v = problem.wave.frequency_hz
     args = (v, (r1, r2), w12, w21, phi12, phi21, alpha)
     state = [0.0] * 6
     h = step_s
+    settle_steps = int(round(settle_s / h))
+    # Record until oscillator 1 has turned a full cycle (either way round), at most 10 wave
+    # periods: a network locked near zero frequency has no usable cycle and is penalised.
+    limit_steps = settle_steps + int(round(10.0 / (v * h)))
     phases, outputs = [], []
-    t = 0.0
-    cycle_start = None
-    while True:
+    for n in range(1, limit_steps + 1):
         k1 = _derivative(state, *args)
         k2 = _derivative([s + 0.5 * h * k for s, k in zip(state, k1)], *args)
         k3 = _derivative([s + 0.5 * h * k for s, k in zip(state, k2)], *args)
         k4 = _derivative([s + h * k for s, k in zip(state, k3)], *args)
         state = [s + h / 6.0 * (a + 2.0 * b + 2.0 * c + d)
                  for s, a, b, c, d in zip(state, k1, k2, k3, k4)]
-        t += h
-        if t >= settle_s:
-            if cycle_start is None:
-                cycle_start = state[0]
+        if n >= settle_steps:
             phases.append(state[0])
             outputs.append((state[2] * math.cos(state[0]), state[3] * math.cos(state[1])))
-            if state[0] - cycle_start > 2.0 * math.pi + 2.0 * abs(k1[0]) * h:
+            if abs(state[0] - phases[0]) > 2.0 * math.pi + 2.0 * abs(k1[0]) * h:
                 break
     phases = np.array(phases)
     outputs = np.array(outputs)
     omega_measured = (phases[-1] - phases[0]) / (h * (len(phases) - 1))
-    # Oscillator 1's phase on the loss grid; the other output follows by interpolation.
     omega = 2.0 * np.pi * v
+    if abs(phases[-1] - phases[0]) < 2.0 * np.pi:
+        return np.zeros((problem.samples_per_period, 2)), math.nan
+    if phases[-1] < phases[0]:  # turning backwards: same waveform as a function of phase
+        phases, outputs = phases[::-1], outputs[::-1]
+    # Oscillator 1's phase on the loss grid; the outputs follow by interpolation in phase.
     grid = oscillator1_phase(problem) + (np.pi if r1 < 0.0 else 0.0) + omega * problem.times()
     grid = phases[0] + np.mod(grid - phases[0], 2.0 * np.pi)
     angles = np.stack([np.interp(grid, phases, outputs[:, i]) for i in range(2)], axis=-1)
@@ -78,7 +82,7 @@ def simulated_body_wave_loss(position: np.ndarray, problem: WaveFitProblem, **kw
     """Return the loss of eqs 24-25 (m*s) of one particle (6,) by integrating eq 1."""
     angles, intrinsic = simulated_cycle(position, problem, **kwargs)
     loss = float(waveform_loss(angles[None], problem)[0])
-    if not admissible_frequency(np.array(intrinsic), problem):
+    if not (math.isfinite(intrinsic) and admissible_frequency(np.array(intrinsic), problem)):
         loss += FREQUENCY_PENALTY
     return loss
 
