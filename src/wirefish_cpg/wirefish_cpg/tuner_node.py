@@ -158,6 +158,9 @@ class TunerNode(Node):
         try:
             self._wave_pub.publish(request.wave)
             return self._retune(request, response)
+        except ValueError as error:  # e.g. a geometry FishGeometry refuses
+            response.success, response.message = False, f'rejected: {error}'
+            return response
         finally:
             self._busy.release()
 
