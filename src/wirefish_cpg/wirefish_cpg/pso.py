@@ -43,7 +43,7 @@ class PsoOptions:
     cognitive: float = 1.49618
     social: float = 1.49618
     velocity_limit: float = 0.5
-    stall_iterations: int = 15
+    stall_iterations: int = 20
     stall_tolerance: float = 1e-6
 
     def __post_init__(self) -> None:
