@@ -1,0 +1,141 @@
+"""Codec: round trips, streaming, resynchronisation and error counters."""
+
+import math
+import struct
+
+from cobs import cobs
+from hypothesis import given, settings, strategies as st
+import pytest
+from wirefish_bridge.codec import (crc16, DecoderStats, encode_body, encode_frame, FrameEncoder,
+                                   MAX_ENCODED_FRAME, StreamDecoder)
+from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, MsgType, Role,
+                                      ServoCommand, Status, Telemetry)
+
+f32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
+u16 = st.integers(0, 0xFFFF)
+u32 = st.integers(0, 0xFFFFFFFF)
+messages = st.one_of(
+    st.builds(Heartbeat, version=st.integers(0, 255), role=st.sampled_from(Role), uptime_ms=u32),
+    st.builds(ServoCommand, f32, f32),
+    st.builds(Telemetry, board_time_ms=u32, roll=f32, pitch=f32, yaw=f32,
+              gyro=st.tuples(f32, f32, f32), accel=st.tuples(f32, f32, f32), servo_1=f32,
+              servo_2=f32, battery_v=f32, status=u16),
+    st.builds(ErrorReport, code=st.integers(0, 255), ref_seq=u16),
+)
+TELEMETRY = Telemetry(board_time_ms=1234, roll=0.1, pitch=-0.2, yaw=3.0, gyro=(0.0, 0.5, -1.0),
+                      accel=(0.25, 0.0, 9.75), servo_1=0.375, servo_2=-0.5, battery_v=8.125,
+                      status=int(Status.LOW_BATTERY))
+
+
+def test_crc16_is_ccitt_false():
+    assert crc16(b'123456789') == 0x29B1
+
+
+@given(messages, u16)
+def test_round_trip_of_any_message(message, seq):
+    frames = StreamDecoder().feed(encode_frame(message, seq))
+    assert [(f.seq, f.message) for f in frames] == [(seq, message)]
+
+
+@given(st.lists(messages, min_size=1, max_size=20), st.data())
+@settings(max_examples=200)
+def test_any_chunking_of_a_stream_yields_every_frame_in_order(batch, data):
+    stream = b''.join(encode_frame(m, i) for i, m in enumerate(batch))
+    cuts = sorted(data.draw(st.lists(st.integers(0, len(stream)), max_size=30)))
+    decoder = StreamDecoder()
+    frames = []
+    for start, end in zip([0] + cuts, cuts + [len(stream)]):
+        frames += decoder.feed(stream[start:end])
+    assert [f.message for f in frames] == batch
+    assert decoder.stats.resyncs == 0 and decoder.stats.seq_gaps == 0
+
+
+@given(st.lists(st.binary(max_size=80), min_size=1, max_size=10), messages)
+def test_frame_after_garbage_is_received(garbage_runs, message):
+    decoder = StreamDecoder()
+    decoder.feed(b''.join(garbage_runs))
+    assert [f.message for f in decoder.feed(encode_frame(message, 7))] == [message]
+
+
+@given(st.binary(max_size=5000))
+def test_decoder_never_raises_and_memory_stays_bounded(data):
+    decoder = StreamDecoder()
+    decoder.feed(data)
+    assert decoder.buffered <= MAX_ENCODED_FRAME
+
+
+def test_telemetry_example_encodes_to_the_documented_hex():
+    # The same frame is printed in PROTOCOL.md: keep the two in step.
+    frame = encode_frame(TELEMETRY, 0x0102)
+    assert frame.hex(' ') == (
+        '00 06 20 02 01 d2 04 01 09 cd cc cc 3d cd cc 4c be 01 03 40 40 01 01 01 01 01 01 02 '
+        '3f 01 03 80 bf 01 03 80 3e 01 01 01 01 01 03 1c 41 01 03 c0 3e 01 01 02 bf 01 04 02 '
+        '41 08 03 5c f1 00')
+
+
+def test_servo_command_example_encodes_to_the_documented_hex():
+    frame = encode_frame(ServoCommand(0.25, -0.5), 0x0007)
+    assert frame.hex(' ') == '00 03 10 07 01 01 03 80 3e 01 01 04 bf 9a dc 00'
+
+
+def _corrupt(frame: bytes, index: int, xor: int) -> bytes:
+    data = bytearray(frame)
+    data[index] ^= xor
+    return bytes(data)
+
+
+def _reencoded(body: bytes) -> bytes:
+    return b'\x00' + cobs.encode(body) + b'\x00'
+
+
+GOOD = encode_frame(ServoCommand(0.1, 0.2), 1)
+GOOD_BODY = encode_body(ServoCommand(0.1, 0.2), 1)
+
+
+@pytest.mark.parametrize('stream, counter', [
+    (_corrupt(GOOD, 6, 0x01), 'crc_errors'),                      # one flipped payload bit
+    (_reencoded(GOOD_BODY[:-1] + bytes([GOOD_BODY[-1] ^ 0x80])), 'crc_errors'),
+    (_reencoded(GOOD_BODY[:3]), 'short_frames'),
+    (b'\x00\x05\x01\x02\x00', 'cobs_errors'),                    # code byte past the end
+    (_reencoded(b'\x55\x01\x00' + struct.pack('<H', crc16(b'\x55\x01\x00'))), 'unknown_type'),
+    (_reencoded(GOOD_BODY[:3] + b'\x00' * 4 + struct.pack('<H', crc16(GOOD_BODY[:3] + b'\x00' * 4))),
+     'length_errors'),
+    (_reencoded(GOOD_BODY[:3] + struct.pack('<ff', math.nan, 0.0)
+                + struct.pack('<H', crc16(GOOD_BODY[:3] + struct.pack('<ff', math.nan, 0.0)))),
+     'invalid_payload'),
+    (b'\x01' * (MAX_ENCODED_FRAME + 1) + b'\x00', 'overflows'),
+])
+def test_each_kind_of_damage_is_rejected_and_counted_once(stream, counter):
+    decoder = StreamDecoder()
+    assert decoder.feed(stream) == []
+    expected = DecoderStats(bytes_in=len(stream), resyncs=1).as_dict()
+    expected[counter] = 1
+    assert decoder.stats.as_dict() == expected
+
+
+def test_overflow_is_skipped_up_to_the_next_delimiter_only():
+    decoder = StreamDecoder()
+    frames = decoder.feed(b'\x07' * 1000 + GOOD)
+    assert [f.message for f in frames] == [StreamDecoder().feed(GOOD)[0].message]
+    assert decoder.stats.overflows == 1 and decoder.stats.resyncs == 1
+
+
+def test_missing_sequence_numbers_count_as_gaps():
+    encoder = FrameEncoder()
+    frames = [encoder.encode(ServoCommand(0.0, 0.0)) for _ in range(10)]
+    decoder = StreamDecoder()
+    decoder.feed(b''.join(frames[i] for i in (0, 1, 4, 5, 9)))
+    assert decoder.stats.seq_gaps == 5
+
+
+def test_sequence_numbers_wrap_without_gaps():
+    encoder = FrameEncoder(first_seq=0xFFFE)
+    decoder = StreamDecoder()
+    decoder.feed(b''.join(encoder.encode(Heartbeat()) for _ in range(4)))
+    assert (decoder.stats.frames_ok, decoder.stats.seq_gaps) == (4, 0)
+
+
+def test_error_report_carries_its_code():
+    frame = encode_frame(ErrorReport(ErrorCode.BAD_CRC, 42), 3)
+    (decoded,) = StreamDecoder().feed(frame)
+    assert decoded.kind is MsgType.ERROR and decoded.message == ErrorReport(1, 42)
