@@ -30,7 +30,9 @@ import numpy as np
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import intrinsic_frequency_for, stable_phase_difference
 from wirefish_kinematics.body_wave import body_positions, swing_angles
-from wirefish_kinematics.desired_wave import desired_lateral_position
+from wirefish_kinematics.desired_wave import (desired_lateral_position,
+                                              desired_swing_angles as wave_swing_angles,
+                                              WAVE_TIME_SIGN)
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.wire_coupling import bend_angles
 
@@ -73,8 +75,8 @@ class WaveFitProblem:
     """
     Everything the loss needs besides the swarm: the wave, the fish, and the quadrature.
 
-    ``reverse_wave`` evaluates the desired wave at -t, i.e. travelling the other way than the
-    project's convention (used only to compare the two readings of eq 23).
+    ``reverse_wave`` flips the sign of omega t in eq 23, i.e. the wave travels the other way
+    than the project's convention (used only to compare the two readings of eq 23).
     """
 
     wave: WaveSpec = field(default_factory=WaveSpec)
@@ -86,21 +88,23 @@ class WaveFitProblem:
 
     def stations(self) -> np.ndarray:
         """Return q1 = l1 and q2 = l1 + l2 (m), the link ends O1 and O2 of eq 25, (2,)."""
-        g = self.geometry
-        return np.array([g.l1, g.l1 + g.l2])
+        return np.array(self.geometry.link_end_stations)
 
     def times(self) -> np.ndarray:
         """Return the sample instants of one period, (N,) s, starting at 0."""
         n = self.samples_per_period
         return np.arange(n) / (n * self.wave.frequency_hz)
 
+    def time_sign(self) -> float:
+        """Return the sign of omega t in eq 23 used here (the project's, or the reverse)."""
+        return -WAVE_TIME_SIGN if self.reverse_wave else WAVE_TIME_SIGN
+
     def desired(self) -> np.ndarray:
         """Return y_body(q_i, t_n) of eq 23 at the stations, (N, 2) m."""
-        t = self.times()
-        t = -t if self.reverse_wave else t
         w = self.wave
-        return np.asarray(desired_lateral_position(self.stations()[None, :], t[:, None],
-                                                   w.c1, w.c2, w.k, w.frequency_hz))
+        return np.asarray(desired_lateral_position(
+            self.stations()[None, :], self.times()[:, None], w.c1, w.c2, w.k, w.frequency_hz,
+            time_sign=self.time_sign()))
 
 
 @dataclass(frozen=True)
@@ -186,10 +190,12 @@ def desired_swing_angles(problem: WaveFitProblem) -> np.ndarray:
     """
     Return the expected swing angles theta-bar_i (N, 2) rad of section 5.2, from eq 23.
 
-    The desired wave gives the lateral position y_body(q_i, t) of a station at axial
-    position q_i, so theta-bar_i = atan2(y_body(q_i, t), q_i).
+    theta-bar_i = atan2(y_body(q_i, t), q_i) (``wirefish_kinematics.desired_wave``).
     """
-    return np.arctan2(problem.desired(), problem.stations()[None, :])
+    w = problem.wave
+    return np.stack(wave_swing_angles(problem.times(), w.c1, w.c2, w.k, w.frequency_hz,
+                                      problem.geometry, time_sign=problem.time_sign()),
+                    axis=-1)
 
 
 def swing_angle_rmse_deg(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
