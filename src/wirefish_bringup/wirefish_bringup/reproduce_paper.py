@@ -98,7 +98,7 @@ def _plot(out_dir: Path, fit, problem: WaveFitProblem, summary: dict) -> None:
     fig, axes = plt.subplots(3, 2, figsize=(8, 7), sharex=True)
     for k, ax in enumerate(axes.flat):
         ax.plot(iterations, fit.pso.position_history[:, k], '-', lw=1.2)
-        ax.axvline(converged, color='red', ls=':', label='optimum reached')
+        ax.axvline(converged, color='red', ls=':', label='last improvement')
         ax.set_ylabel(labels[k])
     for ax in axes[-1]:
         ax.set_xlabel('iteration')
