@@ -132,7 +132,7 @@ def estimate_speed(servo_angles: ArrayLike, servo_rates: ArrayLike, dt: float,
     velocity, slope = tail_tip_velocity_and_slope(angles, rates, geometry)
     speed = float(steady_speed(np.mean(velocity ** 2), np.mean(slope ** 2), geometry))
     thrust = float(np.mean(instantaneous_thrust(velocity, slope, speed, geometry)))
-    frequency = 1.0 / (angles.shape[0] * dt)
+    frequency = 1.0 / (angles.shape[0] * float(dt))
     y_tip = tail_tip_lateral_positions(angles, geometry)
     return SpeedEstimate(speed=speed, thrust=thrust,
                          drag=float(drag_force(speed, geometry)),

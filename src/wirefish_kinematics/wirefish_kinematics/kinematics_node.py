@@ -1,0 +1,296 @@
+"""
+kinematics_node: the tail's body wave and swimming-speed estimate from the servo angles.
+
+Subscribes
+    ``servo_cmd`` (sensor_msgs/JointState, sensor-data QoS; joints ``servo_1``, ``servo_2`` in
+    any order, position rad, velocity rad/s optional), or the measured ``servo_state`` when
+    ``use_servo_state`` is true. Samples with NaN/inf values or without both joints are dropped
+    with a throttled warning. Times are the header stamps (node clock if unstamped).
+    ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local): the desired wave;
+    the latest of it and the ``wave_*`` parameters wins.
+Publishes (frame ``tail_base`` = C0 of paper section 3.1)
+    ``body_wave`` (wirefish_msgs/BodyWave, sensor data) at ``publish_rate_hz`` when a new
+    sample arrived: ``station_count`` stations, eqs 2-15; ``y_desired`` (eq 23) once the tail
+    beats, shown at the tail's phase (see ``desired_wave.wave_time_at_phase``).
+    ``body_wave_markers`` (visualization_msgs/MarkerArray, sensor data): tail polyline, desired
+    wave as dots, link ends O1 (sphere) and O2 (cube).
+    ``speed_estimate`` (wirefish_msgs/SpeedEstimate, reliable) once per completed tail beat
+    (stamped at the end of the period), eqs 16-22; all zeros while the tail is at rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Point
+import numpy as np
+from rcl_interfaces.msg import SetParametersResult
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
+                       ReliabilityPolicy)
+from sensor_msgs.msg import JointState
+from visualization_msgs.msg import Marker, MarkerArray
+from wirefish_kinematics.body_wave import body_positions, swing_angles
+from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
+from wirefish_kinematics.geometry import GEOMETRY_FIELDS
+from wirefish_kinematics.lighthill import SpeedEstimate, tail_tip_lateral_positions
+from wirefish_kinematics.node_parameters import (check_value, declare, geometry_from,
+                                                 NODE_PARAMETERS, SPECS)
+from wirefish_kinematics.servo_history import ServoHistory
+from wirefish_kinematics.tail_beat import (estimate_speed_over, fundamental_phase,
+                                           last_tail_beat)
+from wirefish_kinematics.wire_coupling import bend_angles
+from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate as SpeedEstimateMsg
+
+FRAME = 'tail_base'
+JOINTS = ('servo_1', 'servo_2')
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# Below this half range (m) of the tip's lateral motion the tail counts as at rest.
+REST_HALF_RANGE_M = 1e-4
+WARN_PERIOD_S = 2.0
+
+
+@dataclass(frozen=True)
+class WaveTarget:
+    """The desired wave of eq 23: c1 (m/m), c2 (1/m), k (rad/m), frequency (Hz)."""
+
+    c1: float
+    c2: float
+    k: float
+    frequency_hz: float
+
+
+def wave_problem(msg: BodyWaveSpec) -> str | None:
+    """Return why a BodyWaveSpec is unusable, or None."""
+    values = (msg.c1, msg.c2, msg.k, msg.frequency_hz)
+    if not all(math.isfinite(v) for v in values):
+        return f'non-finite value in {values}'
+    if msg.k <= 0.0 or not 0.0 < msg.frequency_hz <= 10.0:
+        return f'need k > 0 and frequency_hz in (0, 10], got k={msg.k}, f={msg.frequency_hz}'
+    return None
+
+
+def servo_sample(msg: JointState) -> tuple[tuple[float, float], tuple[float, float]] | str:
+    """Return (angles, rates) of servo_1, servo_2 in a JointState, or why it is unusable."""
+    names = list(msg.name)
+    if not all(joint in names for joint in JOINTS):
+        return f'JointState needs joints {JOINTS}, got {names}'
+    if len(msg.position) != len(names):
+        return f'JointState has {len(msg.position)} positions for {len(names)} names'
+    index = [names.index(joint) for joint in JOINTS]
+    angles = tuple(float(msg.position[i]) for i in index)
+    if not all(math.isfinite(a) for a in angles):
+        return f'non-finite servo angles {angles}'
+    rates = (math.nan, math.nan)
+    if len(msg.velocity) == len(names):
+        rates = tuple(float(msg.velocity[i]) for i in index)
+        if not all(math.isfinite(r) for r in rates):
+            return f'non-finite servo rates {rates}'
+    return angles, rates
+
+
+def to_stamp(sec: int, nanosec: int) -> Time:
+    """Return a builtin_interfaces/Time."""
+    return Time(sec=int(sec), nanosec=int(nanosec))
+
+
+class KinematicsNode(Node):
+    """Computes the body wave and the Lighthill speed estimate from servo angles."""
+
+    def __init__(self, **kwargs) -> None:
+        """Declare the parameters; wire subscriptions, publishers and the publish timer."""
+        super().__init__('kinematics_node', **kwargs)
+        declare(self, NODE_PARAMETERS)
+        self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
+        self._geometry = geometry_from(self._values)
+        self._target = self._wave_from_parameters()
+        self._history = ServoHistory(2.0 * self._values['max_tail_beat_period_s'])
+        self._latest: tuple[int, int, tuple[float, float]] | None = None
+        self._fresh = False
+        self._last_beat_end: float | None = None
+        self._last_rest_t: float | None = None
+        self._body_pub = self.create_publisher(BodyWave, 'body_wave', qos_profile_sensor_data)
+        self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers',
+                                                 qos_profile_sensor_data)
+        self._speed_pub = self.create_publisher(SpeedEstimateMsg, 'speed_estimate', RELIABLE)
+        self.create_subscription(BodyWaveSpec, 'target_wave', self._on_target, LATCHED)
+        self._servo_sub = None
+        self._subscribe_servo()
+        self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'], self._on_tick)
+        self.add_on_set_parameters_callback(self._validate)
+        self.add_post_set_parameters_callback(self._apply)
+
+    # --- parameters -----------------------------------------------------------------------
+    def _wave_from_parameters(self) -> WaveTarget:
+        v = self._values
+        return WaveTarget(v['wave_c1'], v['wave_c2'], v['wave_k'], v['wave_frequency_hz'])
+
+    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
+        # Check every value and the geometry they make together; reject all with one reason.
+        merged = dict(self._values)
+        for parameter in parameters:
+            spec = SPECS.get(parameter.name)
+            if spec is None:
+                continue
+            reason = check_value(spec, parameter.value)
+            if reason is not None:
+                return SetParametersResult(successful=False, reason=reason)
+            merged[parameter.name] = parameter.value
+        try:
+            geometry_from(merged)
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _apply(self, parameters: list[Parameter]) -> None:
+        names = {p.name for p in parameters if p.name in SPECS}
+        for name in names:
+            self._values[name] = self.get_parameter(name).value
+        if names & set(GEOMETRY_FIELDS):
+            self._geometry = geometry_from(self._values)
+            self._fresh = self._latest is not None
+        if names & {'wave_c1', 'wave_c2', 'wave_k', 'wave_frequency_hz'}:
+            self._target = self._wave_from_parameters()
+        if 'publish_rate_hz' in names:
+            self.destroy_timer(self._timer)
+            self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'],
+                                            self._on_tick)
+        if 'max_tail_beat_period_s' in names:
+            self._history.span_s = 2.0 * self._values['max_tail_beat_period_s']
+        if 'use_servo_state' in names:
+            self._subscribe_servo()
+
+    def _subscribe_servo(self) -> None:
+        if self._servo_sub is not None:
+            self.destroy_subscription(self._servo_sub)
+        topic = 'servo_state' if self._values['use_servo_state'] else 'servo_cmd'
+        self._history.clear()
+        self._latest, self._fresh = None, False
+        self._last_beat_end = self._last_rest_t = None
+        self._servo_sub = self.create_subscription(JointState, topic, self._on_servo,
+                                                   qos_profile_sensor_data)
+
+    # --- inputs ---------------------------------------------------------------------------
+    def _on_servo(self, msg: JointState) -> None:
+        sample = servo_sample(msg)
+        if isinstance(sample, str):
+            self.get_logger().warn(f'{sample}; sample dropped',
+                                   throttle_duration_sec=WARN_PERIOD_S)
+            return
+        sec, nanosec = msg.header.stamp.sec, msg.header.stamp.nanosec
+        if sec == 0 and nanosec == 0:
+            sec, nanosec = self.get_clock().now().seconds_nanoseconds()
+        angles, rates = sample
+        if self._history.add(sec, nanosec, angles, rates):
+            self._latest, self._fresh = (sec, nanosec, angles), True
+
+    def _on_target(self, msg: BodyWaveSpec) -> None:
+        reason = wave_problem(msg)
+        if reason is not None:
+            self.get_logger().warn(f'target_wave ignored: {reason}')
+            return
+        self._target = WaveTarget(msg.c1, msg.c2, msg.k, msg.frequency_hz)
+
+    # --- outputs --------------------------------------------------------------------------
+    def _on_tick(self) -> None:
+        if not self._fresh:
+            return
+        self._fresh = False
+        sec, nanosec, angles = self._latest
+        stamp = to_stamp(sec, nanosec)
+        g = self._geometry
+        stations = np.linspace(0.0, g.tail_length, self._values['station_count'])
+        beta1, beta2 = (float(b) for b in bend_angles(angles[0], angles[1], g))
+        x, y = body_positions(stations, beta1, beta2, g)
+        theta1, theta2 = swing_angles(beta1, beta2, g)
+        y_desired = self._update_tail_beat(stations)
+        msg = BodyWave(q=stations.tolist(), x=x.tolist(), y=y.tolist(),
+                       y_desired=[] if y_desired is None else y_desired.tolist(),
+                       beta1=beta1, beta2=beta2, theta1=float(theta1), theta2=float(theta2))
+        msg.header.stamp, msg.header.frame_id = stamp, FRAME
+        self._body_pub.publish(msg)
+        ends_x, ends_y = body_positions(np.array(g.link_end_stations), beta1, beta2, g)
+        self._marker_pub.publish(self._markers(stamp, x, y, stations, y_desired,
+                                               ends_x, ends_y))
+
+    def _update_tail_beat(self, stations: np.ndarray) -> np.ndarray | None:
+        """Publish a speed estimate per new tail beat; return y_desired at the tail's phase."""
+        g = self._geometry
+        times, angles, rates = self._history.arrays()
+        y_tip = tail_tip_lateral_positions(angles, g)
+        beat = last_tail_beat(times, y_tip, REST_HALF_RANGE_M)
+        if beat is None:
+            at_rest = 0.5 * np.ptp(y_tip) < REST_HALF_RANGE_M
+            span = self._values['max_tail_beat_period_s']
+            if (at_rest and self._history.duration_s() >= span
+                    and (self._last_rest_t is None or times[-1] - self._last_rest_t >= span)):
+                self._last_rest_t = float(times[-1])
+                self._publish_speed(SpeedEstimate(0.0, 0.0, 0.0, 0.0, 0.0, 0.5 * np.ptp(y_tip)),
+                                    float(times[-1]))
+            return None
+        if beat.end != self._last_beat_end:
+            self._last_beat_end = beat.end
+            self._publish_speed(estimate_speed_over(times, angles, rates, beat.start, beat.end,
+                                                    g), beat.end)
+        target = self._target
+        beta1, beta2 = bend_angles(angles[:, 0], angles[:, 1], g)
+        _, y_q1 = body_positions(np.array([g.l1]), beta1, beta2, g)
+        phase = fundamental_phase(times, y_q1[:, 0], beat, times[-1])
+        tau = wave_time_at_phase(phase, g.l1, target.k, target.frequency_hz)
+        return desired_lateral_position(stations, tau, target.c1, target.c2, target.k,
+                                        target.frequency_hz)
+
+    def _publish_speed(self, estimate: SpeedEstimate, t: float) -> None:
+        msg = SpeedEstimateMsg(speed=estimate.speed, thrust=estimate.thrust,
+                               drag=estimate.drag, swimming_number=estimate.swimming_number,
+                               tail_beat_hz=estimate.tail_beat_hz,
+                               tail_tip_amplitude=float(estimate.tail_tip_amplitude))
+        msg.header.stamp = to_stamp(*self._history.stamp_of(t))
+        msg.header.frame_id = FRAME
+        self._speed_pub.publish(msg)
+
+    def _markers(self, stamp: Time, x: np.ndarray, y: np.ndarray, stations: np.ndarray,
+                 y_desired: np.ndarray | None, ends_x: np.ndarray, ends_y: np.ndarray
+                 ) -> MarkerArray:
+        def marker(marker_id: int, kind: int, points_x, points_y, scale: float,
+                   rgb: tuple[float, float, float]) -> Marker:
+            m = Marker(ns='body_wave', id=marker_id, type=kind, action=Marker.ADD)
+            m.header.stamp, m.header.frame_id = stamp, FRAME
+            m.pose.orientation.w = 1.0
+            m.scale.x = m.scale.y = m.scale.z = scale
+            m.color.r, m.color.g, m.color.b = rgb
+            m.color.a = 1.0
+            m.points = [Point(x=float(px), y=float(py)) for px, py in zip(points_x, points_y)]
+            return m
+
+        markers = [marker(0, Marker.LINE_STRIP, x, y, 0.004, (0.1, 0.3, 0.9)),
+                   marker(2, Marker.SPHERE_LIST, ends_x[:1], ends_y[:1], 0.012, (0.9, 0.5, 0.1)),
+                   marker(3, Marker.CUBE_LIST, ends_x[1:], ends_y[1:], 0.012, (0.8, 0.1, 0.1))]
+        if y_desired is None:
+            gone = Marker(ns='body_wave', id=1, action=Marker.DELETE)
+            gone.header.stamp, gone.header.frame_id = stamp, FRAME
+            markers.append(gone)
+        else:
+            markers.append(marker(1, Marker.POINTS, stations, y_desired, 0.004,
+                                  (0.2, 0.7, 0.2)))
+        return MarkerArray(markers=markers)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the kinematics node until shutdown."""
+    rclpy.init(args=args)
+    node = KinematicsNode()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
