@@ -32,7 +32,7 @@ class TailBeat:
 
     @property
     def period(self) -> float:
-        """Return the period (s)."""
+        """Return the duration of the tail beat (s)."""
         return self.end - self.start
 
     @property
