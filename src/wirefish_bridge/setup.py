@@ -8,7 +8,7 @@ setup(
     packages=find_packages(exclude=['test']),
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
-        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name, ['package.xml', 'PROTOCOL.md', 'README.md']),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
@@ -19,6 +19,8 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
+            'bridge_node = wirefish_bridge.bridge_node:main',
+            'fish_sim = wirefish_bridge.fish_sim:main',
         ],
     },
 )

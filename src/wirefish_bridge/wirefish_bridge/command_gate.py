@@ -1,0 +1,75 @@
+"""
+Servo command gating of the bridge: rate limit and failsafe (pure, no I/O, no rclpy).
+
+Times are seconds of any monotonic clock. The node calls ``on_command`` for every servo_cmd
+message and ``on_tick`` from a timer; each returns the angles to send now, or None.
+"""
+
+from __future__ import annotations
+
+NEUTRAL = (0.0, 0.0)
+
+
+class CommandGate:
+    """
+    Forward at most ``max_rate_hz`` commands per second and command neutral on silence.
+
+    A command arriving sooner than 1/``max_rate_hz`` after the last one sent is held; the next
+    tick sends the newest held one (older ones are superseded, never queued). When no command
+    arrived for ``timeout_s`` (or none ever did) the gate is in failsafe: it returns
+    ``NEUTRAL`` at most every ``neutral_period_s`` so a lost frame is repeated.
+    """
+
+    def __init__(self, max_rate_hz: float, timeout_s: float, limit_rad: float,
+                 neutral_period_s: float = 0.1) -> None:
+        """Set the rate limit (Hz), the silence timeout (s) and the angle clamp (rad)."""
+        self.max_rate_hz = max_rate_hz
+        self.timeout_s = timeout_s
+        self.limit_rad = limit_rad
+        self.neutral_period_s = neutral_period_s
+        self.failsafe = True
+        self.failsafe_entries = 0
+        self.clamped = 0
+        self._last_command_time: float | None = None
+        self._last_sent_time = -float('inf')
+        self._pending: tuple[float, float] | None = None
+
+    def _clamp(self, angles: tuple[float, float]) -> tuple[float, float]:
+        limit = self.limit_rad
+        clamped = tuple(min(limit, max(-limit, a)) for a in angles)
+        if clamped != tuple(angles):
+            self.clamped += 1
+        return clamped
+
+    def on_command(self, angles: tuple[float, float], now: float
+                   ) -> tuple[float, float] | None:
+        """Take a new command (rad); return it (clamped) if it may go out now, else None."""
+        self._last_command_time = now
+        self.failsafe = False
+        angles = self._clamp(angles)
+        if now - self._last_sent_time >= 1.0 / self.max_rate_hz:
+            self._pending = None
+            self._last_sent_time = now
+            return angles
+        self._pending = angles
+        return None
+
+    def on_tick(self, now: float) -> tuple[float, float] | None:
+        """Return a held command that may now go out, or NEUTRAL in failsafe, or None."""
+        silent = (self._last_command_time is None
+                  or now - self._last_command_time > self.timeout_s)
+        if silent:
+            if not self.failsafe:
+                self.failsafe = True
+                self.failsafe_entries += 1
+                self._last_sent_time = -float('inf')  # send neutral at once
+            self._pending = None
+            if now - self._last_sent_time >= self.neutral_period_s:
+                self._last_sent_time = now
+                return NEUTRAL
+            return None
+        if self._pending is not None and now - self._last_sent_time >= 1.0 / self.max_rate_hz:
+            angles, self._pending = self._pending, None
+            self._last_sent_time = now
+            return angles
+        return None

@@ -1,0 +1,164 @@
+"""
+Speed of the virtual fish against tail-beat frequency at 5 cm tail-tip amplitude (paper Fig 11).
+
+``python -m wirefish_bridge.fig11 --out out/fig11.png`` runs the sweep (faster than real time,
+no ROS) and writes the PNG and the numbers. The gait is Table 1's CPG with both amplitudes
+scaled so that the kinematic tail-tip half amplitude with ideal servos is 5 cm; at each
+frequency the virtual fish is driven with the CPG's locked output (sampled at 200 Hz, as
+cpg_node publishes it) and its mean surge speed is taken once the transient has died out. The
+servo model's rate limit and lag make the real amplitude, and with it the speed, collapse at
+high frequency; ``ideal`` is eq 18 on the commanded angles (servos that follow exactly).
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, replace
+import json
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import brentq
+from wirefish_cpg.oscillator import CpgParameters
+from wirefish_cpg.steady_state import (intrinsic_frequency_for, stable_phase_difference,
+                                       steady_state_servo_angles)
+from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.lighthill import estimate_speed, SpeedEstimate
+
+from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
+
+TABLE_1 = CpgParameters()  # the defaults are Table 1 (alpha = 20, b = 0)
+COMMAND_RATE_HZ = 200.0
+
+
+def locked_gait(frequency_hz: float, scale: float = 1.0,
+                base: CpgParameters = TABLE_1) -> CpgParameters:
+    """
+    Return ``base`` with amplitudes times ``scale`` and v set so the network locks at f.
+
+    The coupling shifts the locked frequency away from v (eq 1); scaling both amplitudes leaves
+    the locked phase difference unchanged.
+    """
+    amplitude = tuple(scale * a for a in base.amplitude)
+    r1, r2 = amplitude
+    delta = stable_phase_difference(r1, r2, base.w12, base.w21, base.phi12, base.phi21)
+    v = float(intrinsic_frequency_for(frequency_hz, r2, base.w12, base.phi12, delta))
+    return replace(base, amplitude=amplitude, frequency_hz=v)
+
+
+def ideal_estimate(params: CpgParameters, frequency_hz: float, geometry: FishGeometry,
+                   samples: int = 400) -> SpeedEstimate:
+    """Return eq 18 (kinematics core) on one period of the commanded (locked) servo angles."""
+    dt = 1.0 / (frequency_hz * samples)
+    angles, rates = steady_state_servo_angles(params, np.arange(samples) * dt)
+    return estimate_speed(angles, rates, dt, geometry)
+
+
+def amplitude_scale_for(tip_amplitude_m: float, geometry: FishGeometry,
+                        frequency_hz: float = 3.0) -> float:
+    """Return the factor on Table 1's amplitudes giving ``tip_amplitude_m`` with ideal servos."""
+    def error(scale: float) -> float:
+        gait = locked_gait(frequency_hz, scale)
+        return ideal_estimate(gait, frequency_hz, geometry).tail_tip_amplitude - tip_amplitude_m
+    return float(brentq(error, 0.01, 3.0, xtol=1e-6))
+
+
+@dataclass(frozen=True)
+class SteadyRun:
+    """Result of driving the virtual fish with one gait: mean speed and tail amplitude."""
+
+    frequency_hz: float
+    speed: float            # mean surge speed over the averaging window (m/s)
+    tail_tip_amplitude: float  # half peak-to-peak of the simulated tail tip offset (m)
+    ideal_speed: float      # eq 18 on the commanded angles (m/s)
+
+
+def run_steady(params: CpgParameters, frequency_hz: float, geometry: FishGeometry,
+               config: SimConfig | None = None, settle_s: float = 5.0,
+               average_s: float = 2.0) -> SteadyRun:
+    """
+    Drive a virtual fish with the locked gait ``params`` and return its steady mean speed.
+
+    Commands at 200 Hz (as cpg_node); ``settle_s`` for the transient (several surge time
+    constants), then the mean over ``average_s`` rounded to whole tail-beat periods.
+    """
+    config = config or SimConfig(command_timeout_s=None, heartbeat_timeout_s=None)
+    fish = VirtualFish(config, geometry, np.random.default_rng(0))
+    dt = 1.0 / COMMAND_RATE_HZ
+    periods = max(1, round(average_s * frequency_hz))
+    steps_settle = round(settle_s / dt)
+    steps_average = round(periods / frequency_hz / dt)
+    times = np.arange(steps_settle + steps_average) * dt
+    commands, _ = steady_state_servo_angles(params, times)
+    speeds, tips = [], []
+    for i, (servo_1, servo_2) in enumerate(commands.tolist()):
+        fish.command(servo_1, servo_2)
+        fish.step(dt)
+        if i >= steps_settle:
+            speeds.append(fish.state.speed)
+            tips.append(fish.state.tail_tip_offset)
+    ideal = ideal_estimate(params, frequency_hz, geometry).speed
+    return SteadyRun(frequency_hz, float(np.mean(speeds)), 0.5 * float(np.ptp(tips)), ideal)
+
+
+def speed_sweep(frequencies_hz: np.ndarray | None = None, tip_amplitude_m: float = 0.05,
+                geometry: FishGeometry | None = None,
+                config: SimConfig | None = None) -> list[SteadyRun]:
+    """Return the steady runs at ``frequencies_hz`` (default 1..8 Hz by 0.5) at 5 cm."""
+    geometry = geometry or FishGeometry()
+    if frequencies_hz is None:
+        frequencies_hz = np.arange(1.0, 8.01, 0.5)
+    scale = amplitude_scale_for(tip_amplitude_m, geometry)
+    return [run_steady(locked_gait(f, scale), f, geometry, config)
+            for f in np.asarray(frequencies_hz, dtype=float).tolist()]
+
+
+def peak_frequency(runs: list[SteadyRun]) -> float:
+    """Return the frequency (Hz) of the fastest run."""
+    return max(runs, key=lambda run: run.speed).frequency_hz
+
+
+def write_png(runs: list[SteadyRun], path: Path) -> None:
+    """Plot speed and tail amplitude against frequency (the shape of Fig 11) to ``path``."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    f = [r.frequency_hz for r in runs]
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.plot(f, [r.speed for r in runs], 'o-', label='virtual fish (servo model)')
+    ax.plot(f, [r.ideal_speed for r in runs], '--', color='gray',
+            label='eq 18, ideal servos')
+    ax.axvline(peak_frequency(runs), color='C3', lw=0.8, ls=':')
+    ax.set_xlabel('tail-beat frequency (Hz)')
+    ax.set_ylabel('steady swimming speed (m/s)')
+    ax.set_title('Speed vs frequency at 5 cm tail-tip amplitude (cf. paper Fig 11)')
+    twin = ax.twinx()
+    twin.plot(f, [100.0 * r.tail_tip_amplitude for r in runs], 's:', color='C2', ms=4,
+              label='simulated tail-tip amplitude')
+    twin.set_ylabel('tail-tip half amplitude (cm)', color='C2')
+    lines = ax.get_legend_handles_labels()
+    more = twin.get_legend_handles_labels()
+    ax.legend(lines[0] + more[0], lines[1] + more[1], loc='upper left', fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the sweep, write the PNG, print the numbers as JSON."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--out', type=Path, default=Path('out/fig11.png'), help='PNG path')
+    parser.add_argument('--amplitude', type=float, default=0.05, help='tail-tip amplitude (m)')
+    args = parser.parse_args(argv)
+    runs = speed_sweep(tip_amplitude_m=args.amplitude)
+    write_png(runs, args.out)
+    print(json.dumps({'png': str(args.out), 'peak_hz': peak_frequency(runs),
+                      'runs': [r.__dict__ for r in runs]}, indent=1))
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

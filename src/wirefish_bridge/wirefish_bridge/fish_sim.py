@@ -1,0 +1,201 @@
+"""
+fish_sim: the virtual fish on a pseudo-terminal, playing the board's firmware in real time.
+
+``fish_sim --link /tmp/wirefish-tty`` opens a pty pair, prints the device path on stdout (one
+line, flushed), points the link at it and runs until SIGINT/SIGTERM (exit code 0). The core
+(``VirtualFish``) needs no ROS; with ``--ros`` the process also publishes ``sim/ground_truth``
+(nav_msgs/Odometry, frame ``odom``, child ``base_link``). Fault flags: ``--corrupt-fraction``,
+``--drop-fraction``, ``--stall-every/--stall-for`` (firmware freezes: no output, input lost),
+``--reopen-every/--reopen-count/--reopen-delay`` (close the device, wait, open a new one).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+import select
+import signal
+import sys
+import time
+
+import numpy as np
+
+from wirefish_bridge.faults import FaultInjector
+from wirefish_bridge.pty_device import PtyDevice
+from wirefish_bridge.servo_model import ServoParameters
+from wirefish_bridge.virtual_fish import ImuNoise, SimConfig, VirtualFish
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the argument parser (every option of the virtual fish is a flag)."""
+    p = argparse.ArgumentParser(prog='fish_sim', description=__doc__.split('\n\n')[0])
+    p.add_argument('--link', type=Path, default=None,
+                   help='symlink pointing at the current pty device (e.g. /tmp/wirefish-tty)')
+    p.add_argument('--ros', action='store_true', help='publish sim/ground_truth')
+    p.add_argument('--ground-truth-hz', type=float, default=50.0)
+    p.add_argument('--seed', type=int, default=0, help='seed of IMU noise and faults')
+    p.add_argument('--telemetry-hz', type=float, default=100.0)
+    p.add_argument('--heartbeat-hz', type=float, default=2.0)
+    p.add_argument('--command-timeout', type=float, default=0.5,
+                   help='firmware: neutral after this long without SERVO_CMD (s)')
+    p.add_argument('--heartbeat-timeout', type=float, default=1.5,
+                   help='firmware: neutral after this long without a host heartbeat (s)')
+    p.add_argument('--speed-time-constant', type=float, default=0.75,
+                   help='surge time constant set by the force scale (s)')
+    p.add_argument('--servo-rate-limit', type=float, default=12.0, help='rad/s')
+    p.add_argument('--servo-lag', type=float, default=0.02, help='first-order lag (s)')
+    p.add_argument('--servo-update-hz', type=float, default=333.0)
+    p.add_argument('--servo-limit', type=float, default=math.pi / 2, help='+-rad')
+    p.add_argument('--imu-noise-scale', type=float, default=1.0,
+                   help='factor on IMU noise and bias (0 = perfect IMU)')
+    p.add_argument('--corrupt-fraction', type=float, default=0.0,
+                   help='probability that an output byte is corrupted')
+    p.add_argument('--drop-fraction', type=float, default=0.0,
+                   help='probability that an output frame is dropped')
+    p.add_argument('--stall-every', type=float, default=0.0, help='stall period (s), 0 = off')
+    p.add_argument('--stall-for', type=float, default=0.0, help='stall duration (s)')
+    p.add_argument('--reopen-every', type=float, default=0.0,
+                   help='close and reopen the device every this many s (0 = never)')
+    p.add_argument('--reopen-count', type=int, default=0, help='how many reopens (0 = no limit)')
+    p.add_argument('--reopen-delay', type=float, default=0.3,
+                   help='time the device is absent during a reopen (s)')
+    return p
+
+
+def config_from(args: argparse.Namespace) -> SimConfig:
+    """Return the SimConfig of the parsed flags."""
+    return SimConfig(
+        telemetry_hz=args.telemetry_hz, heartbeat_hz=args.heartbeat_hz,
+        command_timeout_s=args.command_timeout, heartbeat_timeout_s=args.heartbeat_timeout,
+        speed_time_constant_s=args.speed_time_constant,
+        servo=ServoParameters(args.servo_rate_limit, args.servo_lag, args.servo_update_hz,
+                              args.servo_limit),
+        imu_noise=ImuNoise().scaled(args.imu_noise_scale))
+
+
+class GroundTruthPublisher:
+    """sim/ground_truth (nav_msgs/Odometry) from the fish state; only with --ros."""
+
+    def __init__(self, ros_args: list[str]) -> None:
+        """Initialise rclpy without its signal handlers (ours stop the loop cleanly)."""
+        import rclpy
+        from rclpy.signals import SignalHandlerOptions
+        from nav_msgs.msg import Odometry
+
+        self._rclpy = rclpy
+        rclpy.init(args=ros_args, signal_handler_options=SignalHandlerOptions.NO)
+        self.node = rclpy.create_node('fish_sim')
+        self._odometry = Odometry
+        self.publisher = self.node.create_publisher(Odometry, 'sim/ground_truth', 10)
+
+    def publish(self, fish: VirtualFish) -> None:
+        """Publish the fish's ground truth now."""
+        s = fish.state
+        msg = self._odometry()
+        msg.header.stamp = self.node.get_clock().now().to_msg()
+        msg.header.frame_id = 'odom'
+        msg.child_frame_id = 'base_link'
+        msg.pose.pose.position.x, msg.pose.pose.position.y = s.x, s.y
+        msg.pose.pose.orientation.z = math.sin(s.yaw / 2.0)
+        msg.pose.pose.orientation.w = math.cos(s.yaw / 2.0)
+        msg.twist.twist.linear.x = s.speed
+        msg.twist.twist.angular.z = s.yaw_rate
+        self.publisher.publish(msg)
+
+    def close(self) -> None:
+        """Destroy the node and shut rclpy down."""
+        self.node.destroy_node()
+        self._rclpy.try_shutdown()
+
+
+class Schedule:
+    """Periodic fault windows: is an event active at time t (s since start)?"""
+
+    def __init__(self, every_s: float, duration_s: float, count: int = 0) -> None:
+        """Every ``every_s`` s an event of ``duration_s`` s; at most ``count`` (0 = no limit)."""
+        self.every_s, self.duration_s, self.count = every_s, duration_s, count
+
+    def index(self, t: float) -> int | None:
+        """Return the number of the event active at ``t``, or None."""
+        if self.every_s <= 0.0 or t < self.every_s:
+            return None
+        n = int(t // self.every_s)
+        if self.count and n > self.count:
+            return None
+        return n if t - n * self.every_s < self.duration_s else None
+
+
+def run(args: argparse.Namespace, ros_args: list[str]) -> int:
+    """Run the virtual fish until SIGINT/SIGTERM; return the exit code."""
+    stop = []
+    signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+    rng = np.random.default_rng(args.seed)
+    fish = VirtualFish(config_from(args), rng=rng)
+    faults = FaultInjector(np.random.default_rng(args.seed + 1), args.corrupt_fraction,
+                           args.drop_fraction)
+    stalls = Schedule(args.stall_every, args.stall_for)
+    reopens = Schedule(args.reopen_every, args.reopen_delay, args.reopen_count)
+    device = PtyDevice(args.link)
+    ground_truth = GroundTruthPublisher(ros_args) if args.ros else None
+    try:
+        print(device.open(), flush=True)
+        start = last = time.monotonic()
+        next_truth = start
+        reopened = 0
+        while not stop:
+            now = time.monotonic()
+            elapsed = now - start
+            closing = reopens.index(elapsed)
+            if closing is not None and device.is_open:
+                device.close()
+                print(f'fish_sim: device closed (reopen {closing})', file=sys.stderr, flush=True)
+            elif closing is None and not device.is_open:
+                path = device.open()
+                reopened += 1
+                print(f'fish_sim: reopened as {path} ({reopened})', file=sys.stderr, flush=True)
+            stalled = stalls.index(elapsed) is not None
+            data = device.read()
+            if data and not stalled:
+                fish.receive(data)
+            fish.step(now - last)
+            last = now
+            output = fish.take_output()
+            if device.is_open and not stalled and output:
+                device.write(faults.apply(output))
+            if ground_truth is not None and now >= next_truth:
+                ground_truth.publish(fish)
+                next_truth += 1.0 / args.ground_truth_hz
+            # Sleep until the next telemetry is due or the host writes, whichever is first.
+            wait = max(0.0005, min(0.01, 1.0 / args.telemetry_hz / 2.0))
+            if device.is_open:
+                try:
+                    select.select([device], [], [], wait)
+                except InterruptedError:
+                    pass
+            else:
+                time.sleep(wait)
+    finally:
+        device.close()
+        device.remove_link()
+        if ground_truth is not None:
+            ground_truth.close()
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: split off --ros-args, parse the flags, run."""
+    argv = list(sys.argv if argv is None else argv)
+    ros_args = argv
+    try:
+        from rclpy.utilities import remove_ros_args
+        plain = remove_ros_args(argv)[1:]
+    except ImportError:
+        plain = argv[1:]
+    args = build_parser().parse_args(plain)
+    return run(args, ros_args)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -1,0 +1,60 @@
+"""
+ROS parameters from one table: declaration with descriptors, and pure validation.
+
+No rclpy import at module level, so the validation is testable without ROS. Each
+``ParameterSpec`` is a name, default, description and (for numbers) an inclusive range.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """A parameter: default (float, int, bool or str), description, inclusive range."""
+
+    name: str
+    default: float | int | bool | str
+    description: str
+    low: float | None = None
+    high: float | None = None
+
+
+def check_value(spec: ParameterSpec, value: object) -> str | None:
+    """Return why ``value`` is not acceptable for ``spec``, or None if it is."""
+    kind = type(spec.default)
+    if kind is bool or kind is str:
+        if type(value) is not kind:
+            return f'{spec.name} must be a {kind.__name__}, got {value!r}'
+        if kind is str and not value:
+            return f'{spec.name} must not be empty'
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f'{spec.name} must be a number, got {value!r}'
+    if kind is int and not isinstance(value, int):
+        return f'{spec.name} must be an integer, got {value!r}'
+    if not math.isfinite(value):
+        return f'{spec.name} must be finite, got {value}'
+    if spec.low is not None and value < spec.low:
+        return f'{spec.name} must be >= {spec.low:g}, got {value:g}'
+    if spec.high is not None and value > spec.high:
+        return f'{spec.name} must be <= {spec.high:g}, got {value:g}'
+    return None
+
+
+def declare(node, specs: tuple[ParameterSpec, ...]) -> None:
+    """Declare every spec on ``node`` with a descriptor carrying its description and range."""
+    from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+
+    for spec in specs:
+        descriptor = ParameterDescriptor(description=spec.description)
+        if spec.low is not None and spec.high is not None:
+            if type(spec.default) is float:
+                descriptor.floating_point_range = [FloatingPointRange(
+                    from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
+            elif type(spec.default) is int:
+                descriptor.integer_range = [IntegerRange(
+                    from_value=int(spec.low), to_value=int(spec.high), step=1)]
+        node.declare_parameter(spec.name, spec.default, descriptor)

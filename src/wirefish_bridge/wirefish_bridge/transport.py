@@ -1,0 +1,192 @@
+"""
+Serial transport of the bridge: pyserial, a reader thread, reconnection with backoff.
+
+No rclpy and no protocol knowledge: bytes in (``on_data`` called from the reader thread),
+bytes out (``write``, non-blocking). When the device disappears (unplugged, or the virtual
+fish closed its pseudo-terminal) the reader thread reports it through ``on_state``, closes the
+port, and retries opening the same path with exponential backoff until it is back; nobody has
+to restart anything. Errors are typed (``LinkError`` and subclasses); nothing calls sys.exit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+import enum
+import threading
+
+import serial
+
+
+class LinkError(Exception):
+    """Base class of the transport's errors."""
+
+
+class LinkDown(LinkError):
+    """The port is not open (device absent, or reconnecting)."""
+
+
+class LinkWriteError(LinkError):
+    """A write failed or was cut short (device gone, or its buffer full)."""
+
+
+class LinkState(enum.Enum):
+    """State of the link, as reported to ``on_state``."""
+
+    CONNECTING = 'connecting'
+    CONNECTED = 'connected'
+    DISCONNECTED = 'disconnected'
+    STOPPED = 'stopped'
+
+
+@dataclass
+class LinkStats:
+    """Counters of a ``SerialLink`` (monotonic). ``reconnects`` = successful opens - 1."""
+
+    opens: int = 0
+    reconnects: int = 0
+    disconnects: int = 0
+    open_failures: int = 0
+    bytes_in: int = 0
+    bytes_out: int = 0
+    write_failures: int = 0
+    last_error: str = ''
+
+
+def next_backoff(current_s: float, minimum_s: float, maximum_s: float) -> float:
+    """Return the next retry delay: double ``current_s``, within [minimum_s, maximum_s]."""
+    return min(maximum_s, max(minimum_s, 2.0 * current_s))
+
+
+class SerialLink:
+    """
+    One serial port, kept open by a reader thread.
+
+    ``on_data(chunk)`` and ``on_state(state, detail)`` run on the reader thread: keep them
+    short (the bridge feeds its decoder and wakes its executor). ``write`` may be called from
+    any thread and never blocks.
+    """
+
+    def __init__(self, port: str, baudrate: int, on_data: Callable[[bytes], None],
+                 on_state: Callable[[LinkState, str], None] | None = None, *,
+                 backoff_min_s: float = 0.1, backoff_max_s: float = 1.0,
+                 read_timeout_s: float = 0.05,
+                 serial_factory: Callable[..., serial.Serial] = serial.Serial) -> None:
+        """Configure the link; nothing is opened before ``start``."""
+        self.port = port
+        self.baudrate = baudrate
+        self.stats = LinkStats()
+        self._on_data = on_data
+        self._on_state = on_state or (lambda state, detail: None)
+        self._backoff_min_s = backoff_min_s
+        self._backoff_max_s = backoff_max_s
+        self._read_timeout_s = read_timeout_s
+        self._factory = serial_factory
+        self._serial: serial.Serial | None = None
+        self._lock = threading.Lock()   # guards _serial between the reader and writers
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self.state = LinkState.STOPPED
+
+    @property
+    def connected(self) -> bool:
+        """Return True while the port is open."""
+        return self.state is LinkState.CONNECTED
+
+    def start(self) -> None:
+        """Start the reader thread (which opens the port); idempotent."""
+        if self._thread is not None:
+            return
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name=f'serial:{self.port}',
+                                        daemon=True)
+        self._thread.start()
+
+    def stop(self, timeout_s: float = 2.0) -> None:
+        """Stop the reader thread, join it and close the port."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout_s)
+            self._thread = None
+        self._close()
+        self._set_state(LinkState.STOPPED, 'stopped')
+
+    def write(self, data: bytes) -> None:
+        """
+        Write ``data`` without blocking.
+
+        Raises ``LinkDown`` when the port is not open, ``LinkWriteError`` when the device
+        failed or took only part of ``data`` (the receiver discards the cut frame).
+        """
+        with self._lock:
+            port = self._serial
+            if port is None:
+                raise LinkDown(f'{self.port} is not open')
+            try:
+                written = port.write(data)
+            except (serial.SerialException, OSError) as error:
+                self.stats.write_failures += 1
+                raise LinkWriteError(f'write to {self.port} failed: {error}') from error
+        self.stats.bytes_out += written or 0
+        if written != len(data):
+            self.stats.write_failures += 1
+            raise LinkWriteError(f'{self.port} took {written} of {len(data)} bytes')
+
+    def _set_state(self, state: LinkState, detail: str) -> None:
+        if state is not self.state:
+            self.state = state
+            self._on_state(state, detail)
+
+    def _close(self) -> None:
+        with self._lock:
+            port, self._serial = self._serial, None
+        if port is not None:
+            try:
+                port.close()
+            except (serial.SerialException, OSError):
+                pass  # closing a vanished device may fail; it is closed either way
+
+    def _open(self) -> bool:
+        try:
+            # write_timeout=0: non-blocking writes, so no caller ever waits on the device.
+            port = self._factory(self.port, self.baudrate, timeout=self._read_timeout_s,
+                                 write_timeout=0)
+            port.reset_input_buffer()  # stale bytes from before we were listening
+        except (serial.SerialException, OSError, ValueError) as error:
+            self.stats.open_failures += 1
+            self.stats.last_error = str(error)
+            return False
+        with self._lock:
+            self._serial = port
+        self.stats.opens += 1
+        if self.stats.opens > 1:
+            self.stats.reconnects += 1
+        return True
+
+    def _run(self) -> None:
+        backoff = self._backoff_min_s
+        self._set_state(LinkState.CONNECTING, f'opening {self.port}')
+        while not self._stop.is_set():
+            port = self._serial
+            if port is None:
+                if self._open():
+                    backoff = self._backoff_min_s
+                    self._set_state(LinkState.CONNECTED, f'{self.port} open')
+                else:
+                    self._stop.wait(backoff)
+                    backoff = next_backoff(backoff, self._backoff_min_s, self._backoff_max_s)
+                continue
+            try:
+                chunk = port.read(port.in_waiting or 1)
+            except (serial.SerialException, OSError, TypeError, AttributeError) as error:
+                # TypeError/AttributeError: pyserial's read on a port closed under it.
+                self.stats.disconnects += 1
+                self.stats.last_error = str(error)
+                self._close()
+                self._set_state(LinkState.DISCONNECTED, f'{self.port} lost: {error}')
+                self._stop.wait(backoff)
+                continue
+            if chunk:
+                self.stats.bytes_in += len(chunk)
+                self._on_data(chunk)
+        self._close()
