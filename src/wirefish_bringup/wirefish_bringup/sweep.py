@@ -1,0 +1,158 @@
+"""
+`wirefish sweep`: model and virtual-fish swimming speed over the paper's grid (Figs 9-11).
+
+The grid of section 5.4: f = 1.0 ... 3.0 Hz in steps of 0.2 at tail-tip half amplitudes
+{4, 4.5, 6.5, 8, 9} cm, plus 5 cm from 1 to 8 Hz (Fig 11). At each point Table 1's amplitudes
+are scaled so the ideal-servo tail tip swings the stated amplitude, and the network is locked at
+f. "model" is eq 18 on the commanded angles (kinematics core); "virtual fish" is the steady mean
+surge speed of the simulated fish (servo rate limit and lag, surge dynamics) driven by the same
+commands. The paper's stated points are drawn beside them.
+"""
+
+import argparse
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+GRID_FREQUENCIES_HZ = tuple(round(1.0 + 0.2 * k, 1) for k in range(11))
+GRID_AMPLITUDES_M = (0.04, 0.045, 0.065, 0.08, 0.09)
+FIG11_AMPLITUDE_M = 0.05
+FIG11_FREQUENCIES_HZ = tuple(float(f) for f in np.arange(1.0, 8.01, 0.5))
+# The paper's figures as stated in its text: (f Hz, tip amplitude m or None for Table 1, U m/s).
+PAPER_POINTS = ((3.0, None, 0.39), (6.5, 0.05, 0.54), (1.0, 0.09, 0.33 * 1.0 * 0.53))
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    """One grid point: model and virtual-fish steady speed (m/s) and swimming numbers."""
+
+    frequency_hz: float
+    tip_amplitude_m: float
+    model_speed: float
+    fish_speed: float | None
+    body_length: float
+
+    def swimming_number(self, speed: float | None) -> float | None:
+        """Return Sw = U / (f L) for ``speed``."""
+        return None if speed is None else speed / (self.frequency_hz * self.body_length)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish sweep`."""
+    parser.add_argument('-o', '--out', type=Path, default=Path('out', 'sweep'),
+                        help='where the PNGs and sweep.csv go')
+    parser.add_argument('--model-only', action='store_true',
+                        help='skip the virtual fish (eq 18 only, a second instead of a minute)')
+
+
+def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) -> SweepPoint:
+    """Compute one grid point with the default geometry."""
+    from wirefish_bridge.fig11 import run_steady
+    from wirefish_bringup.calibrate_drag import (amplitude_scale_for, estimate,
+                                                 table1_locked_at)
+    from wirefish_kinematics.geometry import FishGeometry
+
+    geometry = FishGeometry()
+    scale = amplitude_scale_for(tip_amplitude_m, frequency_hz, geometry)
+    params = table1_locked_at(frequency_hz, scale)
+    model = estimate(params, geometry).speed
+    fish = run_steady(params, frequency_hz, geometry).speed if with_fish else None
+    return SweepPoint(frequency_hz, tip_amplitude_m, float(model), fish, geometry.body_length)
+
+
+def run_sweep(with_fish: bool = True) -> tuple[list[SweepPoint], list[SweepPoint]]:
+    """Return (the Fig 9/10 grid, the Fig 11 line)."""
+    grid = [sweep_point(f, a, with_fish) for a in GRID_AMPLITUDES_M for f in GRID_FREQUENCIES_HZ]
+    line = [sweep_point(f, FIG11_AMPLITUDE_M, with_fish) for f in FIG11_FREQUENCIES_HZ]
+    return grid, line
+
+
+def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> list[Path]:
+    """Write sweep.csv and the Fig 9/10/11-like PNGs; return the paths written."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    out.mkdir(parents=True, exist_ok=True)
+    rows = ['figure,frequency_hz,tip_amplitude_m,model_speed_mps,fish_speed_mps,model_sw,fish_sw']
+    for name, points in (('9-10', grid), ('11', line)):
+        for p in points:
+            fish = _optional(p.fish_speed, '.4f')
+            fish_sw = _optional(p.swimming_number(p.fish_speed), '.4f')
+            rows.append(f'{name},{p.frequency_hz:.2f},{p.tip_amplitude_m:.3f},'
+                        f'{p.model_speed:.4f},{fish},{p.swimming_number(p.model_speed):.4f},'
+                        f'{fish_sw}')
+    paths = [out / 'sweep.csv']
+    paths[0].write_text('\n'.join(rows) + '\n')
+    for figure, quantity in (('fig9_speed.png', 'speed'), ('fig10_swimming_number.png', 'sw')):
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        for amplitude in GRID_AMPLITUDES_M:
+            points = [p for p in grid if p.tip_amplitude_m == amplitude]
+            f = [p.frequency_hz for p in points]
+            model = [p.model_speed if quantity == 'speed' else p.swimming_number(p.model_speed)
+                     for p in points]
+            line_ = ax.plot(f, model, '-', label=f'{amplitude * 100:g} cm model (eq 18)')[0]
+            if points[0].fish_speed is not None:
+                fish = [p.fish_speed if quantity == 'speed' else p.swimming_number(p.fish_speed)
+                        for p in points]
+                ax.plot(f, fish, '--', color=line_.get_color())
+        for f, amplitude, speed in PAPER_POINTS:
+            if f <= 3.0:
+                value = speed if quantity == 'speed' else speed / (f * 0.53)
+                ax.plot(f, value, 'k*', markersize=12)
+        ax.plot([], [], 'k--', label='virtual fish (dashed)')
+        ax.plot([], [], 'k*', label='paper (stated in text)')
+        ax.set(xlabel='tail-beat frequency (Hz)',
+               ylabel='steady speed (m/s)' if quantity == 'speed' else 'Sw = U / (f L)',
+               title='Speed over the paper grid (Fig 9)' if quantity == 'speed'
+               else 'Swimming number (Fig 10)')
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / figure, dpi=110)
+        plt.close(fig)
+        paths.append(out / figure)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot([p.frequency_hz for p in line], [p.model_speed for p in line], '-',
+            label='model (eq 18, ideal servos)')
+    if line[0].fish_speed is not None:
+        ax.plot([p.frequency_hz for p in line], [p.fish_speed for p in line], 'o--',
+                label='virtual fish (servo limits)')
+    ax.plot(6.5, 0.54, 'k*', markersize=12, label='paper: 0.54 m/s at 6.5 Hz')
+    ax.set(xlabel='tail-beat frequency (Hz)', ylabel='steady speed (m/s)',
+           title='5 cm tail-tip amplitude (Fig 11)')
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / 'fig11_speed_5cm.png', dpi=110)
+    plt.close(fig)
+    paths.append(out / 'fig11_speed_5cm.png')
+    return paths
+
+
+def _optional(value: float | None, spec: str) -> str:
+    return '' if value is None else format(value, spec)
+
+
+def table(grid: list[SweepPoint], line: list[SweepPoint]) -> str:
+    """Return the sweep as a text table, the paper's stated points marked."""
+    stated = {(f, a): u for f, a, u in PAPER_POINTS if a is not None}
+    lines = [f'{"f Hz":>5} {"amp cm":>6} {"model m/s":>9} {"fish m/s":>8} {"model Sw":>8} '
+             f'{"fish Sw":>7}  paper']
+    for p in [*grid, *line]:
+        paper = stated.get((p.frequency_hz, p.tip_amplitude_m))
+        note = '' if paper is None else (
+            f'U {paper:.3f} m/s (Sw {paper / (p.frequency_hz * p.body_length):.2f})')
+        lines.append(f'{p.frequency_hz:5.1f} {p.tip_amplitude_m * 100:6.1f} '
+                     f'{p.model_speed:9.3f} {_optional(p.fish_speed, "8.3f"):>8} '
+                     f'{p.swimming_number(p.model_speed):8.3f} '
+                     f'{_optional(p.swimming_number(p.fish_speed), "7.3f"):>7}  {note}')
+    return '\n'.join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish sweep`; print the table and the files written."""
+    grid, line = run_sweep(with_fish=not args.model_only)
+    print(table(grid, line))
+    for path in write_outputs(grid, line, args.out):
+        print(f'wrote {path}')
+    return 0
