@@ -148,7 +148,7 @@ def report(geometry: FishGeometry) -> str:
                      f'{100 * e.tail_tip_amplitude:6.2f}cm {e.speed:6.3f}m/s '
                      f'{point.paper_speed:6.3f}m/s {e.speed - point.paper_speed:+8.3f} '
                      f'{e.swimming_number:8.3f} {paper_sw:8.3f}')
-    lines.append(f'(aim: |miss| <= {PAPER_RMSE} m/s, the paper\'s sim-vs-experiment RMSE)')
+    lines.append(f'(aim: |miss| <= {PAPER_RMSE} m/s, the paper sim-vs-experiment RMSE)')
     return '\n'.join(lines)
 
 

@@ -77,22 +77,32 @@ def wave_problem(msg: BodyWaveSpec) -> str | None:
     return None
 
 
-def servo_sample(msg: JointState) -> tuple[tuple[float, float], tuple[float, float]] | str:
+@dataclass(frozen=True)
+class SampleProblem:
+    """Why a JointState was dropped: a kind (throttled separately) and a message."""
+
+    kind: str
+    message: str
+
+
+def servo_sample(msg: JointState
+                 ) -> tuple[tuple[float, float], tuple[float, float]] | SampleProblem:
     """Return (angles, rates) of servo_1, servo_2 in a JointState, or why it is unusable."""
     names = list(msg.name)
     if not all(joint in names for joint in JOINTS):
-        return f'JointState needs joints {JOINTS}, got {names}'
+        return SampleProblem('names', f'JointState needs joints {JOINTS}, got {names}')
     if len(msg.position) != len(names):
-        return f'JointState has {len(msg.position)} positions for {len(names)} names'
+        return SampleProblem('size', f'JointState has {len(msg.position)} positions for '
+                             f'{len(names)} names')
     index = [names.index(joint) for joint in JOINTS]
     angles = tuple(float(msg.position[i]) for i in index)
     if not all(math.isfinite(a) for a in angles):
-        return f'non-finite servo angles {angles}'
-    rates = (math.nan, math.nan)
+        return SampleProblem('angles', f'non-finite servo angles {angles}')
+    rates = (math.nan, math.nan)  # no velocities: eqs 21-22 use differences of the angles
     if len(msg.velocity) == len(names):
         rates = tuple(float(msg.velocity[i]) for i in index)
         if not all(math.isfinite(r) for r in rates):
-            return f'non-finite servo rates {rates}'
+            return SampleProblem('rates', f'non-finite servo rates {rates}')
     return angles, rates
 
 
@@ -116,6 +126,7 @@ class KinematicsNode(Node):
         self._fresh = False
         self._last_beat_end: float | None = None
         self._last_rest_t: float | None = None
+        self._warned: dict[str, float] = {}
         self._body_pub = self.create_publisher(BodyWave, 'body_wave', qos_profile_sensor_data)
         self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers',
                                                  qos_profile_sensor_data)
@@ -180,9 +191,12 @@ class KinematicsNode(Node):
     # --- inputs ---------------------------------------------------------------------------
     def _on_servo(self, msg: JointState) -> None:
         sample = servo_sample(msg)
-        if isinstance(sample, str):
-            self.get_logger().warn(f'{sample}; sample dropped',
-                                   throttle_duration_sec=WARN_PERIOD_S)
+        if isinstance(sample, SampleProblem):
+            # throttled per kind, so that one bad source cannot hide another
+            now = self.get_clock().now().nanoseconds * 1e-9
+            if now - self._warned.get(sample.kind, -math.inf) >= WARN_PERIOD_S:
+                self._warned[sample.kind] = now
+                self.get_logger().warn(f'{sample.message}; sample dropped')
             return
         sec, nanosec = msg.header.stamp.sec, msg.header.stamp.nanosec
         if sec == 0 and nanosec == 0:
