@@ -54,11 +54,6 @@ def lag(output: float, motor: float, time_constant: float, dt: float) -> float:
     return motor + (output - motor) * math.exp(-dt / time_constant)
 
 
-def lag_rate(output: float, motor: float, time_constant: float) -> float:
-    """Return d(output)/dt (rad/s) of the first-order lag: (motor - output) / tau."""
-    return (motor - output) / time_constant
-
-
 class Servo:
     """One servo: set-point held between PWM frames, slewing motor, lagging output."""
 
@@ -79,5 +74,7 @@ class Servo:
             self.setpoint = clamp_to_limit(command, p.limit_rad)
             self._until_update += 1.0 / p.update_hz
         self.motor = slew(self.motor, self.setpoint, p.rate_limit_rad_s, dt)
+        previous = self.angle
         self.angle = lag(self.angle, self.motor, p.time_constant_s, dt)
-        self.rate = lag_rate(self.angle, self.motor, p.time_constant_s)
+        # The mean rate over the step (exact for the step taken, also when tau << dt).
+        self.rate = (self.angle - previous) / dt

@@ -108,7 +108,7 @@ class VirtualFish:
         self._host_version_ok = True
         self._commanded = (0.0, 0.0)
         self._outbox: list[bytes] = []
-        self._next_telemetry = 0.0
+        self._next_telemetry = 1.0 / self.config.telemetry_hz
         self._next_heartbeat = 0.0
         self._remainder = 0.0
         self._crc_errors_reported = 0
