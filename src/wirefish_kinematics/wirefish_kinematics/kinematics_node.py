@@ -43,7 +43,7 @@ from wirefish_kinematics.node_parameters import (check_value, declare, geometry_
                                                  NODE_PARAMETERS, SPECS)
 from wirefish_kinematics.servo_history import ServoHistory
 from wirefish_kinematics.tail_beat import (estimate_speed_over, fundamental_phase,
-                                           last_tail_beat)
+                                           last_tail_beat, TailBeat)
 from wirefish_kinematics.wire_coupling import bend_angles
 from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate as SpeedEstimateMsg
 
@@ -55,6 +55,9 @@ RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 # Below this half range (m) of the tip's lateral motion the tail counts as at rest.
 REST_HALF_RANGE_M = 1e-4
 WARN_PERIOD_S = 2.0
+# The tail-beat search runs at most this often (s of sample time): an estimate is then at
+# most this late, and the node does not re-scan its history at every body_wave.
+DETECTION_PERIOD_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -124,8 +127,12 @@ class KinematicsNode(Node):
         self._history = ServoHistory(2.0 * self._values['max_tail_beat_period_s'])
         self._latest: tuple[int, int, tuple[float, float]] | None = None
         self._fresh = False
+        # tail-beat state, reset with the history (_subscribe_servo)
         self._last_beat_end: float | None = None
         self._last_rest_t: float | None = None
+        self._last_detection_t: float | None = None
+        self._beat: TailBeat | None = None
+        self._beat_phase = 0.0  # phase (rad) of y(q1)'s fundamental at the beat's start
         self._warned: dict[str, float] = {}
         self._body_pub = self.create_publisher(BodyWave, 'body_wave', qos_profile_sensor_data)
         self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers',
@@ -184,7 +191,7 @@ class KinematicsNode(Node):
         topic = 'servo_state' if self._values['use_servo_state'] else 'servo_cmd'
         self._history.clear()
         self._latest, self._fresh = None, False
-        self._last_beat_end = self._last_rest_t = None
+        self._last_beat_end = self._last_rest_t = self._last_detection_t = self._beat = None
         self._servo_sub = self.create_subscription(JointState, topic, self._on_servo,
                                                    qos_profile_sensor_data)
 
@@ -224,7 +231,12 @@ class KinematicsNode(Node):
         beta1, beta2 = (float(b) for b in bend_angles(angles[0], angles[1], g))
         x, y = body_positions(stations, beta1, beta2, g)
         theta1, theta2 = swing_angles(beta1, beta2, g)
-        y_desired = self._update_tail_beat(stations)
+        t = self._history.last_time()
+        last = self._last_detection_t
+        if last is None or not 0.0 <= t - last < DETECTION_PERIOD_S:  # also after a jump back
+            self._last_detection_t = t
+            self._update_tail_beat()
+        y_desired = self._desired_wave(t, stations)
         msg = BodyWave(q=stations.tolist(), x=x.tolist(), y=y.tolist(),
                        y_desired=[] if y_desired is None else y_desired.tolist(),
                        beta1=beta1, beta2=beta2, theta1=float(theta1), theta2=float(theta2))
@@ -234,13 +246,14 @@ class KinematicsNode(Node):
         self._marker_pub.publish(self._markers(stamp, x, y, stations, y_desired,
                                                ends_x, ends_y))
 
-    def _update_tail_beat(self, stations: np.ndarray) -> np.ndarray | None:
-        """Publish a speed estimate per new tail beat; return y_desired at the tail's phase."""
+    def _update_tail_beat(self) -> None:
+        """Find the last full tail beat; publish an estimate per new one (or one at rest)."""
         g = self._geometry
         times, angles, rates = self._history.arrays()
         y_tip = tail_tip_lateral_positions(angles, g)
         beat = last_tail_beat(times, y_tip, REST_HALF_RANGE_M)
         if beat is None:
+            self._beat = None
             at_rest = 0.5 * np.ptp(y_tip) < REST_HALF_RANGE_M
             span = self._values['max_tail_beat_period_s']
             if (at_rest and self._history.duration_s() >= span
@@ -248,16 +261,25 @@ class KinematicsNode(Node):
                 self._last_rest_t = float(times[-1])
                 self._publish_speed(SpeedEstimate(0.0, 0.0, 0.0, 0.0, 0.0, 0.5 * np.ptp(y_tip)),
                                     float(times[-1]))
-            return None
-        if beat.end != self._last_beat_end:
-            self._last_beat_end = beat.end
-            self._publish_speed(estimate_speed_over(times, angles, rates, beat.start, beat.end,
-                                                    g), beat.end)
-        target = self._target
+            return
+        if beat.end == self._last_beat_end:
+            return
+        self._last_beat_end = beat.end
+        self._publish_speed(estimate_speed_over(times, angles, rates, beat.start, beat.end, g),
+                            beat.end)
+        # the overlay's phase: that of y(q1) over this beat (paper eq 25 aligns at O1)
         beta1, beta2 = bend_angles(angles[:, 0], angles[:, 1], g)
         _, y_q1 = body_positions(np.array([g.l1]), beta1, beta2, g)
-        phase = fundamental_phase(times, y_q1[:, 0], beat, times[-1])
-        tau = wave_time_at_phase(phase, g.l1, target.k, target.frequency_hz)
+        self._beat = beat
+        self._beat_phase = float(fundamental_phase(times, y_q1[:, 0], beat, beat.start))
+
+    def _desired_wave(self, t: float, stations: np.ndarray) -> np.ndarray | None:
+        """Return y_body at the stations, shown at the tail's phase at t; None if unknown."""
+        if self._beat is None:
+            return None
+        target = self._target
+        phase = self._beat_phase + 2.0 * math.pi * (t - self._beat.start) / self._beat.period
+        tau = wave_time_at_phase(phase, self._geometry.l1, target.k, target.frequency_hz)
         return desired_lateral_position(stations, tau, target.c1, target.c2, target.k,
                                         target.frequency_hz)
 

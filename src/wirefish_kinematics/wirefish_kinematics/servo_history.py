@@ -56,6 +56,10 @@ class ServoHistory:
         """Return the time between the first and the last sample kept (s)."""
         return self._samples[-1][0] - self._samples[0][0] if self._samples else 0.0
 
+    def last_time(self) -> float:
+        """Return the time of the last sample (s, relative to origin_s); 0 if empty."""
+        return self._samples[-1][0] if self._samples else 0.0
+
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Return (times (T,) s relative to origin_s, angles (T, 2) rad, rates (T, 2) rad/s)."""
         data = np.array(self._samples, dtype=float).reshape(-1, 5)
