@@ -51,4 +51,3 @@ def test_firmware_goes_neutral_when_commands_or_heartbeats_stop(spawn, tmp_path)
         assert no_commands[-1][1].status & Status.FAILSAFE_HEARTBEAT == 0
         silent = _telemetry_for(port, decoder, 1.2)
         assert silent[-1][1].status & Status.FAILSAFE_HEARTBEAT
-

@@ -98,8 +98,8 @@ GOOD_BODY = encode_body(ServoCommand(0.1, 0.2), 1)
     (_reencoded(GOOD_BODY[:3]), 'short_frames'),
     (b'\x00\x05\x01\x02\x00', 'cobs_errors'),                    # code byte past the end
     (_reencoded(b'\x55\x01\x00' + struct.pack('<H', crc16(b'\x55\x01\x00'))), 'unknown_type'),
-    (_reencoded(GOOD_BODY[:3] + b'\x00' * 4 + struct.pack('<H', crc16(GOOD_BODY[:3] + b'\x00' * 4))),
-     'length_errors'),
+    (_reencoded(GOOD_BODY[:3] + b'\x00' * 4
+                + struct.pack('<H', crc16(GOOD_BODY[:3] + b'\x00' * 4))), 'length_errors'),
     (_reencoded(GOOD_BODY[:3] + struct.pack('<ff', math.nan, 0.0)
                 + struct.pack('<H', crc16(GOOD_BODY[:3] + struct.pack('<ff', math.nan, 0.0)))),
      'invalid_payload'),

@@ -23,6 +23,7 @@ import threading
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import Vector3Stamped
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -30,7 +31,6 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import BatteryState, Imu, JointState
-from geometry_msgs.msg import Vector3Stamped
 
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate

@@ -19,13 +19,12 @@ from pathlib import Path
 
 import numpy as np
 from scipy.optimize import brentq
+from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import (intrinsic_frequency_for, stable_phase_difference,
                                        steady_state_servo_angles)
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import estimate_speed, SpeedEstimate
-
-from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
 
 TABLE_1 = CpgParameters()  # the defaults are Table 1 (alpha = 20, b = 0)
 COMMAND_RATE_HZ = 200.0

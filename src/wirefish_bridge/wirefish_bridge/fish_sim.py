@@ -110,7 +110,7 @@ class GroundTruthPublisher:
 
 
 class Schedule:
-    """Periodic fault windows: is an event active at time t (s since start)?"""
+    """Periodic fault windows: which event (if any) is active at time t (s since start)."""
 
     def __init__(self, every_s: float, duration_s: float, count: int = 0) -> None:
         """Every ``every_s`` s an event of ``duration_s`` s; at most ``count`` (0 = no limit)."""
@@ -140,7 +140,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     device = PtyDevice(args.link)
     ground_truth = GroundTruthPublisher(ros_args) if args.ros else None
     try:
-        print(device.open(), flush=True)
+        print(device.open_pair(), flush=True)
         start = last = time.monotonic()
         next_truth = start
         reopened = 0
@@ -152,7 +152,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
                 device.close()
                 print(f'fish_sim: device closed (reopen {closing})', file=sys.stderr, flush=True)
             elif closing is None and not device.is_open:
-                path = device.open()
+                path = device.open_pair()
                 reopened += 1
                 print(f'fish_sim: reopened as {path} ({reopened})', file=sys.stderr, flush=True)
             stalled = stalls.index(elapsed) is not None

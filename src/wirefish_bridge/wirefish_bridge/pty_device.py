@@ -1,8 +1,8 @@
 """
 The virtual fish's end of a pseudo-terminal pair, with a stable symlink to the device.
 
-``open`` makes a new pty pair (raw mode), and atomically re-points the symlink (``link``) to its
-slave device, so a bridge that opens the link path always finds the current device, as with
+``open_pair`` makes a new pty pair (raw mode), and atomically re-points the symlink (``link``)
+to its slave device, so a bridge that opens the link path always finds the current device, as with
 /dev/serial/by-id/ for a real board. ``close`` closes both ends, which the bridge sees as EIO
 on its old descriptor (the device was "unplugged").
 """
@@ -36,7 +36,7 @@ class PtyDevice:
             raise OSError(errno.EBADF, 'pty is closed')
         return self._master
 
-    def open(self) -> str:
+    def open_pair(self) -> str:
         """Open a new pty pair, point the symlink at it and return the slave device path."""
         master, slave = os.openpty()
         # Raw mode before anyone opens the slave: no echo, no CR/LF translation of our bytes.

@@ -1,6 +1,8 @@
 """
-Servo model of the virtual fish (a model assumption; the paper only says the servos cannot
-follow the CPG above about 5 Hz, section 5.4).
+Servo model of the virtual fish.
+
+A model assumption: the paper only says the servos cannot follow the CPG above about 5 Hz
+(section 5.4).
 
 Each servo is a cascade, advanced in fixed steps:
 

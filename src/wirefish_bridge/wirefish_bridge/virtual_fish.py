@@ -13,17 +13,16 @@ from dataclasses import dataclass, field
 import math
 
 import numpy as np
-from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust,
-                                           tail_tip_lateral_positions,
-                                           tail_tip_velocity_and_slope)
-
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.fish_dynamics import (force_scale_for_time_constant, GRAVITY,
                                            surge_acceleration, wrap_angle, yaw_acceleration)
 from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, PROTOCOL_VERSION, Role,
                                       ServoCommand, Status, Telemetry)
 from wirefish_bridge.servo_model import Servo, ServoParameters
+from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust,
+                                           tail_tip_lateral_positions,
+                                           tail_tip_velocity_and_slope)
 
 
 @dataclass(frozen=True)
@@ -93,7 +92,7 @@ class VirtualFish:
         self.config = config or SimConfig()
         self.geometry = geometry or FishGeometry()
         self.rng = rng if rng is not None else np.random.default_rng(0)
-        c, g = self.config, self.geometry
+        c = self.config
         self.total_mass = c.mass_kg + c.added_mass_kg
         self.state = FishState()
         self.servos = (Servo(c.servo), Servo(c.servo))
@@ -136,7 +135,7 @@ class VirtualFish:
             self._outbox.append(self.encoder.encode(ErrorReport(ErrorCode.BAD_CRC, 0)))
 
     def command(self, servo_1: float, servo_2: float) -> None:
-        """Take a servo command (rad), as a SERVO_CMD frame would."""
+        """Register servo targets (rad) now, as a SERVO_CMD frame would."""
         self.commands_received += 1
         self.last_command = (servo_1, servo_2)
         self._commanded = (servo_1, servo_2)
