@@ -174,6 +174,7 @@ class KinematicsNode(Node):
         if names & set(GEOMETRY_FIELDS):
             self._geometry = geometry_from(self._values)
             self._fresh = self._latest is not None
+            self._beat = None  # the overlay's phase is re-measured with the new geometry
         if names & {'wave_c1', 'wave_c2', 'wave_k', 'wave_frequency_hz'}:
             self._target = self._wave_from_parameters()
         if 'publish_rate_hz' in names:
@@ -262,24 +263,26 @@ class KinematicsNode(Node):
                 self._publish_speed(SpeedEstimate(0.0, 0.0, 0.0, 0.0, 0.0, 0.5 * np.ptp(y_tip)),
                                     float(times[-1]))
             return
-        if beat.end == self._last_beat_end:
-            return
-        self._last_beat_end = beat.end
-        self._publish_speed(estimate_speed_over(times, angles, rates, beat.start, beat.end, g),
-                            beat.end)
-        # the overlay's phase: that of y(q1) over this beat (paper eq 25 aligns at O1)
-        beta1, beta2 = bend_angles(angles[:, 0], angles[:, 1], g)
-        _, y_q1 = body_positions(np.array([g.l1]), beta1, beta2, g)
-        self._beat = beat
-        self._beat_phase = float(fundamental_phase(times, y_q1[:, 0], beat, beat.start))
+        if beat.end != self._last_beat_end:
+            self._last_beat_end = beat.end
+            self._publish_speed(estimate_speed_over(times, angles, rates, beat.start, beat.end,
+                                                    g), beat.end)
+        if self._beat is None or self._beat.end != beat.end:
+            # the overlay's phase: that of y(q1) over this beat (paper eq 25 aligns at O1)
+            beta1, beta2 = bend_angles(angles[:, 0], angles[:, 1], g)
+            _, y_q1 = body_positions(np.array([g.l1]), beta1, beta2, g)
+            self._beat = beat
+            self._beat_phase = float(fundamental_phase(times, y_q1[:, 0], beat, beat.start))
 
     def _desired_wave(self, t: float, stations: np.ndarray) -> np.ndarray | None:
         """Return y_body at the stations, shown at the tail's phase at t; None if unknown."""
         if self._beat is None:
             return None
-        target = self._target
+        target, q1 = self._target, self._geometry.l1
         phase = self._beat_phase + 2.0 * math.pi * (t - self._beat.start) / self._beat.period
-        tau = wave_time_at_phase(phase, self._geometry.l1, target.k, target.frequency_hz)
+        if target.c1 * q1 + target.c2 * q1 * q1 < 0.0:  # a negative envelope flips the sign
+            phase += math.pi
+        tau = wave_time_at_phase(phase, q1, target.k, target.frequency_hz)
         return desired_lateral_position(stations, tau, target.c1, target.c2, target.k,
                                         target.frequency_hz)
 
