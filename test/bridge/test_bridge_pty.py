@@ -168,3 +168,29 @@ def test_bridge_and_fish_exit_cleanly_on_sigint(spawn, probe, tmp_path):
     assert stop_process(fish) == 0
     assert not os.path.lexists(link)
     assert math.isfinite(_stamp(probe.imu[-1]))
+
+
+def _set_parameters(probe, parameters):
+    from rcl_interfaces.srv import SetParameters
+    client = probe.node.create_client(SetParameters, 'bridge_node/set_parameters')
+    assert spin_until(probe.executor, client.service_is_ready, 20.0)
+    future = client.call_async(SetParameters.Request(
+        parameters=[p.to_parameter_msg() for p in parameters]))
+    assert spin_until(probe.executor, future.done, 10.0)
+    return future.result().results
+
+
+def test_invalid_parameter_is_refused_with_a_reason_and_a_valid_one_applies(spawn, probe,
+                                                                            tmp_path):
+    from rclpy.parameter import Parameter
+    link = tmp_path / 'tty'
+    _start_fish(spawn, link)
+    _start_bridge(spawn, link)
+    (refused,) = _set_parameters(probe, [Parameter('command_timeout_s', value=-1.0)])
+    assert not refused.successful and 'command_timeout_s' in refused.reason
+    (backoff,) = _set_parameters(probe, [Parameter('reconnect_backoff_max_s', value=0.05)])
+    assert not backoff.successful and 'reconnect_backoff' in backoff.reason
+    (applied,) = _set_parameters(probe, [Parameter('imu_frame_id', value='imu_test')])
+    assert applied.successful
+    assert spin_until(probe.executor,
+                      lambda: probe.imu and probe.imu[-1].header.frame_id == 'imu_test', 10.0)

@@ -1,0 +1,160 @@
+"""Pure parts of the bridge: command gate, conversions, parameters, transport with a fake port."""
+
+import math
+import threading
+
+from hypothesis import given, strategies as st
+import pytest
+import serial
+from wirefish_bridge.bridge_node import check_combination, PARAMETERS
+from wirefish_bridge.command_gate import CommandGate, NEUTRAL
+from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy, \
+    rpy_from_quaternion
+from wirefish_bridge.parameters import check_value
+from wirefish_bridge.transport import LinkDown, LinkState, next_backoff, SerialLink
+
+SPECS = {spec.name: spec for spec in PARAMETERS}
+
+
+def test_gate_forwards_at_most_max_rate_and_releases_the_newest_held_command():
+    gate = CommandGate(max_rate_hz=10.0, timeout_s=1.0, limit_rad=1.0)
+    assert gate.on_command((0.1, 0.1), 0.00) == (0.1, 0.1)
+    assert gate.on_command((0.2, 0.2), 0.03) is None
+    assert gate.on_command((0.3, 0.3), 0.06) is None
+    assert gate.on_tick(0.08) is None
+    assert gate.on_tick(0.10) == (0.3, 0.3)
+    assert gate.on_tick(0.20) is None
+
+
+def test_gate_is_neutral_before_any_command_and_after_the_timeout():
+    gate = CommandGate(max_rate_hz=100.0, timeout_s=0.5, limit_rad=1.0)
+    assert gate.on_tick(0.0) == NEUTRAL and gate.failsafe
+    gate.on_command((0.4, 0.4), 1.0)
+    assert not gate.failsafe
+    assert gate.on_tick(1.4) is None
+    assert gate.on_tick(1.51) == NEUTRAL
+    assert gate.failsafe and gate.failsafe_entries == 1
+
+
+def test_gate_clamps_to_the_servo_limit():
+    gate = CommandGate(max_rate_hz=100.0, timeout_s=0.5, limit_rad=0.5)
+    assert gate.on_command((2.0, -2.0), 0.0) == (0.5, -0.5)
+    assert gate.clamped == 1
+
+
+@pytest.mark.parametrize('rpy, xyzw', [
+    ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),
+    ((0.0, 0.0, math.pi / 2), (0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5))),   # yaw: about z
+    ((math.pi / 2, 0.0, 0.0), (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))),   # roll: about x
+    ((0.0, math.pi / 2, 0.0), (0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5))),   # pitch: about y
+])
+def test_quaternion_axes(rpy, xyzw):
+    assert quaternion_from_rpy(*rpy) == pytest.approx(xyzw)
+
+
+def test_quaternion_is_zyx_intrinsic():
+    # Rz(yaw) Ry(pitch) Rx(roll) applied to x: the heading of the body's x axis.
+    roll, pitch, yaw = 0.3, -0.4, 1.1
+    x, y, z, w = quaternion_from_rpy(roll, pitch, yaw)
+    forward = (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y))
+    assert forward == pytest.approx((math.cos(yaw) * math.cos(pitch),
+                                     math.sin(yaw) * math.cos(pitch), -math.sin(pitch)))
+
+
+angles = st.floats(-3.0, 3.0)
+
+
+@given(angles, st.floats(-1.5, 1.5), angles)
+def test_rpy_round_trips_through_the_quaternion(roll, pitch, yaw):
+    q = quaternion_from_rpy(roll, pitch, yaw)
+    assert sum(c * c for c in q) == pytest.approx(1.0)
+    assert rpy_from_quaternion(*q) == pytest.approx((roll, pitch, yaw), abs=1e-9)
+
+
+def test_zero_stddev_means_unknown_covariance():
+    assert diagonal_covariance((0.0, 0.0, 0.0)) == [0.0] * 9
+    assert diagonal_covariance((0.1, 0.2, 0.3))[::4] == pytest.approx([0.01, 0.04, 0.09])
+
+
+@pytest.mark.parametrize('name, value', [
+    ('max_command_rate_hz', 0.0), ('max_command_rate_hz', math.nan),
+    ('command_timeout_s', -1.0), ('baudrate', 1.5), ('port', ''), ('port', 3),
+    ('servo_limit_rad', 4.0), ('imu_frame_id', ''),
+])
+def test_invalid_parameter_values_are_refused_with_a_reason(name, value):
+    assert name in check_value(SPECS[name], value)
+
+
+def test_backoff_limits_must_be_ordered():
+    values = {s.name: s.default for s in PARAMETERS}
+    assert check_combination(values) is None
+    values['reconnect_backoff_max_s'] = 0.05
+    assert 'reconnect_backoff_max_s' in check_combination(values)
+
+
+def test_backoff_doubles_up_to_the_maximum():
+    delays = [0.1]
+    for _ in range(5):
+        delays.append(next_backoff(delays[-1], 0.1, 1.0))
+    assert delays == pytest.approx([0.1, 0.2, 0.4, 0.8, 1.0, 1.0])
+
+
+class FakePort:
+    """A pyserial stand-in: yields scripted chunks, then fails like an unplugged device."""
+
+    def __init__(self, chunks):
+        self.chunks = list(chunks)
+        self.written = []
+        self.closed = False
+
+    in_waiting = 0
+
+    def reset_input_buffer(self):
+        pass
+
+    def read(self, size):
+        if self.chunks:
+            return self.chunks.pop(0)
+        raise serial.SerialException('device reports readiness to read but returned no data')
+
+    def write(self, data):
+        self.written.append(data)
+        return len(data)
+
+    def close(self):
+        self.closed = True
+
+
+def test_link_reopens_after_the_device_vanishes_and_reports_each_state():
+    ports = [FakePort([b'ab']), FakePort([b'cd']), FakePort([b'ef'] + [b''] * 10**6)]
+    attempts = []
+
+    def factory(*args, **kwargs):
+        attempts.append(args[0])
+        if len(attempts) in (2, 3):   # absent twice after the first loss
+            raise serial.SerialException('could not open port')
+        return ports.pop(0)
+
+    data, states = [], []
+    done = threading.Event()
+
+    def on_data(chunk):
+        data.append(chunk)
+        if len(data) == 3:
+            done.set()
+    link = SerialLink('/dev/fake', 115200, on_data, lambda s, d: states.append(s),
+                      backoff_min_s=0.001, backoff_max_s=0.004, serial_factory=factory)
+    link.start()
+    assert done.wait(10.0)
+    link.write(b'x')
+    link.stop()
+    assert data == [b'ab', b'cd', b'ef']
+    assert (link.stats.reconnects, link.stats.disconnects, link.stats.open_failures) == (2, 2, 2)
+    assert states[:3] == [LinkState.CONNECTING, LinkState.CONNECTED, LinkState.DISCONNECTED]
+    assert states[-1] is LinkState.STOPPED
+
+
+def test_writing_to_a_closed_link_raises_link_down():
+    link = SerialLink('/dev/none', 115200, lambda chunk: None)
+    with pytest.raises(LinkDown):
+        link.write(b'x')
