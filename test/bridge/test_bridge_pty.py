@@ -194,3 +194,40 @@ def test_invalid_parameter_is_refused_with_a_reason_and_a_valid_one_applies(spaw
     assert applied.successful
     assert spin_until(probe.executor,
                       lambda: probe.imu and probe.imu[-1].header.frame_id == 'imu_test', 10.0)
+
+
+def test_fish_sim_publishes_ground_truth_of_a_fish_swimming_on_bridge_commands(
+        spawn, probe, tmp_path):
+    from nav_msgs.msg import Odometry
+    truth = []
+    probe.node.create_subscription(Odometry, 'sim/ground_truth', truth.append, 10)
+    link = tmp_path / 'tty'
+    _start_fish(spawn, link, '--ros')
+    _start_bridge(spawn, link)
+    assert spin_until(probe.executor, lambda: len(probe.imu) > 10 and truth, 20.0)
+    start = time.monotonic()
+    deadline = start + 3.0
+    while time.monotonic() < deadline:   # a 3 Hz beat of both servos
+        phase = 2 * math.pi * 3.0 * (time.monotonic() - start)
+        probe.cmd.publish(JointState(name=['servo_1', 'servo_2'],
+                                     position=[0.38 * math.cos(phase),
+                                               0.47 * math.cos(phase + 1.0)]))
+        probe.executor.spin_once(timeout_sec=0.005)
+    last = truth[-1]
+    print(f'ground truth after 3 s: U = {last.twist.twist.linear.x:.3f} m/s, '
+          f'x = {last.pose.pose.position.x:.3f} m')
+    assert (last.header.frame_id, last.child_frame_id) == ('odom', 'base_link')
+    assert last.twist.twist.linear.x > 0.1 and last.pose.pose.position.x > 0.1
+
+
+def test_dropped_frames_are_counted_as_sequence_gaps(spawn, probe, tmp_path):
+    link = tmp_path / 'tty'
+    _start_fish(spawn, link, '--drop-fraction', '0.2')
+    _start_bridge(spawn, link)
+    assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
+    probe.spin_for(3.0)
+    diagnostics = probe.last_diagnostics()
+    print(f'drop 20 %: {diagnostics["drops"]} gaps, {diagnostics["frames_in"]} frames in')
+    drops, frames = int(diagnostics['drops']), int(diagnostics['frames_in'])
+    assert drops / (drops + frames) == pytest.approx(0.2, abs=0.07)
+    assert diagnostics['crc_errors'] == '0'

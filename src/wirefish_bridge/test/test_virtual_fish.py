@@ -121,3 +121,18 @@ def test_imu_noise_is_reproducible_with_a_seed():
         fish.step(0.01)
         return _telemetry(fish)[0]
     assert first(3) == first(3) and first(3) != first(4)
+
+
+@pytest.mark.parametrize('offset, sign', [(0.2, -1.0), (-0.2, 1.0)])
+def test_tail_held_to_one_side_turns_the_fish_that_way(offset, sign):
+    # A positive bend is to the right (+y of C0); turning right is a negative yaw about z up.
+    fish = VirtualFish(SimConfig(command_timeout_s=None, heartbeat_timeout_s=None),
+                       FishGeometry())
+    fish.state.speed = 0.3
+    dt, rates = 0.005, []
+    for i in range(400):
+        beat = 0.3 * np.sin(2 * np.pi * 2.0 * i * dt)
+        fish.command(offset + beat, offset + beat)
+        fish.step(dt)
+        rates.append(fish.state.yaw_rate)
+    assert sign * np.mean(rates[200:]) > 0.1   # mean over the last second (whole beats)

@@ -15,9 +15,9 @@ only by the speed ripple within a tail beat (~1 %), so the period means of s F_T
 still balance exactly where F_T = F_D.
 
 Yaw: a model assumption (the paper has none): the yaw rate relaxes with ``time_constant`` to
--gain U y_tip / L, where y_tip is the tail tip's lateral offset (+ = right in C0). A tail held
-to the right turns the fish right (negative yaw about z up); the beating part of y_tip averages
-out and leaves the head's small yaw oscillation.
+-gain U y_tip / L (gain 20 by default), where y_tip is the tail tip's lateral offset (+ = right
+in C0). A tail held to the right turns the fish right (negative yaw about z up); the beating
+part of y_tip averages out and leaves the head's small yaw oscillation.
 """
 
 from __future__ import annotations

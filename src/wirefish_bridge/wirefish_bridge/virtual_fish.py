@@ -55,7 +55,7 @@ class SimConfig:
     added_mass_kg: float = 0.27
     speed_time_constant_s: float = 0.75
     speed_floor_m_s: float = 0.05
-    yaw_gain: float = 3.0
+    yaw_gain: float = 20.0  # 3 cm tail offset at 0.3 m/s turns ~20 deg/s (assumption)
     yaw_time_constant_s: float = 0.3
     physics_dt_s: float = 0.001
     telemetry_hz: float = 100.0
