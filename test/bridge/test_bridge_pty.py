@@ -231,3 +231,17 @@ def test_dropped_frames_are_counted_as_sequence_gaps(spawn, probe, tmp_path):
     drops, frames = int(diagnostics['drops']), int(diagnostics['frames_in'])
     assert drops / (drops + frames) == pytest.approx(0.2, abs=0.07)
     assert diagnostics['crc_errors'] == '0'
+
+
+def test_a_stalled_fish_shows_as_a_gap_and_the_stream_resumes(spawn, probe, tmp_path):
+    link = tmp_path / 'tty'
+    _start_fish(spawn, link, '--stall-every', '2.5', '--stall-for', '1.0')
+    bridge = _start_bridge(spawn, link)
+    assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
+    probe.spin_for(4.0)
+    stamps = [_stamp(m) for m in probe.imu]
+    longest = max(b - a for a, b in zip(stamps, stamps[1:]))
+    print(f'longest imu gap during stalls of 1 s: {longest:.3f} s')
+    assert 0.9 < longest < 1.3
+    assert bridge.poll() is None
+    assert probe.last_diagnostics()['link_state'] == 'connected'
