@@ -31,7 +31,7 @@ EXPECTED_RATES_HZ = {
     'imu/data': 100.0,
     'attitude': 100.0,
     'servo_state': 100.0,
-    'sim/ground_truth': 100.0,
+    'sim/ground_truth': 50.0,
 }
 # Slow topics: present, at least this often.
 EXPECTED_MIN_RATES_HZ = {'/diagnostics': 0.5, 'speed_estimate': 0.5, 'battery': 0.5}
@@ -120,6 +120,7 @@ def test_ten_second_recording_loses_nothing(running_graph, tmp_path):
          '--namespace', running_graph.namespace, '--duration', '10'],
         env=running_graph.env, capture_output=True, text=True, timeout=90)
     assert result.returncode == 0, result.stderr
+    assert 'lost in transport: 0' in result.stdout, result.stdout
     bag = read_bag(bag_path)
     for topic, nominal in EXPECTED_RATES_HZ.items():
         full = _full(running_graph.namespace, topic)
@@ -131,6 +132,9 @@ def test_ten_second_recording_loses_nothing(running_graph, tmp_path):
             stamps = np.array([m.markers[0].header.stamp.sec
                                + 1e-9 * m.markers[0].header.stamp.nanosec for _, m in msgs])
         stats = topic_stats(full, bag.types[full], stamps)
-        assert stats.drops == 0, f'{full}: {stats}'
-        assert len(msgs) == pytest.approx(10.0 * nominal, rel=0.1), full
+        assert stats.rate_hz == pytest.approx(nominal, rel=0.1), f'{full}: {stats}'
+        # 'lost in transport: 0' above is the middleware's own count (sequence numbers): every
+        # sample a publisher sent is in the bag. Gaps in the stamps also hold timer ticks that a
+        # publisher skipped when the shared machine starved it; those stay a small fraction.
+        assert stats.drops <= 0.03 * stats.count, f'{full}: {stats}'
     assert math.isclose(bag.duration_s, 10.0, abs_tol=1.5)

@@ -14,6 +14,7 @@ import time
 
 from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, sim_tty_link,
                                     validate_namespace)
+from wirefish_bringup.compose import NODE_CLASSES as COMPOSED_NODES
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
@@ -38,29 +39,48 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--no-status', action='store_true', help='skip the topic-rate table')
 
 
-def _status_table(namespace: str) -> str:
+def _wait_ready(namespace: str, node_names: list[str], show_status: bool,
+                stop_requested: list, timeout_s: float = 30.0) -> str | None:
+    """
+    Wait until every node of the graph is on the ROS graph; return the status table or None.
+
+    A node is "up" once it is discoverable (its rclpy.init and constructor are done), so a
+    Ctrl-C after "running:" always reaches nodes that handle it cleanly.
+    """
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
-    from wirefish_bringup.monitor import measure_rates
+    from wirefish_bringup.monitor import measure_rates, settle_discovery
 
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node('wirefish_status', namespace=namespace)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
+    expected = {f'{namespace.rstrip("/")}/{name}' for name in node_names}
+
+    def discovered() -> set[str]:
+        return {f'{ns.rstrip("/")}/{name}' for name, ns in node.get_node_names_and_namespaces()}
+
     try:
-        time.sleep(1.0)  # discovery
+        deadline = time.monotonic() + timeout_s
+        while not expected <= discovered():
+            if stop_requested or time.monotonic() > deadline:
+                missing = ', '.join(sorted(expected - discovered()))
+                return None if stop_requested else f'not up after {timeout_s:g} s: {missing}'
+            executor.spin_once(timeout_sec=0.1)
+        if not show_status:
+            return ''
+        settle_discovery(node, executor, namespace)
         rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S)
-        nodes = sorted(f'{ns.rstrip("/")}/{name}' for name, ns in
-                       node.get_node_names_and_namespaces() if name != 'wirefish_status')
     finally:
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()
-    lines = [f'nodes: {", ".join(nodes)}', f'{"topic":<40} {"type":<38} {"rate":>9}']
+    lines = [f'nodes: {", ".join(sorted(expected))}',
+             f'{"topic":<40} {"type":<38} {"rate":>9}']
     for topic, (type_name, rate) in rates.items():
-        shown = f'{rate:7.1f} Hz' if rate > 0 else '  latched' if rate == 0 else ''
+        shown = f'{rate:7.1f} Hz' if rate > 0 else '  latched'
         lines.append(f'{topic:<40} {type_name:<38} {shown:>9}')
     return '\n'.join(lines)
 
@@ -101,8 +121,14 @@ def run(args: argparse.Namespace) -> int:
                 'record', '-o', str(bag_path), '--namespace', namespace)))
         print(f'started {len(supervisor.processes)} processes in {namespace}; '
               f'logs in {run_dir / "logs"}')
-        if not args.no_status and not stop_requested:
-            print(_status_table(namespace))
+        node_names = [spec.name for spec in specs if spec.name != 'fish_nodes']
+        if args.single_process:
+            node_names += list(COMPOSED_NODES)
+        status = _wait_ready(namespace, node_names, not args.no_status, stop_requested)
+        if status and status.startswith('not up'):
+            raise RuntimeError(status)
+        if status:
+            print(status)
         if bag_path is not None:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
         else:

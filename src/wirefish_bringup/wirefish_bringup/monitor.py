@@ -8,6 +8,20 @@ from rclpy.node import Node
 from wirefish_bringup.topics import graph_topics, matching_qos, message_class
 
 
+def settle_discovery(node: Node, executor: SingleThreadedExecutor, namespace: str,
+                     quiet_s: float = 1.5, timeout_s: float = 10.0) -> None:
+    """Spin until the graph's topic set has not changed for ``quiet_s`` (or ``timeout_s``)."""
+    start = changed = time.monotonic()
+    seen = graph_topics(node, namespace)
+    while time.monotonic() - start < timeout_s:
+        executor.spin_once(timeout_sec=0.25)
+        now = graph_topics(node, namespace)
+        if now != seen:
+            seen, changed = now, time.monotonic()
+        elif seen and time.monotonic() - changed >= quiet_s:
+            return
+
+
 def measure_rates(node: Node, executor: SingleThreadedExecutor, namespace: str,
                   window_s: float) -> dict[str, tuple[str, float]]:
     """Return {topic: (type, messages per second)} received over ``window_s`` seconds."""

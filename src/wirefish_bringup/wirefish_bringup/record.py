@@ -7,6 +7,8 @@ import sys
 
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 
+NOTHING_TIMEOUT_S = 30.0
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish record`."""
@@ -14,7 +16,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='bag directory (default: out/bags/wirefish_<time>); must not exist')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
     parser.add_argument('--duration', type=float, default=None,
-                        help='stop after this many seconds (default: until Ctrl-C)')
+                        help='record this many seconds from the first message received '
+                        '(default: until Ctrl-C)')
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,7 +41,17 @@ def run(args: argparse.Namespace) -> int:
     rclpy.init()
     recorder = BagRecorder(bag_path, namespace)
     if args.duration is not None:
-        recorder.create_timer(args.duration, lambda: rclpy.try_shutdown())
+        started_ns = recorder.get_clock().now().nanoseconds
+
+        def stop_when_done() -> None:
+            now = recorder.get_clock().now().nanoseconds
+            first = recorder.first_message_ns
+            # Discovery can take a few seconds on a loaded machine: the duration counts from
+            # the first message, with a bound for a graph that never publishes anything.
+            if (first is not None and now - first >= args.duration * 1e9) or \
+                    now - started_ns >= (args.duration + NOTHING_TIMEOUT_S) * 1e9:
+                rclpy.try_shutdown()
+        recorder.create_timer(0.02, stop_when_done)
     try:
         rclpy.spin(recorder)
     except (KeyboardInterrupt, ExternalShutdownException):
@@ -46,10 +59,12 @@ def run(args: argparse.Namespace) -> int:
     finally:
         recorder.close()
         counts = dict(recorder.counts)
+        lost = dict(recorder.lost)
         recorder.destroy_node()
         rclpy.try_shutdown()
     total = sum(counts.values())
-    print(f'wrote {total} messages on {len(counts)} topics to {bag_path}')
+    print(f'wrote {total} messages on {len(counts)} topics to {bag_path}; '
+          f'lost in transport: {sum(lost.values())}')
     for topic, count in sorted(counts.items()):
-        print(f'  {topic:<40} {count:>7}')
+        print(f'  {topic:<40} {count:>7} (lost {lost[topic]})')
     return 0

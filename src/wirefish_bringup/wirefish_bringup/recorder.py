@@ -8,6 +8,7 @@ periodic rescan, so the recorder can start before or after the nodes.
 
 from pathlib import Path
 
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rosbags.rosbag2 import StoragePlugin, Writer
 
@@ -30,7 +31,10 @@ class BagRecorder(Node):
         self._writer.open()
         self._connections: dict = {}
         self.counts: dict[str, int] = {}
+        # Samples the middleware reports lost on the way to us (DDS 'sample lost' status).
+        self.lost: dict[str, int] = {}
         self._closed = False
+        self.first_message_ns: int | None = None
         self._scan()
         self.create_timer(rescan_period_s, self._scan)
 
@@ -47,8 +51,12 @@ class BagRecorder(Node):
             self._connections[topic] = self._writer.add_connection(
                 topic, type_name, typestore=self._typestore)
             self.counts[topic] = 0
-            self.create_subscription(msg_class, topic, self._make_callback(topic),
-                                     matching_qos(self, topic, QUEUE_DEPTH), raw=True)
+            self.lost[topic] = 0
+            self.create_subscription(
+                msg_class, topic, self._make_callback(topic),
+                matching_qos(self, topic, QUEUE_DEPTH), raw=True,
+                event_callbacks=SubscriptionEventCallbacks(
+                    message_lost=lambda info, topic=topic: self._on_lost(topic, info)))
             self.get_logger().info(f'recording {topic} [{type_name}]')
 
     def _make_callback(self, topic: str):
@@ -57,9 +65,16 @@ class BagRecorder(Node):
         def on_message(data: bytes) -> None:
             if self._closed:
                 return
-            self._writer.write(connection, self.get_clock().now().nanoseconds, data)
+            now = self.get_clock().now().nanoseconds
+            if self.first_message_ns is None:
+                self.first_message_ns = now
+            self._writer.write(connection, now, data)
             self.counts[topic] += 1
         return on_message
+
+    def _on_lost(self, topic: str, info) -> None:
+        self.lost[topic] += info.total_count_change
+        self.get_logger().warning(f'{topic}: {info.total_count_change} messages lost in transport')
 
     def close(self) -> None:
         """Finish the bag (MCAP summary and metadata.yaml); idempotent."""
