@@ -12,9 +12,9 @@ import signal
 import sys
 import time
 
+from wirefish_bringup.compose import NODE_CLASSES as COMPOSED_NODES
 from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, sim_tty_link,
                                     validate_namespace)
-from wirefish_bringup.compose import NODE_CLASSES as COMPOSED_NODES
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
@@ -80,7 +80,7 @@ def _wait_ready(namespace: str, node_names: list[str], show_status: bool,
     lines = [f'nodes: {", ".join(sorted(expected))}',
              f'{"topic":<40} {"type":<38} {"rate":>9}']
     for topic, (type_name, rate) in rates.items():
-        shown = f'{rate:7.1f} Hz' if rate > 0 else '  latched'
+        shown = f'{rate:7.1f} Hz' if rate > 0 else 'no msgs'  # idle, or latched only
         lines.append(f'{topic:<40} {type_name:<38} {shown:>9}')
     return '\n'.join(lines)
 
