@@ -54,7 +54,7 @@ def recording(duration_s: float, domain_id: int) -> dict:
             'topics': {s.topic: {'count': s.count, 'rate_hz': s.rate_hz, 'drops': s.drops}
                        for s in stats},
             'messages': sum(s.count for s in stats),
-            'drops': sum(s.drops for s in stats)}
+            'drops': sum(max(s.drops, 0) for s in stats)}
 
 
 def _run(name: str, func, *args, **kwargs):

@@ -33,24 +33,33 @@ class TopicStats:
     type_name: str
     count: int
     rate_hz: float
-    median_period_s: float
+    period_s: float
     max_gap_s: float
     drops: int
 
 
 def topic_stats(topic: str, type_name: str, stamps_s: np.ndarray) -> TopicStats:
-    """Summarise one topic from its message stamps (s), header stamps where it has them."""
+    """
+    Summarise one topic from its message stamps (s), header stamps where it has them.
+
+    Drops are the messages that the stamps' span at the topic's period calls for but that are
+    missing. The period is the median over windows of 20 intervals, so arrival jitter (a late
+    sample, then an early one) averages out and only real gaps count. Topics without a steady
+    period (events such as speed_estimate) get no drop count (-1).
+    """
     count = len(stamps_s)
     if count < 2:
         return TopicStats(topic, type_name, count, 0.0, float('nan'), float('nan'), 0)
-    periods = np.diff(np.sort(stamps_s))
-    median = float(np.median(periods))
-    span = float(stamps_s.max() - stamps_s.min())
-    # Lost = messages the stamps' span calls for that are not there. A late sample followed by
-    # an early one (timer jitter) loses nothing; only a real gap lowers the count.
-    drops = max(0, int(round(span / median)) + 1 - count) if median > 0 else 0
+    stamps_s = np.sort(stamps_s)
+    periods = np.diff(stamps_s)
+    span = float(stamps_s[-1] - stamps_s[0])
+    window = min(20, count - 1)
+    period = float(np.median((stamps_s[window:] - stamps_s[:-window]) / window))
+    steady = period > 0 and np.percentile(periods, 90) <= 10 * max(np.percentile(periods, 10),
+                                                                    1e-3 * period)
+    drops = max(0, int(round(span / period)) + 1 - count) if steady else -1
     return TopicStats(topic, type_name, count, (count - 1) / span if span > 0 else 0.0,
-                      median, float(periods.max()), drops)
+                      period, float(periods.max()), drops)
 
 
 def _series(bag, topic: str) -> list:
@@ -147,8 +156,9 @@ def summary_table(stats: list[TopicStats], bag) -> str:
     lines = [f'bag: {bag.path}  duration {bag.duration_s:.1f} s',
              f'{"topic":<34} {"count":>7} {"rate Hz":>8} {"max gap s":>9} {"drops":>6}']
     for s in stats:
+        drops = '—' if s.drops < 0 else str(s.drops)
         lines.append(f'{s.topic:<34} {s.count:>7} {s.rate_hz:>8.1f} {s.max_gap_s:>9.3f} '
-                     f'{s.drops:>6}')
+                     f'{drops:>6}')
     diagnostics = _series(bag, '/diagnostics')
     if diagnostics:
         lines.append('last /diagnostics:')
