@@ -55,8 +55,8 @@ def topic_stats(topic: str, type_name: str, stamps_s: np.ndarray) -> TopicStats:
     span = float(stamps_s[-1] - stamps_s[0])
     window = min(20, count - 1)
     period = float(np.median((stamps_s[window:] - stamps_s[:-window]) / window))
-    steady = period > 0 and np.percentile(periods, 90) <= 10 * max(np.percentile(periods, 10),
-                                                                    1e-3 * period)
+    shortest = max(float(np.percentile(periods, 10)), 1e-3 * period)
+    steady = period > 0 and np.percentile(periods, 90) <= 10 * shortest
     drops = max(0, int(round(span / period)) + 1 - count) if steady else -1
     return TopicStats(topic, type_name, count, (count - 1) / span if span > 0 else 0.0,
                       period, float(periods.max()), drops)
