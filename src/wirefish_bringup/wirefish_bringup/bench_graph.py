@@ -18,6 +18,8 @@ import psutil
 from wirefish_bringup.graph import fish_graph, NodeSpec
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
+READY_TIMEOUT_S = 120.0
+
 
 def percentiles_ms(values_s: np.ndarray) -> dict[str, float]:
     """Return p50, p99 and max of ``values_s`` in milliseconds."""
@@ -148,7 +150,13 @@ def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = F
                     counts[key] += 1
                 node.create_subscription(msg_type, f'/bench_fish_{i}/{topic}', count,
                                          qos_profile_sensor_data)
-        spin_for(executor, 5.0)
+        # Starting many Python processes on two cores takes a while: wait until every fish
+        # streams both topics (the time that takes is a figure too), then warm up 3 s more.
+        launched = time.monotonic()
+        while time.monotonic() - launched < READY_TIMEOUT_S and not all(counts.values()):
+            spin_for(executor, 0.5)
+        ready_s = time.monotonic() - launched if all(counts.values()) else float('nan')
+        spin_for(executor, 3.0)
         for key in counts:
             counts[key] = 0
         pids = [p.pid for p in supervisor.processes.values()]
@@ -165,4 +173,4 @@ def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = F
             'servo_cmd_hz_min': min(servo), 'servo_cmd_hz_median': float(np.median(servo)),
             'imu_hz_min': min(imu), 'imu_hz_median': float(np.median(imu)),
             'cpu_percent_total': 100.0 * (cpu_end - cpu_start) / elapsed,
-            'crashed': crashed}
+            'ready_s': ready_s, 'crashed': crashed}

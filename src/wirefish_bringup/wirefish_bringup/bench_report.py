@@ -81,7 +81,7 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         table.append(('Recording, 60 s at default rates: messages in the bag, lost',
                       '0 lost', f'{rec["messages"]} messages, {rec["drops"]} lost',
                       _verdict(rec, rec['drops'] == 0),
-                      'wirefish up --duration; loss = gaps in header stamps > 1.5 periods'))
+                      'wirefish up --duration; lost = missing from the header stamps at the period (report.py)'))
     for r in results.get('fleet', []):
         if 'error' in r:
             table.append(('Fish graphs on one machine', '8 at default rates', r['error'],
@@ -96,7 +96,9 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                       f'{r["imu_hz_min"]:.1f} Hz, CPU {r["cpu_percent_total"]:.0f} % '
                       f'(of {results["machine"]["cores"]} cores × 100)'
                       + (f', crashed: {r["crashed"]}' if r['crashed'] else ''),
-                      _verdict(r, ok), '10 s window after 5 s warm-up'))
+                      _verdict(r, ok),
+                      f'all streaming after {r.get("ready_s", float("nan")):.0f} s; then 3 s '
+                      'warm-up, 10 s window'))
     return table
 
 

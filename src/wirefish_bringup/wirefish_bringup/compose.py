@@ -26,7 +26,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
     parser.add_argument('--port', required=True, help='serial device for the bridge')
     parser.add_argument('--params-file', default=None, help='parameter YAML')
-    parser.add_argument('--threads', type=int, default=4, help='executor threads')
+    parser.add_argument('--executor', choices=('single', 'multi'), default='single',
+                        help='SingleThreadedExecutor (default: least overhead per callback; a '
+                        'retune pauses the other nodes for its ~0.1 s) or MultiThreadedExecutor')
 
 
 def node_class(path: str) -> type:
@@ -37,8 +39,11 @@ def node_class(path: str) -> type:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish compose` until SIGINT/SIGTERM; return the exit code."""
+    import signal
+
     import rclpy
-    from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+    from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
 
     try:
         namespace = validate_namespace(args.namespace)
@@ -46,9 +51,15 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish compose: {error}', file=sys.stderr)
         return 2
     params = str(args.params_file or default_params_file())
-    rclpy.init()
+    # SIGINT/SIGTERM end the spin loop between callbacks, so no callback ever publishes on a
+    # context that is being shut down; then the nodes are destroyed and the context shut down.
+    stop_requested = []
+    signal.signal(signal.SIGINT, lambda *_: stop_requested.append(True))
+    signal.signal(signal.SIGTERM, lambda *_: stop_requested.append(True))
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     nodes = []
-    executor = MultiThreadedExecutor(num_threads=args.threads)
+    executor = (SingleThreadedExecutor() if args.executor == 'single'
+                else MultiThreadedExecutor(num_threads=4))
     try:
         for name, path in NODE_CLASSES.items():
             cli_args = ['--ros-args', '-r', f'__ns:={namespace}', '--params-file', params]
@@ -57,9 +68,8 @@ def run(args: argparse.Namespace) -> int:
             node = node_class(path)(cli_args=cli_args)
             nodes.append(node)
             executor.add_node(node)
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        while not stop_requested:
+            executor.spin_once(timeout_sec=0.1)
     finally:
         executor.shutdown()
         for node in reversed(nodes):

@@ -41,18 +41,27 @@ class Supervisor:
         self._logs: list = []
 
     def start(self, spec: NodeSpec) -> subprocess.Popen:
-        """Start one process of the graph; its output goes to ``<log_dir>/<name>.log``."""
+        """
+        Start one process of the graph; its output goes to ``<log_dir>/<key>.log``.
+
+        The key is the spec's name, made unique (``bridge_node_2`` ...) when several fish run
+        under one supervisor, so every process is tracked and stopped.
+        """
         self._log_dir.mkdir(parents=True, exist_ok=True)
         executable = spec.executable_path()
         if not executable.is_file():
             raise FileNotFoundError(f'{spec.package}/{spec.executable} is not installed at '
                                     f'{executable}: run `make setup`')
-        log = open(self._log_dir / f'{spec.name}.log', 'w', buffering=1)
+        key, n = spec.name, 1
+        while key in self.processes:
+            n += 1
+            key = f'{spec.name}_{n}'
+        log = open(self._log_dir / f'{key}.log', 'w', buffering=1)
         self._logs.append(log)
         proc = subprocess.Popen([str(executable), *spec.arguments], env=self._env,
                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                 start_new_session=True, preexec_fn=_die_with_parent)
-        self.processes[spec.name] = proc
+        self.processes[key] = proc
         return proc
 
     def exited(self) -> dict[str, int]:
