@@ -81,7 +81,8 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         table.append(('Recording, 60 s at default rates: messages in the bag, lost',
                       '0 lost', f'{rec["messages"]} messages, {rec["drops"]} lost',
                       _verdict(rec, rec['drops'] == 0),
-                      'wirefish up --duration; lost = missing from the header stamps at the period (report.py)'))
+                      'wirefish up --duration; lost = missing from the header stamps at the '
+                      'period (report.py)'))
     for r in results.get('fleet', []):
         if 'error' in r:
             table.append(('Fish graphs on one machine', '8 at default rates', r['error'],
