@@ -11,6 +11,7 @@ import json
 import os
 from pathlib import Path
 import platform
+import re
 import subprocess
 import sys
 import tempfile
@@ -50,10 +51,13 @@ def recording(duration_s: float, domain_id: int) -> dict:
                    timeout=duration_s + 120)
     bag = next(out.glob('run_*/bag'))
     stats = write_report(bag, bag.parent / 'report')
+    recorder_log = (bag.parent / 'logs' / 'recorder.log').read_text()
+    transport = re.search(r'lost in transport: (\d+)', recorder_log)
     return {'duration_s': duration_s,
             'topics': {s.topic: {'count': s.count, 'rate_hz': s.rate_hz, 'drops': s.drops}
                        for s in stats},
             'messages': sum(s.count for s in stats),
+            'lost_in_transport': int(transport.group(1)) if transport else None,
             'drops': sum(max(s.drops, 0) for s in stats)}
 
 

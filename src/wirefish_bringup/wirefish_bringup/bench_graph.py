@@ -18,7 +18,7 @@ import psutil
 from wirefish_bringup.graph import fish_graph, NodeSpec
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
-READY_TIMEOUT_S = 120.0
+READY_TIMEOUT_S = 60.0
 
 
 def percentiles_ms(values_s: np.ndarray) -> dict[str, float]:

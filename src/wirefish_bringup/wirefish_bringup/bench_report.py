@@ -79,7 +79,9 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         table.append(('Recording, 60 s at default rates', '0 lost', rec['error'], 'failed', ''))
     elif rec:
         table.append(('Recording, 60 s at default rates: messages in the bag, lost',
-                      '0 lost', f'{rec["messages"]} messages, {rec["drops"]} lost',
+                      '0 lost', f'{rec["messages"]} messages; {rec["drops"]} missing from the '
+                      'stamps (publisher ticks skipped or lost); lost in transport (DDS count): '
+                      f'{rec.get("lost_in_transport")}',
                       _verdict(rec, rec['drops'] == 0),
                       'wirefish up --duration; lost = missing from the header stamps at the '
                       'period (report.py)'))
