@@ -4,8 +4,8 @@ import subprocess
 import sys
 
 import pytest
-from wirefish_bringup.calibrate_drag import (calibrated_drag_coefficient, PAPER_POINTS, predict,
-                                             table1_locked_at, tip_half_amplitude)
+from wirefish_bringup.calibrate_drag import calibrated_drag_coefficient, PAPER_POINTS, predict
+from wirefish_cpg.table1_gait import table1_locked_at, tip_half_amplitude
 from wirefish_kinematics.geometry import FishGeometry
 
 

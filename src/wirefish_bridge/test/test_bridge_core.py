@@ -10,8 +10,8 @@ from wirefish_bridge.bridge_node import check_combination, PARAMETERS
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy, \
     rpy_from_quaternion
-from wirefish_bridge.parameters import check_value
 from wirefish_bridge.transport import LinkDown, LinkState, next_backoff, SerialLink
+from wirefish_common.parameter_table import check_value
 
 SPECS = {spec.name: spec for spec in PARAMETERS}
 

@@ -3,17 +3,18 @@
 import numpy as np
 import pytest
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.fig11 import locked_gait, run_steady, speed_sweep
+from wirefish_bridge.fig11 import run_steady, speed_sweep
 from wirefish_bridge.fish_dynamics import force_scale_for_time_constant
 from wirefish_bridge.protocol import Heartbeat, ServoCommand, Status, Telemetry
 from wirefish_bridge.servo_model import Servo, ServoParameters
 from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
 from wirefish_cpg.steady_state import steady_state_servo_angles
+from wirefish_cpg.table1_gait import table1_locked_at
 from wirefish_kinematics.geometry import FishGeometry
 
 
 def test_table_1_gait_at_3_hz_swims_within_10_percent_of_eq_18():
-    run = run_steady(locked_gait(3.0), 3.0, FishGeometry())
+    run = run_steady(table1_locked_at(3.0), 3.0, FishGeometry())
     print(f'3 Hz: virtual fish {run.speed:.4f} m/s, eq 18 {run.ideal_speed:.4f} m/s '
           f'({100 * (run.speed / run.ideal_speed - 1):+.1f} %)')
     assert run.speed == pytest.approx(run.ideal_speed, rel=0.10)
@@ -23,10 +24,10 @@ def test_table_1_gait_at_3_hz_swims_within_10_percent_of_eq_18():
 def test_speed_time_constant_is_the_configured_one(tau):
     config = SimConfig(command_timeout_s=None, heartbeat_timeout_s=None,
                        speed_time_constant_s=tau)
-    final = run_steady(locked_gait(3.0), 3.0, FishGeometry(), config).speed
+    final = run_steady(table1_locked_at(3.0), 3.0, FishGeometry(), config).speed
     fish = VirtualFish(config, FishGeometry())
     dt, warm_up = 0.005, 200   # 1 s for the servos to reach their steady oscillation
-    commands, _ = steady_state_servo_angles(locked_gait(3.0),
+    commands, _ = steady_state_servo_angles(table1_locked_at(3.0),
                                             np.arange(warm_up + int(3 * tau / dt)) * dt)
     speeds = []
     for i, (servo_1, servo_2) in enumerate(commands.tolist()):

@@ -34,13 +34,13 @@ from sensor_msgs.msg import BatteryState, Imu, JointState
 
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate
-from wirefish_bridge.parameters import check_value, declare, ParameterSpec
 from wirefish_bridge.protocol import (DEFAULT_BAUDRATE, ErrorCode, ErrorReport, Heartbeat,
                                       PROTOCOL_VERSION, Role, ServoCommand, Status, Telemetry)
 from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, SERVO_NAMES,
                                           servo_state_message)
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
+from wirefish_common.parameter_table import check_value, declare, ParameterSpec
 
 PARAMETERS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '

@@ -13,53 +13,19 @@ high frequency; ``ideal`` is eq 18 on the commanded angles (servos that follow e
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 import json
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import brentq
 from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
 from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.steady_state import (intrinsic_frequency_for, stable_phase_difference,
-                                       steady_state_servo_angles)
+from wirefish_cpg.steady_state import steady_state_servo_angles
+from wirefish_cpg.table1_gait import amplitude_scale_for, locked_speed_estimate, table1_locked_at
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.lighthill import estimate_speed, SpeedEstimate
 
-TABLE_1 = CpgParameters()  # the defaults are Table 1 (alpha = 20, b = 0)
+SCALE_FREQUENCY_HZ = 3.0  # amplitudes are scaled once, with ideal servos, at this frequency
 COMMAND_RATE_HZ = 200.0
-
-
-def locked_gait(frequency_hz: float, scale: float = 1.0,
-                base: CpgParameters = TABLE_1) -> CpgParameters:
-    """
-    Return ``base`` with amplitudes times ``scale`` and v set so the network locks at f.
-
-    The coupling shifts the locked frequency away from v (eq 1); scaling both amplitudes leaves
-    the locked phase difference unchanged.
-    """
-    amplitude = tuple(scale * a for a in base.amplitude)
-    r1, r2 = amplitude
-    delta = stable_phase_difference(r1, r2, base.w12, base.w21, base.phi12, base.phi21)
-    v = float(intrinsic_frequency_for(frequency_hz, r2, base.w12, base.phi12, delta))
-    return replace(base, amplitude=amplitude, frequency_hz=v)
-
-
-def ideal_estimate(params: CpgParameters, frequency_hz: float, geometry: FishGeometry,
-                   samples: int = 400) -> SpeedEstimate:
-    """Return eq 18 (kinematics core) on one period of the commanded (locked) servo angles."""
-    dt = 1.0 / (frequency_hz * samples)
-    angles, rates = steady_state_servo_angles(params, np.arange(samples) * dt)
-    return estimate_speed(angles, rates, dt, geometry)
-
-
-def amplitude_scale_for(tip_amplitude_m: float, geometry: FishGeometry,
-                        frequency_hz: float = 3.0) -> float:
-    """Return the factor on Table 1's amplitudes giving ``tip_amplitude_m`` with ideal servos."""
-    def error(scale: float) -> float:
-        gait = locked_gait(frequency_hz, scale)
-        return ideal_estimate(gait, frequency_hz, geometry).tail_tip_amplitude - tip_amplitude_m
-    return float(brentq(error, 0.01, 3.0, xtol=1e-6))
 
 
 @dataclass(frozen=True)
@@ -96,7 +62,7 @@ def run_steady(params: CpgParameters, frequency_hz: float, geometry: FishGeometr
         if i >= steps_settle:
             speeds.append(fish.state.speed)
             tips.append(fish.state.tail_tip_offset)
-    ideal = ideal_estimate(params, frequency_hz, geometry).speed
+    ideal = locked_speed_estimate(params, geometry).speed
     return SteadyRun(frequency_hz, float(np.mean(speeds)), 0.5 * float(np.ptp(tips)), ideal)
 
 
@@ -112,8 +78,8 @@ def speed_sweep(frequencies_hz: np.ndarray | None = None, tip_amplitude_m: float
     geometry = geometry or FishGeometry()
     if frequencies_hz is None:
         frequencies_hz = np.arange(1.0, 10.01, 0.5)
-    scale = amplitude_scale_for(tip_amplitude_m, geometry)
-    return [run_steady(locked_gait(f, scale), f, geometry, config)
+    scale = amplitude_scale_for(tip_amplitude_m, SCALE_FREQUENCY_HZ, geometry)
+    return [run_steady(table1_locked_at(f, scale), f, geometry, config)
             for f in np.asarray(frequencies_hz, dtype=float).tolist()]
 
 

@@ -19,24 +19,17 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass, replace
-import math
 import sys
 
 import numpy as np
-from scipy.optimize import brentq
-from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.steady_state import (intrinsic_frequency_for, stable_phase_difference,
-                                       steady_state_phases, steady_state_servo_angles)
+from wirefish_cpg.table1_gait import (amplitude_scale_for, locked_speed_estimate,
+                                      one_locked_period, table1_locked_at, tip_half_amplitude)
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.lighthill import (drag_coefficient_for_speed, estimate_speed,
-                                           SpeedEstimate, tail_tip_lateral_positions,
+from wirefish_kinematics.lighthill import (drag_coefficient_for_speed, SpeedEstimate,
                                            tail_tip_velocity_and_slope)
 
-TABLE1 = CpgParameters()  # Table 1: w12, w21, phi12, phi21, R1, R2; alpha = 20, b = 0
 CALIBRATION_HZ = 3.0
 CALIBRATION_SPEED = 0.39  # m/s, section 5.3 (Fig 8b)
-SAMPLES_PER_PERIOD = 512
-AMPLITUDE_SAMPLES = 4096  # dense sampling for the tip's half amplitude (peaks between samples)
 PAPER_RMSE = 0.045  # m/s, the paper's simulation-vs-experiment RMSE (section 5.4)
 
 
@@ -57,53 +50,14 @@ PAPER_POINTS = (
 )
 
 
-def table1_locked_at(frequency_hz: float, amplitude_scale: float = 1.0) -> CpgParameters:
-    """Return Table 1 with R_i scaled and v chosen so that the network locks at frequency_hz."""
-    r1, r2 = (amplitude_scale * r for r in TABLE1.amplitude)
-    delta = stable_phase_difference(r1, r2, TABLE1.w12, TABLE1.w21, TABLE1.phi12, TABLE1.phi21)
-    v = float(intrinsic_frequency_for(frequency_hz, r2, TABLE1.w12, TABLE1.phi12, delta))
-    return replace(TABLE1, frequency_hz=v, amplitude=(r1, r2))
-
-
-def one_period(params: CpgParameters, samples: int) -> tuple[np.ndarray, np.ndarray, float]:
-    """Return (angles (N, 2) rad, rates (N, 2) rad/s, dt s) over one locked period."""
-    _, omega = steady_state_phases(params)
-    dt = 2.0 * math.pi / omega / samples
-    angles, rates = steady_state_servo_angles(params, np.arange(samples) * dt)
-    return angles, rates, dt
-
-
-def tip_half_amplitude(params: CpgParameters, geometry: FishGeometry) -> float:
-    """Return the tail tip's half peak-to-peak lateral excursion (m) in the steady state."""
-    angles, _, _ = one_period(params, AMPLITUDE_SAMPLES)
-    return 0.5 * float(np.ptp(tail_tip_lateral_positions(angles, geometry)))
-
-
-def estimate(params: CpgParameters, geometry: FishGeometry) -> SpeedEstimate:
-    """Return the eq 16-22 estimate of the locked steady state of ``params``."""
-    angles, rates, dt = one_period(params, SAMPLES_PER_PERIOD)
-    return estimate_speed(angles, rates, dt, geometry)
-
-
 def calibrated_drag_coefficient(geometry: FishGeometry = FishGeometry(),
                                 frequency_hz: float = CALIBRATION_HZ,
                                 speed: float = CALIBRATION_SPEED) -> float:
     """Return the C_D for which eq 18 gives ``speed`` with Table 1 locked at frequency_hz."""
-    angles, rates, _ = one_period(table1_locked_at(frequency_hz), SAMPLES_PER_PERIOD)
+    angles, rates, _ = one_locked_period(table1_locked_at(frequency_hz))
     velocity, slope = tail_tip_velocity_and_slope(angles, rates, geometry)
     return drag_coefficient_for_speed(speed, float(np.mean(velocity ** 2)),
                                       float(np.mean(slope ** 2)), geometry)
-
-
-def amplitude_scale_for(tip_amplitude: float, frequency_hz: float,
-                        geometry: FishGeometry) -> float:
-    """Return the factor on Table 1's R_i that gives the tail tip this half amplitude (m)."""
-    limit = 0.999 * (math.pi / 2) / max(abs(r) for r in TABLE1.amplitude)  # |R_i| <= pi/2
-
-    def miss(scale: float) -> float:
-        return tip_half_amplitude(table1_locked_at(frequency_hz, scale), geometry) - tip_amplitude
-
-    return brentq(miss, 1e-6, limit, xtol=1e-12)
 
 
 @dataclass(frozen=True)
@@ -120,7 +74,7 @@ def predict(point: PaperPoint, geometry: FishGeometry) -> Prediction:
     scale = (1.0 if point.tip_amplitude is None
              else amplitude_scale_for(point.tip_amplitude, point.frequency_hz, geometry))
     params = table1_locked_at(point.frequency_hz, scale)
-    result = replace(estimate(params, geometry),
+    result = replace(locked_speed_estimate(params, geometry),
                      tail_tip_amplitude=tip_half_amplitude(params, geometry))
     return Prediction(point=point, amplitude_scale=scale, estimate=result)
 

@@ -30,8 +30,8 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
+from wirefish_common.parameter_table import check_value, declare, ParameterSpec
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
-from wirefish_cpg.parameter_specs import check_value, declare, ParameterSpec
 from wirefish_msgs.msg import CpgParams
 
 HALF_PI = math.pi / 2

@@ -36,9 +36,9 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray
+from wirefish_common.parameter_table import check_value, declare, ParameterSpec
 from wirefish_cpg.cpg_node import to_message
 from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.parameter_specs import check_value, declare, ParameterSpec
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait
 from wirefish_cpg.wave_loss import WaveFitProblem, WaveSpec

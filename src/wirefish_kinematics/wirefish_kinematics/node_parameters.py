@@ -1,28 +1,15 @@
 """
-The kinematics node's parameters as one table, and their pure validation (no rclpy import).
+The kinematics node's parameters as one table (no rclpy import).
 
-``check_value`` runs in the node's ``add_on_set_parameters_callback``; ``declare`` builds each
-``ParameterDescriptor`` with its description and ``FloatingPointRange``/``IntegerRange``.
+Validation and declaration are the shared ones of ``wirefish_common.parameter_table``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-import math
-
+from wirefish_common.parameter_table import check_value, declare as declare_specs, ParameterSpec
 from wirefish_kinematics.geometry import FishGeometry, GEOMETRY_FIELDS
 
-
-@dataclass(frozen=True)
-class ParameterSpec:
-    """A parameter: default (float, int or bool), description, inclusive range [low, high]."""
-
-    name: str
-    default: float | int | bool
-    description: str
-    low: float | None = None
-    high: float | None = None
-    low_exclusive: bool = False
+__all__ = ['check_value', 'declare', 'geometry_from', 'NODE_PARAMETERS', 'ParameterSpec', 'SPECS']
 
 
 _DEFAULT = FishGeometry()
@@ -67,45 +54,11 @@ NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
 SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
 
 
-def check_value(spec: ParameterSpec, value: object) -> str | None:
-    """Return why ``value`` is not acceptable for ``spec``, or None if it is."""
-    kind = type(spec.default)
-    if kind is bool:
-        return None if type(value) is bool else f'{spec.name} must be a bool, got {value!r}'
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return f'{spec.name} must be a number, got {value!r}'
-    if kind is int and not isinstance(value, int):
-        return f'{spec.name} must be an integer, got {value!r}'
-    if not math.isfinite(value):
-        return f'{spec.name} must be finite, got {value}'
-    if spec.low is not None:
-        if spec.low_exclusive and value <= spec.low:
-            return f'{spec.name} must be > {spec.low:g}, got {value:g}'
-        if value < spec.low:
-            return f'{spec.name} must be >= {spec.low:g}, got {value:g}'
-    if spec.high is not None and value > spec.high:
-        return f'{spec.name} must be <= {spec.high:g}, got {value:g}'
-    return None
-
-
 def geometry_from(values: dict[str, object]) -> FishGeometry:
     """Return the FishGeometry of a name -> value mapping (raises ValueError if invalid)."""
     return FishGeometry(**{name: values[name] for name in GEOMETRY_FIELDS})
 
 
 def declare(node, specs: tuple[ParameterSpec, ...] = NODE_PARAMETERS) -> None:
-    """Declare every spec on ``node`` with a descriptor carrying its description and range."""
-    from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
-
-    for spec in specs:
-        descriptor = ParameterDescriptor(description=spec.description)
-        if spec.low is not None and spec.high is not None:
-            if type(spec.default) is float:
-                descriptor.floating_point_range = [FloatingPointRange(
-                    from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
-            elif type(spec.default) is int:
-                descriptor.integer_range = [IntegerRange(
-                    from_value=int(spec.low), to_value=int(spec.high), step=1)]
-        if spec.low_exclusive:
-            descriptor.additional_constraints = f'> {spec.low:g}'
-        node.declare_parameter(spec.name, spec.default, descriptor)
+    """Declare the kinematics node's parameters (all of them by default) on ``node``."""
+    declare_specs(node, specs)

@@ -14,7 +14,7 @@ from wirefish_cpg.cpg_node import SPECS
     ('amplitude_2', True),
 ])
 def test_invalid_values_are_refused_with_a_reason(name, value):
-    from wirefish_cpg.parameter_specs import check_value
+    from wirefish_common.parameter_table import check_value
     reason = check_value(SPECS[name], value)
     assert reason is not None and name in reason
 
@@ -24,5 +24,5 @@ def test_invalid_values_are_refused_with_a_reason(name, value):
     ('alpha', 200.0), ('publish_rate_hz', 1000.0), ('autostart', False),
 ])
 def test_values_at_the_edges_of_the_ranges_are_accepted(name, value):
-    from wirefish_cpg.parameter_specs import check_value
+    from wirefish_common.parameter_table import check_value
     assert check_value(SPECS[name], value) is None

@@ -1,10 +1,11 @@
 """
-Declarations and validation of ROS parameters from one table (no rclpy import at module level).
+ROS parameters from one table: declaration with descriptors, and pure validation.
 
-Each ``ParameterSpec`` is a name, default, description and (for numbers) an inclusive range
-plus optional strict lower bound. ``check_value`` is the pure validation the nodes run in their
-``add_on_set_parameters_callback``; ``declare`` builds the ``ParameterDescriptor`` with the
-matching ``FloatingPointRange``/``IntegerRange``.
+Each ``ParameterSpec`` is a name, a default (its type is the parameter's type), a description
+and, for numbers, an inclusive range with an optional strict lower bound. ``check_value`` is the
+pure validation a node runs in its ``add_on_set_parameters_callback``; ``declare`` builds the
+``ParameterDescriptor`` with the matching ``FloatingPointRange`` / ``IntegerRange``. No rclpy
+import at module level, so the validation is testable without ROS.
 """
 
 from __future__ import annotations
@@ -29,7 +30,11 @@ def check_value(spec: ParameterSpec, value: object) -> str | None:
     """Return why ``value`` is not acceptable for ``spec``, or None if it is."""
     kind = type(spec.default)
     if kind is bool or kind is str:
-        return None if type(value) is kind else f'{spec.name} must be a {kind.__name__}'
+        if type(value) is not kind:
+            return f'{spec.name} must be a {kind.__name__}, got {value!r}'
+        if kind is str and not value:
+            return f'{spec.name} must not be empty'
+        return None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return f'{spec.name} must be a number, got {value!r}'
     if kind is int and not isinstance(value, int):

@@ -1,0 +1,1 @@
+"""Pieces the wirefish nodes share: the ROS parameter table."""
