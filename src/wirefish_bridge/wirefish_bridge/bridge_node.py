@@ -40,7 +40,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, SERVO_NAMES,
                                           servo_state_message)
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
-from wirefish_common.parameter_table import check_value, declare, ParameterSpec
+from wirefish_common.parameter_table import declare, merged_update, ParameterSpec
 
 PARAMETERS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '
@@ -129,15 +129,10 @@ class BridgeNode(Node):
 
     # --- parameters -------------------------------------------------------------------------
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        merged = dict(self._values)
-        for parameter in parameters:
-            spec = SPECS.get(parameter.name)
-            if spec is None:
-                continue
-            reason = check_value(spec, parameter.value)
-            if reason is not None:
-                return SetParametersResult(successful=False, reason=reason)
-            merged[parameter.name] = parameter.value
+        merged, reason = merged_update(SPECS, self._values,
+                                       [(p.name, p.value) for p in parameters])
+        if reason is not None:
+            return SetParametersResult(successful=False, reason=reason)
         reason = check_combination(merged)
         return SetParametersResult(successful=reason is None, reason=reason or '')
 

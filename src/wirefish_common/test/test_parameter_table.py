@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from wirefish_common.parameter_table import check_value, ParameterSpec
+from wirefish_common.parameter_table import check_value, merged_update, ParameterSpec
 
 RATE = ParameterSpec('rate', 50.0, 'a rate (Hz)', 0.0, 100.0, low_exclusive=True)
 COUNT = ParameterSpec('count', 5, 'a count', 1, 10)
@@ -27,3 +27,17 @@ def test_invalid_values_are_refused_with_a_reason_naming_the_parameter(spec, val
 ])
 def test_values_inside_the_ranges_are_accepted(spec, value):
     assert check_value(spec, value) is None
+
+
+def test_an_update_with_one_bad_value_is_refused_whole_and_changes_nothing():
+    current = {'rate': 50.0, 'count': 5}
+    merged, reason = merged_update({'rate': RATE, 'count': COUNT}, current,
+                                   [('count', 7), ('rate', math.nan), ('use_sim_time', True)])
+    assert reason is not None and 'rate' in reason
+    assert current == {'rate': 50.0, 'count': 5}
+
+
+def test_a_valid_update_is_merged_and_unknown_names_are_left_alone():
+    merged, reason = merged_update({'rate': RATE}, {'rate': 50.0},
+                                   [('rate', 20.0), ('use_sim_time', True)])
+    assert reason is None and merged == {'rate': 20.0}

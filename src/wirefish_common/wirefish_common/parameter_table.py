@@ -67,3 +67,24 @@ def declare(node, specs: tuple[ParameterSpec, ...]) -> None:
         if spec.low_exclusive:
             descriptor.additional_constraints = f'> {spec.low:g}'
         node.declare_parameter(spec.name, spec.default, descriptor)
+
+
+def merged_update(specs: dict[str, ParameterSpec], current: dict[str, object],
+                  updates: list[tuple[str, object]]) -> tuple[dict[str, object], str | None]:
+    """
+    Return (``current`` with ``updates`` applied, the first reason to refuse them or None).
+
+    What a node's ``add_on_set_parameters_callback`` does before it checks the combination:
+    every value is checked against its spec; names outside ``specs`` (e.g. ``use_sim_time``)
+    are left to rclpy.
+    """
+    merged = dict(current)
+    for name, value in updates:
+        spec = specs.get(name)
+        if spec is None:
+            continue
+        reason = check_value(spec, value)
+        if reason is not None:
+            return merged, reason
+        merged[name] = value
+    return merged, None

@@ -30,7 +30,7 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
-from wirefish_common.parameter_table import check_value, declare, ParameterSpec
+from wirefish_common.parameter_table import declare, merged_update, ParameterSpec
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_msgs.msg import CpgParams
 
@@ -122,15 +122,10 @@ class CpgNode(Node):
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
         # Check every value and the combination; reject the whole set with the first reason.
-        merged = dict(self._values)
-        for parameter in parameters:
-            spec = SPECS.get(parameter.name)
-            if spec is None:
-                continue
-            reason = check_value(spec, parameter.value)
-            if reason is not None:
-                return SetParametersResult(successful=False, reason=reason)
-            merged[parameter.name] = parameter.value
+        merged, reason = merged_update(SPECS, self._values,
+                                       [(p.name, p.value) for p in parameters])
+        if reason is not None:
+            return SetParametersResult(successful=False, reason=reason)
         try:
             parameters_from(merged)
         except ValueError as error:

@@ -39,7 +39,7 @@ from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
 from wirefish_kinematics.lighthill import SpeedEstimate, tail_tip_lateral_positions
-from wirefish_kinematics.node_parameters import (check_value, declare, geometry_from,
+from wirefish_kinematics.node_parameters import (declare, geometry_from, merged_update,
                                                  NODE_PARAMETERS, SPECS)
 from wirefish_kinematics.servo_history import ServoHistory
 from wirefish_kinematics.tail_beat import (estimate_speed_over, fundamental_phase,
@@ -152,15 +152,10 @@ class KinematicsNode(Node):
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
         # Check every value and the geometry they make together; reject all with one reason.
-        merged = dict(self._values)
-        for parameter in parameters:
-            spec = SPECS.get(parameter.name)
-            if spec is None:
-                continue
-            reason = check_value(spec, parameter.value)
-            if reason is not None:
-                return SetParametersResult(successful=False, reason=reason)
-            merged[parameter.name] = parameter.value
+        merged, reason = merged_update(SPECS, self._values,
+                                       [(p.name, p.value) for p in parameters])
+        if reason is not None:
+            return SetParametersResult(successful=False, reason=reason)
         try:
             geometry_from(merged)
         except ValueError as error:
