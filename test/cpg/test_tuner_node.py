@@ -54,6 +54,9 @@ def test_bad_requests_are_refused_with_reasons_and_leave_the_cpg_untouched(spawn
     spawn([CPG_NODE])
     spawn([TUNER_NODE])
     probe.wait_samples(20)
+    # The latched cpg_params may arrive after the first samples on a loaded machine: count
+    # the announcements only once it is in.
+    assert spin_until(probe.executor, lambda: len(probe.cpg_params) > 0, WAIT_S)
     before = probe.get_parameters(CPG_NAMES)
     announced = len(probe.cpg_params)
     client = probe.node.create_client(RetuneGait, 'retune_gait')
