@@ -40,7 +40,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, SERVO_NAMES,
                                           servo_state_message)
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
-from wirefish_common.parameter_table import declare, merged_update, ParameterSpec
+from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
 
 PARAMETERS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '
@@ -129,12 +129,7 @@ class BridgeNode(Node):
 
     # --- parameters -------------------------------------------------------------------------
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        merged, reason = merged_update(SPECS, self._values,
-                                       [(p.name, p.value) for p in parameters])
-        if reason is not None:
-            return SetParametersResult(successful=False, reason=reason)
-        reason = check_combination(merged)
-        return SetParametersResult(successful=reason is None, reason=reason or '')
+        return validate_update(SPECS, self._values, parameters, check_combination)
 
     def _apply(self, parameters: list[Parameter]) -> None:
         names = {p.name for p in parameters if p.name in SPECS}

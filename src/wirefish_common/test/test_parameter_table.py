@@ -3,7 +3,8 @@
 import math
 
 import pytest
-from wirefish_common.parameter_table import check_value, merged_update, ParameterSpec
+from wirefish_common.parameter_table import (check_value, merged_update, ParameterSpec,
+                                             validate_update)
 
 RATE = ParameterSpec('rate', 50.0, 'a rate (Hz)', 0.0, 100.0, low_exclusive=True)
 COUNT = ParameterSpec('count', 5, 'a count', 1, 10)
@@ -41,3 +42,25 @@ def test_a_valid_update_is_merged_and_unknown_names_are_left_alone():
     merged, reason = merged_update({'rate': RATE}, {'rate': 50.0},
                                    [('rate', 20.0), ('use_sim_time', True)])
     assert reason is None and merged == {'rate': 20.0}
+
+
+class _Param:
+    def __init__(self, name, value):
+        self.name, self.value = name, value
+
+
+def _geometry(values):
+    if values['rate'] > values['count'] * 10:
+        raise ValueError('rate must not exceed 10 x count')
+    return object()  # what a node builds from a consistent set
+
+
+@pytest.mark.parametrize('updates, successful, reason_has', [
+    ([('rate', 20.0)], True, ''),
+    ([('rate', math.inf)], False, 'rate'),
+    ([('rate', 80.0)], False, '10 x count'),
+])
+def test_validate_update_judges_values_then_their_combination(updates, successful, reason_has):
+    result = validate_update({'rate': RATE, 'count': COUNT}, {'rate': 50.0, 'count': 5},
+                             [_Param(*u) for u in updates], _geometry)
+    assert result.successful == successful and reason_has in result.reason

@@ -88,3 +88,26 @@ def merged_update(specs: dict[str, ParameterSpec], current: dict[str, object],
             return merged, reason
         merged[name] = value
     return merged, None
+
+
+def validate_update(specs: dict[str, ParameterSpec], current: dict[str, object], parameters,
+                    combination=None):
+    """
+    Return the ``SetParametersResult`` of a node's ``add_on_set_parameters_callback``.
+
+    ``parameters`` are rclpy ``Parameter`` objects. Every value is checked against its spec,
+    then ``combination(merged values)`` (if given) judges the whole set: a string it returns, or
+    the message of a ``ValueError`` it raises, is the reason; anything else it returns (None, or
+    the object it built from the values) means the set is consistent. The whole set is rejected
+    with the first reason, so an invalid update changes nothing.
+    """
+    from rcl_interfaces.msg import SetParametersResult
+
+    merged, reason = merged_update(specs, current, [(p.name, p.value) for p in parameters])
+    if reason is None and combination is not None:
+        try:
+            verdict = combination(merged)
+            reason = verdict if isinstance(verdict, str) else None
+        except ValueError as error:
+            reason = str(error)
+    return SetParametersResult(successful=reason is None, reason=reason or '')

@@ -30,7 +30,7 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
-from wirefish_common.parameter_table import declare, merged_update, ParameterSpec
+from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_msgs.msg import CpgParams
 
@@ -121,16 +121,8 @@ class CpgNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        # Check every value and the combination; reject the whole set with the first reason.
-        merged, reason = merged_update(SPECS, self._values,
-                                       [(p.name, p.value) for p in parameters])
-        if reason is not None:
-            return SetParametersResult(successful=False, reason=reason)
-        try:
-            parameters_from(merged)
-        except ValueError as error:
-            return SetParametersResult(successful=False, reason=str(error))
-        return SetParametersResult(successful=True)
+        # Every value, then the CpgParameters they make together (its ValueError is the reason).
+        return validate_update(SPECS, self._values, parameters, parameters_from)
 
     def _apply(self, parameters: list[Parameter]) -> None:
         names = {p.name for p in parameters if p.name in SPECS}

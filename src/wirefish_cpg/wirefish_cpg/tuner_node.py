@@ -36,7 +36,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray
-from wirefish_common.parameter_table import check_value, declare, ParameterSpec
+from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
 from wirefish_cpg.cpg_node import to_message
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
@@ -128,12 +128,7 @@ class TunerNode(Node):
                             callback_group=ReentrantCallbackGroup())
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        for parameter in parameters:
-            spec = SPECS.get(parameter.name)
-            reason = None if spec is None else check_value(spec, parameter.value)
-            if reason is not None:
-                return SetParametersResult(successful=False, reason=reason)
-        return SetParametersResult(successful=True)
+        return validate_update(SPECS, {}, parameters)
 
     def _value(self, name: str):
         return self.get_parameter(name).value

@@ -39,8 +39,8 @@ from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
 from wirefish_kinematics.lighthill import SpeedEstimate, tail_tip_lateral_positions
-from wirefish_kinematics.node_parameters import (declare, geometry_from, merged_update,
-                                                 NODE_PARAMETERS, SPECS)
+from wirefish_kinematics.node_parameters import (declare, geometry_from, NODE_PARAMETERS,
+                                                 SPECS, validate_update)
 from wirefish_kinematics.servo_history import ServoHistory
 from wirefish_kinematics.tail_beat import (estimate_speed_over, fundamental_phase,
                                            last_tail_beat, TailBeat)
@@ -151,16 +151,8 @@ class KinematicsNode(Node):
         return WaveTarget(v['wave_c1'], v['wave_c2'], v['wave_k'], v['wave_frequency_hz'])
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        # Check every value and the geometry they make together; reject all with one reason.
-        merged, reason = merged_update(SPECS, self._values,
-                                       [(p.name, p.value) for p in parameters])
-        if reason is not None:
-            return SetParametersResult(successful=False, reason=reason)
-        try:
-            geometry_from(merged)
-        except ValueError as error:
-            return SetParametersResult(successful=False, reason=str(error))
-        return SetParametersResult(successful=True)
+        # Every value, then the geometry they make together (its ValueError is the reason).
+        return validate_update(SPECS, self._values, parameters, geometry_from)
 
     def _apply(self, parameters: list[Parameter]) -> None:
         names = {p.name for p in parameters if p.name in SPECS}

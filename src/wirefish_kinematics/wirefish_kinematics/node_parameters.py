@@ -7,11 +7,11 @@ Validation and declaration are the shared ones of ``wirefish_common.parameter_ta
 from __future__ import annotations
 
 from wirefish_common.parameter_table import (check_value, declare as declare_specs,
-                                             merged_update, ParameterSpec)
+                                             merged_update, ParameterSpec, validate_update)
 from wirefish_kinematics.geometry import FishGeometry, GEOMETRY_FIELDS
 
 __all__ = ['check_value', 'declare', 'geometry_from', 'merged_update', 'NODE_PARAMETERS',
-           'ParameterSpec', 'SPECS']
+           'ParameterSpec', 'SPECS', 'validate_update']
 
 
 _DEFAULT = FishGeometry()
