@@ -6,6 +6,7 @@ Every topic at its rate; a retune with apply changes the servo commands without 
 """
 
 import math
+import re
 import subprocess
 import sys
 
@@ -121,8 +122,14 @@ def test_ten_second_recording_loses_nothing(running_graph, tmp_path):
          '--namespace', running_graph.namespace, '--duration', '10'],
         env=running_graph.env, capture_output=True, text=True, timeout=90)
     assert result.returncode == 0, result.stderr
-    assert 'lost in transport: 0' in result.stdout, result.stdout
+    # Nothing lost: the middleware's own count, and no number absent from any publisher's
+    # sequence between its first and last sample (a count, whatever the cause of a loss).
+    assert 'lost in transport: 0;' in result.stdout, result.stdout
+    assert "missing from the publishers' sequences: 0" in result.stdout, result.stdout
+    assert 'sequence not checked' not in result.stdout, result.stdout
     bag = read_bag(bag_path)
+    written = int(re.search(r'wrote (\d+) messages', result.stdout).group(1))
+    assert sum(len(msgs) for msgs in bag.messages.values()) == written
     for topic, nominal in EXPECTED_RATES_HZ.items():
         full = _full(running_graph.namespace, topic)
         msgs = bag.messages[full]
@@ -132,10 +139,9 @@ def test_ten_second_recording_loses_nothing(running_graph, tmp_path):
         else:  # MarkerArray: the stamps of its markers
             stamps = np.array([m.markers[0].header.stamp.sec
                                + 1e-9 * m.markers[0].header.stamp.nanosec for _, m in msgs])
+        # Counts match the rates. Gaps in the stamps are timer ticks a publisher skipped while
+        # the shared machine starved it (it sent nothing, so nothing was lost): `make bench`
+        # measures those, a test does not time them.
         stats = topic_stats(full, bag.types[full], stamps)
-        assert stats.rate_hz == pytest.approx(nominal, rel=0.1), f'{full}: {stats}'
-        # 'lost in transport: 0' above is the middleware's own count (sequence numbers): every
-        # sample a publisher sent is in the bag. Gaps in the stamps also hold timer ticks that a
-        # publisher skipped when the shared machine starved it; those stay a small fraction.
-        assert stats.drops <= 0.03 * stats.count, f'{full}: {stats}'
+        assert stats.rate_hz == pytest.approx(nominal, rel=RATE_TOLERANCE), f'{full}: {stats}'
     assert math.isclose(bag.duration_s, 10.0, abs_tol=1.5)

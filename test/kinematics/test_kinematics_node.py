@@ -15,6 +15,7 @@ pytestmark = pytest.mark.ros
 G = FishGeometry()
 POSE_A = (0.3, -0.2)
 POSE_B = (-0.1, 0.4)
+BEAT_HZ = 1.7  # a beat whose period does not divide the node's history span
 
 
 def core_wave(angles, stations: int = 50, geometry: FishGeometry = G):
@@ -106,6 +107,26 @@ def test_speed_estimate_equals_the_core_over_the_last_tail_beat(start_node, prob
     y_q1 = body_positions(np.array([q1]), *beta, G)[1][:, 0]
     half_range = 0.5 * np.ptp(y_q1)
     assert wave.y_desired[1] / (0.3 * q1) == pytest.approx(wave.y[1] / half_range, abs=0.1)
+
+
+def test_one_speed_estimate_per_tail_beat(start_node, probe):
+    start_node('-p', 'station_count:=4')
+    probe.wait_connected()
+    index = 0
+
+    def six_estimates() -> bool:
+        nonlocal index
+        angles, rates = locked_servo(index * 0.01, BEAT_HZ)
+        probe.send(index, angles, rates)
+        index += 1
+        probe.spin(0.005)
+        return len(probe.speed) >= 6
+
+    probe.wait_for(six_estimates, 'six speed estimates')
+    ends = np.array([stamp_s(msg) for msg in probe.speed])
+    # Consecutive estimates end one beat apart: none repeated for the same beat, although the
+    # history (not a whole number of beats long) moves its crossings by a few ms.
+    np.testing.assert_allclose(np.diff(ends), 1.0 / BEAT_HZ, atol=0.02)
 
 
 def test_a_tail_at_rest_reports_zero_speed(start_node, probe):

@@ -6,6 +6,7 @@ from pathlib import Path
 import sys
 
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+from wirefish_bringup.sequence_gaps import SequenceGaps
 
 NOTHING_TIMEOUT_S = 30.0
 
@@ -60,11 +61,28 @@ def run(args: argparse.Namespace) -> int:
         recorder.close()
         counts = dict(recorder.counts)
         lost = dict(recorder.lost)
+        sequences = dict(recorder.sequences)
         recorder.destroy_node()
         rclpy.try_shutdown()
-    total = sum(counts.values())
-    print(f'wrote {total} messages on {len(counts)} topics to {bag_path}; '
-          f'lost in transport: {sum(lost.values())}')
-    for topic, count in sorted(counts.items()):
-        print(f'  {topic:<40} {count:>7} (lost {lost[topic]})')
+    print(recording_summary(bag_path, counts, lost, sequences), flush=True)
     return 0
+
+
+def recording_summary(bag_path: Path, counts: dict[str, int], lost: dict[str, int],
+                      sequences: dict[str, SequenceGaps]) -> str:
+    """
+    Return what was written and what never arrived, per topic.
+
+    'lost in transport' is the middleware's own count; 'missing' counts the numbers absent from
+    each publisher's sequence between its first and last sample in the bag (every cause of loss;
+    not checked on a topic where a second publisher appeared).
+    """
+    checked = {t: s for t, s in sequences.items() if not s.ambiguous}
+    lines = [f'wrote {sum(counts.values())} messages on {len(counts)} topics to {bag_path}; '
+             f"lost in transport: {sum(lost.values())}; missing from the publishers' "
+             f'sequences: {sum(s.missing for s in checked.values())}']
+    for topic, count in sorted(counts.items()):
+        missing = (f'missing {checked[topic].missing}' if topic in checked
+                   else 'several publishers: sequence not checked')
+        lines.append(f'  {topic:<40} {count:>7} (lost {lost[topic]}, {missing})')
+    return '\n'.join(lines)

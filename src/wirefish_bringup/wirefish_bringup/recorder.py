@@ -13,6 +13,7 @@ from rclpy.node import Node
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 from wirefish_bringup.bagfile import wirefish_typestore
+from wirefish_bringup.sequence_gaps import SequenceGaps
 from wirefish_bringup.topics import graph_topics, matching_qos, message_class
 
 BAG_VERSION = 9  # rosbag2 metadata version of ROS 2 Jazzy
@@ -33,6 +34,8 @@ class BagRecorder(Node):
         self.counts: dict[str, int] = {}
         # Samples the middleware reports lost on the way to us (DDS 'sample lost' status).
         self.lost: dict[str, int] = {}
+        # Samples missing from each publisher's sequence numbers: every cause of loss counted.
+        self.sequences: dict[str, SequenceGaps] = {}
         self._closed = False
         self.first_message_ns: int | None = None
         self._scan()
@@ -52,6 +55,7 @@ class BagRecorder(Node):
                 topic, type_name, typestore=self._typestore)
             self.counts[topic] = 0
             self.lost[topic] = 0
+            self.sequences[topic] = SequenceGaps()
             self.create_subscription(
                 msg_class, topic, self._make_callback(topic),
                 matching_qos(self, topic, QUEUE_DEPTH), raw=True,
@@ -61,8 +65,9 @@ class BagRecorder(Node):
 
     def _make_callback(self, topic: str):
         connection = self._connections[topic]
+        sequence = self.sequences[topic]
 
-        def on_message(data: bytes) -> None:
+        def on_message(data: bytes, info: dict) -> None:
             if self._closed:
                 return
             now = self.get_clock().now().nanoseconds
@@ -70,6 +75,7 @@ class BagRecorder(Node):
                 self.first_message_ns = now
             self._writer.write(connection, now, data)
             self.counts[topic] += 1
+            sequence.add(info.get('publication_sequence_number'))
         return on_message
 
     def _on_lost(self, topic: str, info) -> None:

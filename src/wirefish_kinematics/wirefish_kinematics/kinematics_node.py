@@ -250,7 +250,9 @@ class KinematicsNode(Node):
                 self._publish_speed(SpeedEstimate(0.0, 0.0, 0.0, 0.0, 0.0, 0.5 * np.ptp(y_tip)),
                                     float(times[-1]))
             return
-        if beat.end != self._last_beat_end:
+        # The crossings move by a few ms as the history's range slides (they are interpolated
+        # at its middle): the same beat found again is not a new one.
+        if self._last_beat_end is None or beat.end - self._last_beat_end > 0.5 * beat.period:
             self._last_beat_end = beat.end
             self._publish_speed(estimate_speed_over(times, angles, rates, beat.start, beat.end,
                                                     g), beat.end)
