@@ -53,12 +53,14 @@ def recording(duration_s: float, domain_id: int) -> dict:
     stats = write_report(bag, bag.parent / 'report')
     recorder_log = (bag.parent / 'logs' / 'recorder.log').read_text()
     transport = re.search(r'lost in transport: (\d+)', recorder_log)
+    missing = re.search(r"missing from the publishers' sequences: (\d+)", recorder_log)
     return {'duration_s': duration_s,
             'topics': {s.topic: {'count': s.count, 'rate_hz': s.rate_hz, 'drops': s.drops}
                        for s in stats},
             'messages': sum(s.count for s in stats),
             'lost_in_transport': int(transport.group(1)) if transport else None,
-            'drops': sum(max(s.drops, 0) for s in stats)}
+            'missing_from_sequences': int(missing.group(1)) if missing else None,
+            'skipped_ticks': sum(max(s.drops, 0) for s in stats)}
 
 
 def _run(name: str, func, *args, **kwargs):

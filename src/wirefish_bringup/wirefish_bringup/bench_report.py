@@ -78,13 +78,16 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     if 'error' in rec:
         table.append(('Recording, 60 s at default rates', '0 lost', rec['error'], 'failed', ''))
     elif rec:
+        missing = rec.get('missing_from_sequences')
         table.append(('Recording, 60 s at default rates: messages in the bag, lost',
-                      '0 lost', f'{rec["messages"]} messages; {rec["drops"]} missing from the '
-                      'stamps (publisher ticks skipped or lost); lost in transport (DDS count): '
-                      f'{rec.get("lost_in_transport")}',
-                      _verdict(rec, rec['drops'] == 0),
-                      'wirefish up --duration; lost = missing from the header stamps at the '
-                      'period (report.py)'))
+                      '0 lost', f'{rec["messages"]} messages; lost {missing} (numbers missing '
+                      'from the publishers\' sequences; DDS lost count '
+                      f'{rec.get("lost_in_transport")}); {rec.get("skipped_ticks")} publisher '
+                      'ticks skipped (gaps in the header stamps: nothing sent, nothing lost)',
+                      _verdict(rec, missing == 0),
+                      'wirefish up --duration; the recorder counts each publisher\'s DDS '
+                      'sequence numbers; skipped ticks from the stamps at the median period '
+                      '(report.py)'))
     for r in results.get('fleet', []):
         if 'error' in r:
             table.append(('Fish graphs on one machine', '8 at default rates', r['error'],
