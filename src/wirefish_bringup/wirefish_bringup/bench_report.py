@@ -81,11 +81,11 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         missing = rec.get('missing_from_sequences')
         table.append(('Recording, 60 s at default rates: messages in the bag, lost',
                       '0 lost', f'{rec["messages"]} messages; lost {missing} (numbers missing '
-                      'from the publishers\' sequences; DDS lost count '
+                      "from the publishers' sequences; DDS lost count "
                       f'{rec.get("lost_in_transport")}); {rec.get("skipped_ticks")} publisher '
                       'ticks skipped (gaps in the header stamps: nothing sent, nothing lost)',
                       _verdict(rec, missing == 0),
-                      'wirefish up --duration; the recorder counts each publisher\'s DDS '
+                      "wirefish up --duration; the recorder counts each publisher's DDS "
                       'sequence numbers; skipped ticks from the stamps at the median period '
                       '(report.py)'))
     for r in results.get('fleet', []):
