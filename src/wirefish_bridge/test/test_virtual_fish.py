@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.fig11 import run_steady, speed_sweep
+from wirefish_bridge.fig11 import peak_frequency, run_steady, speed_sweep
 from wirefish_bridge.fish_dynamics import force_scale_for_time_constant
 from wirefish_bridge.protocol import Heartbeat, ServoCommand, Status, Telemetry
 from wirefish_bridge.servo_model import Servo, ServoParameters
@@ -61,6 +61,17 @@ def test_speed_rises_then_falls_where_the_servo_cannot_follow():
     assert all(b > a for a, b in zip(speeds[:peak], speeds[1:peak + 1]))
     assert speeds[-1] < speeds[peak]
     assert runs[-1].tail_tip_amplitude < 0.6 * runs[0].tail_tip_amplitude
+
+
+def test_a_slower_servo_peaks_at_a_lower_frequency():
+    frequencies = np.arange(4.0, 10.01, 1.0)
+
+    def peak_hz(rate_limit: float) -> float:
+        config = SimConfig(command_timeout_s=None, heartbeat_timeout_s=None,
+                           servo=ServoParameters(rate_limit_rad_s=rate_limit))
+        return peak_frequency(speed_sweep(frequencies, config=config))
+
+    assert peak_hz(8.0) < peak_hz(12.0)
 
 
 def test_servo_slews_at_its_rate_limit():

@@ -18,6 +18,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+from wirefish_bridge.servo_model import ServoParameters
 from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import steady_state_servo_angles
@@ -123,11 +124,20 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--out', type=Path, default=Path('out/fig11.png'), help='PNG path')
     parser.add_argument('--amplitude', type=float, default=0.05, help='tail-tip amplitude (m)')
+    parser.add_argument('--servo-rate-limit', type=float,
+                        default=ServoParameters.rate_limit_rad_s,
+                        help='servo slew limit (rad/s): where the speed peaks depends on it')
     args = parser.parse_args(argv)
-    runs = speed_sweep(tip_amplitude_m=args.amplitude)
+    try:
+        servo = ServoParameters(rate_limit_rad_s=args.servo_rate_limit)
+    except ValueError as error:
+        parser.error(str(error))
+    config = SimConfig(command_timeout_s=None, heartbeat_timeout_s=None, servo=servo)
+    runs = speed_sweep(tip_amplitude_m=args.amplitude, config=config)
     write_png(runs, args.out)
-    print(json.dumps({'png': str(args.out), 'peak_hz': peak_frequency(runs),
-                      'runs': [r.__dict__ for r in runs]}, indent=1))
+    print(json.dumps({'png': str(args.out), 'servo_rate_limit_rad_s': servo.rate_limit_rad_s,
+                      'peak_hz': peak_frequency(runs), 'runs': [r.__dict__ for r in runs]},
+                     indent=1))
     return 0
 
 
