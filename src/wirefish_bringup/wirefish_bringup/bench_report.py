@@ -119,5 +119,7 @@ def render_markdown(results: dict) -> str:
              '| figure | goal | measured | verdict | how |', '|---|---|---|---|---|']
     for figure, goal, measured, verdict, how in rows(results):
         lines.append(f'| {figure} | {goal} | {measured} | {verdict} | {how} |')
-    lines += ['', 'Raw numbers: `out/bench/results.json` of the same run.', '']
+    lines += ['', 'Raw numbers: `out/bench/results.json` of the same run. Why the figures are '
+              'what they are (py-spy profiles, what limits each missed goal, what would close '
+              'it): [docs/PROFILING.md](docs/PROFILING.md).', '']
     return '\n'.join(lines)
