@@ -14,6 +14,15 @@ import time
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 
 BAR_WIDTH = 30
+UINT32_MAX = 2**32 - 1
+
+
+def count(text: str) -> int:
+    """Return ``text`` as a whole number that fits the request's uint32 fields."""
+    value = int(text)
+    if not 0 <= value <= UINT32_MAX:
+        raise argparse.ArgumentTypeError(f'must be in [0, {UINT32_MAX}], got {value}')
+    return value
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,9 +32,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--k', type=float, default=8.0, help='body wave number (rad/m)')
     parser.add_argument('--freq', type=float, default=1.0, help='tail-beat frequency (Hz)')
     parser.add_argument('--apply', action='store_true', help='apply the fit to the CPG node')
-    parser.add_argument('--seed', type=int, default=0, help='optimiser seed')
-    parser.add_argument('--iterations', type=int, default=0, help='PSO iterations (0: default)')
-    parser.add_argument('--swarm', type=int, default=0, help='PSO particles (0: default)')
+    parser.add_argument('--seed', type=count, default=0, help='optimiser seed')
+    parser.add_argument('--iterations', type=count, default=0,
+                        help='PSO iterations (0: default)')
+    parser.add_argument('--swarm', type=count, default=0, help='PSO particles (0: default)')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
     parser.add_argument('--timeout', type=float, default=120.0,
                         help='seconds to wait for the answer')
@@ -109,8 +119,11 @@ def run(args: argparse.Namespace) -> int:
             print(f'wirefish retune: no answer within {args.timeout:g} s', file=sys.stderr)
             return 1
         response = future.result()
+        if not response.success:  # nothing was fitted or applied: the reason is the answer
+            print(f'wirefish retune: {response.message}', file=sys.stderr)
+            return 1
         print(result_table(response))
-        return 0 if response.success and math.isfinite(response.loss) else 1
+        return 0 if math.isfinite(response.loss) else 1
     except KeyboardInterrupt:
         return 130
     finally:
