@@ -1,7 +1,9 @@
 """Pure parts of the bridge: command gate, conversions, parameters, transport with a fake port."""
 
 import math
+import os
 import threading
+import time
 
 from hypothesis import given, strategies as st
 import pytest
@@ -10,7 +12,8 @@ from wirefish_bridge.bridge_node import check_combination, PARAMETERS
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy, \
     rpy_from_quaternion
-from wirefish_bridge.transport import LinkDown, LinkState, next_backoff, SerialLink
+from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, next_backoff, \
+    SerialLink
 from wirefish_common.parameter_table import check_value
 
 SPECS = {spec.name: spec for spec in PARAMETERS}
@@ -158,3 +161,46 @@ def test_writing_to_a_closed_link_raises_link_down():
     link = SerialLink('/dev/none', 115200, lambda chunk: None)
     with pytest.raises(LinkDown):
         link.write(b'x')
+
+
+def test_a_device_that_stops_reading_drops_frames_instead_of_hanging_the_writer():
+    master, slave = os.openpty()  # nobody ever reads the master side
+    link = SerialLink(os.ttyname(slave), 115200, lambda chunk: None)
+    link.start()
+    outcomes = []
+
+    def fill() -> None:
+        deadline = time.monotonic() + 10.0
+        while not link.connected and time.monotonic() < deadline:
+            time.sleep(0.01)
+        for _ in range(2000):  # 200 kB: far beyond any tty buffer
+            try:
+                link.write(b'\x55' * 100)
+                outcomes.append('sent')
+            except LinkWriteError:
+                outcomes.append('dropped')
+
+    writer = threading.Thread(target=fill, daemon=True)
+    writer.start()
+    writer.join(30.0)
+    assert not writer.is_alive(), 'write() blocked on a full device buffer'
+    link.stop()
+    os.close(master)
+    os.close(slave)
+    assert outcomes.count('sent') > 0 and outcomes[-1] == 'dropped'
+    assert link.stats.write_failures == outcomes.count('dropped')
+
+
+def test_a_port_that_cannot_be_opened_is_reported_once_with_the_reason():
+    reports = []
+    link = SerialLink('/dev/wirefish_no_such_port', 115200, lambda chunk: None,
+                      lambda state, detail: reports.append(detail),
+                      backoff_min_s=0.001, backoff_max_s=0.002)
+    link.start()
+    deadline = time.monotonic() + 10.0
+    while link.stats.open_failures < 5 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    link.stop()
+    failures = [d for d in reports if d.startswith('cannot open /dev/wirefish_no_such_port')]
+    assert link.stats.open_failures >= 5
+    assert len(failures) == 1 and 'No such file' in failures[0]

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 import enum
+import os
 import threading
 
 import serial
@@ -123,7 +124,7 @@ class SerialLink:
             if port is None:
                 raise LinkDown(f'{self.port} is not open')
             try:
-                written = port.write(data)
+                written = _write_without_blocking(port, data)
             except (serial.SerialException, OSError) as error:
                 self.stats.write_failures += 1
                 raise LinkWriteError(f'write to {self.port} failed: {error}') from error
@@ -154,6 +155,8 @@ class SerialLink:
             port.reset_input_buffer()  # stale bytes from before we were listening
         except (serial.SerialException, OSError, ValueError) as error:
             self.stats.open_failures += 1
+            if str(error) != self.stats.last_error:  # say it once, not at every retry
+                self._on_state(self.state, f'cannot open {self.port}: {error}; retrying')
             self.stats.last_error = str(error)
             return False
         with self._lock:
@@ -190,3 +193,22 @@ class SerialLink:
                 self.stats.bytes_in += len(chunk)
                 self._on_data(chunk)
         self._close()
+
+
+def _write_without_blocking(port: serial.Serial, data: bytes) -> int:
+    """
+    Write what the device takes now; return the byte count (0 when its buffer is full).
+
+    pyserial 3.5's ``write`` with ``write_timeout=0`` retries EAGAIN in a loop, so a device that
+    stops reading (a hung board that stays enumerated, a stopped fish_sim) would spin the caller
+    forever once the kernel's buffer fills. The descriptor is non-blocking: write to it directly.
+    Ports without a descriptor (test doubles) use their own ``write``.
+    """
+    try:
+        fd = port.fileno()
+    except (AttributeError, serial.SerialException):
+        return port.write(data)
+    try:
+        return os.write(fd, data)
+    except BlockingIOError:
+        return 0
