@@ -7,6 +7,7 @@ beside the standard tools it stands in for on pip-only machines.
 
 import argparse
 import importlib
+import math
 import sys
 
 # subcommand -> (module, one-line help); modules are imported only when their command runs,
@@ -19,6 +20,17 @@ SUBCOMMANDS = {
     'compose': ('wirefish_bringup.compose', "one fish's ROS nodes in a single process"),
     'sweep': ('wirefish_bringup.sweep', "model and virtual-fish speed over the paper's grid"),
 }
+
+
+def duration_s(text: str) -> float:
+    """Return a --duration option as seconds: finite and > 0 (argparse type)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a number of seconds: {text!r}') from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f'must be a finite number of seconds > 0, got {text}')
+    return value
 
 
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:

@@ -12,10 +12,11 @@ import signal
 import sys
 import time
 
+from wirefish_bringup.cli import duration_s
 from wirefish_bringup.compose import NODE_CLASSES as COMPOSED_NODES
 from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, sim_tty_link,
                                     validate_namespace)
-from wirefish_bringup.supervisor import Supervisor, wait_for_path
+from wirefish_bringup.supervisor import remove_stale_link, Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
 DEVICE_TIMEOUT_S = 15.0
@@ -28,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='drive the virtual fish on a pseudo-terminal (default)')
     target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
-    parser.add_argument('--duration', type=float, default=None,
+    parser.add_argument('--duration', type=duration_s, default=None,
                         help='run this many seconds, record a bag and write a report')
     parser.add_argument('--params-file', type=Path, default=None,
                         help='parameter YAML (default: the installed config/wirefish.yaml)')
@@ -109,9 +110,11 @@ def run(args: argparse.Namespace) -> int:
     code = 0
     try:
         for spec in specs:
-            proc = supervisor.start(spec)
             if spec.executable == 'fish_sim':
                 link = sim_tty_link(namespace)
+                remove_stale_link(link)
+            proc = supervisor.start(spec)
+            if spec.executable == 'fish_sim':
                 if not wait_for_path(link, [proc], DEVICE_TIMEOUT_S):
                     raise RuntimeError('the virtual fish did not open its pseudo-terminal:\n'
                                        + supervisor.log_tail(spec.name))

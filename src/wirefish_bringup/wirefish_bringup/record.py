@@ -5,6 +5,7 @@ from datetime import datetime
 from pathlib import Path
 import sys
 
+from wirefish_bringup.cli import duration_s
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 from wirefish_bringup.sequence_gaps import SequenceGaps
 
@@ -16,7 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('-o', '--output', type=Path, default=None,
                         help='bag directory (default: out/bags/wirefish_<time>); must not exist')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
-    parser.add_argument('--duration', type=float, default=None,
+    parser.add_argument('--duration', type=duration_s, default=None,
                         help='record this many seconds from the first message received '
                         '(default: until Ctrl-C)')
 

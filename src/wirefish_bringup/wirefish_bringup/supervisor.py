@@ -114,6 +114,17 @@ class Supervisor:
                 pass
 
 
+def remove_stale_link(link: Path) -> None:
+    """
+    Remove the pty symlink a killed virtual fish left behind, before starting a new one.
+
+    A stale link may point at a /dev/pts number that another terminal has since taken: waiting
+    for the link to exist would then succeed at once, and the bridge would talk to that terminal.
+    """
+    if link.is_symlink():
+        link.unlink()
+
+
 def wait_for_path(path: Path, procs: Sequence[subprocess.Popen], timeout_s: float) -> bool:
     """Wait until ``path`` exists, giving up early if any of ``procs`` exits."""
     deadline = time.monotonic() + timeout_s
