@@ -24,13 +24,13 @@ class RunningGraph:
     out_dir: Path
 
 
-def start_graph(domain_id: int, out_dir: Path) -> RunningGraph:
-    """Start `wirefish up --sim` (the launcher behind `make run`) on its own domain."""
+def start_graph(domain_id: int, out_dir: Path, *options: str) -> RunningGraph:
+    """Start `wirefish up --sim [options]` (the launcher behind `make run`) on its own domain."""
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
         [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
-         '--namespace', NAMESPACE, '--out', str(out_dir)],
+         '--namespace', NAMESPACE, '--out', str(out_dir), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     deadline = time.monotonic() + 60.0

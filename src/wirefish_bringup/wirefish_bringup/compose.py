@@ -1,14 +1,17 @@
 """
-`wirefish compose`: all of one fish's ROS nodes in one process, on one executor.
+`wirefish compose`: all of one fish's ROS nodes in one process.
 
 The single-process mode of `wirefish up --single-process`: the same node classes, names,
 namespace and parameter file as the one-process-per-node graph, but one Python interpreter and
 one DDS participant instead of four, which is what limits how many fish fit on one machine.
+The tuner spins on an executor and thread of its own: a fit then never stalls the fish's
+streams, and its apply step, which waits for cpg_node's parameter service, can be answered.
 """
 
 import argparse
 import importlib
 import sys
+import threading
 
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, default_params_file, validate_namespace
 
@@ -27,8 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--port', required=True, help='serial device for the bridge')
     parser.add_argument('--params-file', default=None, help='parameter YAML')
     parser.add_argument('--executor', choices=('single', 'multi'), default='single',
-                        help='SingleThreadedExecutor (default: least overhead per callback; a '
-                        'retune pauses the other nodes for its ~0.1 s) or MultiThreadedExecutor')
+                        help='executor of the bridge, CPG and kinematics nodes: '
+                        'SingleThreadedExecutor (default: least overhead per callback) or '
+                        'MultiThreadedExecutor; the tuner always has its own')
 
 
 def node_class(path: str) -> type:
@@ -60,6 +64,10 @@ def run(args: argparse.Namespace) -> int:
     nodes = []
     executor = (SingleThreadedExecutor() if args.executor == 'single'
                 else MultiThreadedExecutor(num_threads=4))
+    # As in its own process (tuner_node.main): a multi-threaded executor, so the service that
+    # runs a fit can wait for the answer of cpg_node's parameter service.
+    tuner_executor = MultiThreadedExecutor(num_threads=4)
+    tuner_thread = threading.Thread(target=tuner_executor.spin, name='tuner', daemon=True)
     try:
         for name, path in NODE_CLASSES.items():
             cli_args = ['--ros-args', '-r', f'__ns:={namespace}', '--params-file', params]
@@ -67,11 +75,15 @@ def run(args: argparse.Namespace) -> int:
                 cli_args += ['-p', f'port:={args.port}']
             node = node_class(path)(cli_args=cli_args)
             nodes.append(node)
-            executor.add_node(node)
+            (tuner_executor if name == 'tuner_node' else executor).add_node(node)
+        tuner_thread.start()
         while not stop_requested:
             executor.spin_once(timeout_sec=0.1)
     finally:
         executor.shutdown()
+        tuner_executor.shutdown()
+        if tuner_thread.is_alive():
+            tuner_thread.join(5.0)
         for node in reversed(nodes):
             node.destroy_node()
         rclpy.try_shutdown()
