@@ -42,7 +42,8 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, SERVO_NAMES,
                                           servo_state_message)
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
-from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.parameter_table import (declare, InvalidParameters, ParameterSpec,
+                                             validate_update)
 
 PARAMETERS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '
@@ -92,7 +93,7 @@ class BridgeNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, wire topics and timers, start the serial link."""
         super().__init__('bridge_node', **kwargs)
-        declare(self, PARAMETERS)
+        declare(self, PARAMETERS, check_combination)
         self._values = {s.name: self.get_parameter(s.name).value for s in PARAMETERS}
         self._started = time.monotonic()
         self._encoder = FrameEncoder()
@@ -359,7 +360,12 @@ def _status_names(status: int) -> str:
 def main(args: list[str] | None = None) -> None:
     """Run the bridge until SIGINT/SIGTERM; the port is closed and its thread joined."""
     rclpy.init(args=args)
-    node = BridgeNode()
+    try:
+        node = BridgeNode()
+    except InvalidParameters as error:  # one clear line, not a traceback
+        rclpy.logging.get_logger('wirefish').fatal(str(error))
+        rclpy.try_shutdown()
+        raise SystemExit(1) from None
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -48,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
     import rclpy
     from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
+    from wirefish_common.parameter_table import InvalidParameters
 
     try:
         namespace = validate_namespace(args.namespace)
@@ -79,6 +80,9 @@ def run(args: argparse.Namespace) -> int:
         tuner_thread.start()
         while not stop_requested:
             executor.spin_once(timeout_sec=0.1)
+    except InvalidParameters as error:
+        print(f'wirefish compose: {error}', file=sys.stderr)
+        return 1
     finally:
         executor.shutdown()
         tuner_executor.shutdown()

@@ -51,9 +51,21 @@ def check_value(spec: ParameterSpec, value: object) -> str | None:
     return None
 
 
-def declare(node, specs: tuple[ParameterSpec, ...]) -> None:
-    """Declare every spec on ``node`` with a descriptor carrying its description and range."""
+class InvalidParameters(ValueError):
+    """The values a node starts with (defaults, YAML, --ros-args -p) are refused."""
+
+
+def declare(node, specs: tuple[ParameterSpec, ...], combination=None) -> None:
+    """
+    Declare every spec on ``node`` with a descriptor carrying its description and range.
+
+    The values the node starts with (a parameter file or ``-p`` may override the defaults) are
+    then judged as a later update would be: each against its spec, then ``combination`` (see
+    ``validate_update``). Raises ``InvalidParameters`` naming the node and the first reason, so
+    a node never runs on values it would refuse in a ``ros2 param set``.
+    """
     from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+    from rclpy.exceptions import InvalidParameterValueException
 
     for spec in specs:
         descriptor = ParameterDescriptor(description=spec.description)
@@ -66,7 +78,14 @@ def declare(node, specs: tuple[ParameterSpec, ...]) -> None:
                     from_value=int(spec.low), to_value=int(spec.high), step=1)]
         if spec.low_exclusive:
             descriptor.additional_constraints = f'> {spec.low:g}'
-        node.declare_parameter(spec.name, spec.default, descriptor)
+        try:
+            node.declare_parameter(spec.name, spec.default, descriptor)
+        except InvalidParameterValueException as error:  # rclpy's own range check
+            raise InvalidParameters(f'{node.get_name()}: {error}') from None
+    values = [(spec.name, node.get_parameter(spec.name).value) for spec in specs]
+    reason = update_problem({spec.name: spec for spec in specs}, {}, values, combination)
+    if reason is not None:
+        raise InvalidParameters(f'{node.get_name()}: invalid parameter: {reason}')
 
 
 def merged_update(specs: dict[str, ParameterSpec], current: dict[str, object],
@@ -103,11 +122,19 @@ def validate_update(specs: dict[str, ParameterSpec], current: dict[str, object],
     """
     from rcl_interfaces.msg import SetParametersResult
 
-    merged, reason = merged_update(specs, current, [(p.name, p.value) for p in parameters])
+    reason = update_problem(specs, current, [(p.name, p.value) for p in parameters],
+                            combination)
+    return SetParametersResult(successful=reason is None, reason=reason or '')
+
+
+def update_problem(specs: dict[str, ParameterSpec], current: dict[str, object],
+                   updates: list[tuple[str, object]], combination=None) -> str | None:
+    """Return the first reason to refuse ``updates`` (values, then their combination), or None."""
+    merged, reason = merged_update(specs, current, updates)
     if reason is None and combination is not None:
         try:
             verdict = combination(merged)
             reason = verdict if isinstance(verdict, str) else None
         except ValueError as error:
             reason = str(error)
-    return SetParametersResult(successful=reason is None, reason=reason or '')
+    return reason

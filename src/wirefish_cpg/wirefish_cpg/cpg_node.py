@@ -33,7 +33,8 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
-from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.parameter_table import (declare, InvalidParameters, ParameterSpec,
+                                             validate_update)
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_msgs.msg import CpgParams
@@ -104,7 +105,7 @@ class CpgNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, wire the topics, services and the publish timer."""
         super().__init__('cpg_node', **kwargs)
-        declare(self, NODE_PARAMETERS)
+        declare(self, NODE_PARAMETERS, parameters_from)
         self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
         params = parameters_from(self._values)
         self._running = bool(self._values['autostart'])
@@ -210,7 +211,12 @@ class CpgNode(Node):
 def main(args: list[str] | None = None) -> None:
     """Run the CPG node until shutdown."""
     rclpy.init(args=args)
-    node = CpgNode()
+    try:
+        node = CpgNode()
+    except InvalidParameters as error:  # one clear line, not a traceback
+        rclpy.logging.get_logger('wirefish').fatal(str(error))
+        rclpy.try_shutdown()
+        raise SystemExit(1) from None
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

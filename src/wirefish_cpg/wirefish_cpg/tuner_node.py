@@ -36,7 +36,8 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray
-from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.parameter_table import (declare, InvalidParameters, ParameterSpec,
+                                             validate_update)
 from wirefish_cpg.cpg_node import to_message
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
@@ -219,7 +220,12 @@ class TunerNode(Node):
 def main(args: list[str] | None = None) -> None:
     """Run the tuner node on a multi-threaded executor until shutdown."""
     rclpy.init(args=args)
-    node = TunerNode()
+    try:
+        node = TunerNode()
+    except InvalidParameters as error:  # one clear line, not a traceback
+        rclpy.logging.get_logger('wirefish').fatal(str(error))
+        rclpy.try_shutdown()
+        raise SystemExit(1) from None
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(node)
     try:

@@ -35,6 +35,7 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import Marker, MarkerArray
+from wirefish_common.parameter_table import InvalidParameters
 from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
@@ -314,7 +315,12 @@ class KinematicsNode(Node):
 def main(args: list[str] | None = None) -> None:
     """Run the kinematics node until shutdown."""
     rclpy.init(args=args)
-    node = KinematicsNode()
+    try:
+        node = KinematicsNode()
+    except InvalidParameters as error:  # one clear line, not a traceback
+        rclpy.logging.get_logger('wirefish').fatal(str(error))
+        rclpy.try_shutdown()
+        raise SystemExit(1) from None
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

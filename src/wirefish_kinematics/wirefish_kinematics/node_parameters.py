@@ -63,4 +63,5 @@ def geometry_from(values: dict[str, object]) -> FishGeometry:
 
 def declare(node, specs: tuple[ParameterSpec, ...] = NODE_PARAMETERS) -> None:
     """Declare the kinematics node's parameters (all of them by default) on ``node``."""
-    declare_specs(node, specs)
+    combination = geometry_from if set(GEOMETRY_FIELDS) <= {s.name for s in specs} else None
+    declare_specs(node, specs, combination)

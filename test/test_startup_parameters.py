@@ -1,0 +1,31 @@
+"""A node started with values it would refuse in a `ros2 param set` exits with one clear line."""
+
+import os
+import subprocess
+
+from ament_index_python.packages import get_package_prefix
+import pytest
+
+pytestmark = pytest.mark.ros
+
+
+def executable(package: str, name: str) -> str:
+    return os.path.join(get_package_prefix(package), 'lib', package, name)
+
+
+@pytest.mark.parametrize('package, node, override, reason', [
+    ('wirefish_cpg', 'cpg_node', 'servo_limit_rad:=0.0', 'servo_limit_rad must be > 0'),
+    ('wirefish_cpg', 'cpg_node', 'frequency_hz:=0.0', 'frequency_hz must be > 0'),
+    ('wirefish_cpg', 'cpg_node', 'amplitude_1:=3.0', 'amplitude_1'),  # beyond the range
+    ('wirefish_cpg', 'tuner_node', 'swarm_size:=0', 'swarm_size'),
+    ('wirefish_kinematics', 'kinematics_node', 'l1:=-0.08', 'l1'),
+    ('wirefish_bridge', 'bridge_node', 'reconnect_backoff_max_s:=0.01',
+     'reconnect_backoff_max_s must be >= reconnect_backoff_min_s'),
+])
+def test_a_node_refuses_to_start_on_invalid_values(ros_env, package, node, override, reason):
+    result = subprocess.run([executable(package, node), '--ros-args', '-p', override],
+                            env=ros_env, capture_output=True, text=True, timeout=60)
+    output = result.stdout + result.stderr
+    assert result.returncode == 1, output
+    assert reason in output and node in output, output
+    assert 'Traceback' not in output, output
