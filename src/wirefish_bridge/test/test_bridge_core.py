@@ -5,6 +5,7 @@ import os
 import threading
 import time
 
+from builtin_interfaces.msg import Time
 from hypothesis import given, strategies as st
 import pytest
 import serial
@@ -12,6 +13,8 @@ from wirefish_bridge.bridge_node import check_combination, PARAMETERS
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy, \
     rpy_from_quaternion
+from wirefish_bridge.protocol import Status, Telemetry
+from wirefish_bridge.ros_messages import imu_message
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, next_backoff, \
     SerialLink
 from wirefish_common.parameter_table import check_value
@@ -93,6 +96,28 @@ def test_backoff_limits_must_be_ordered():
     assert check_combination(values) is None
     values['reconnect_backoff_max_s'] = 0.05
     assert 'reconnect_backoff_max_s' in check_combination(values)
+
+
+@pytest.mark.parametrize('tilt, yaw, consistent', [
+    (0.0175, 0.1, True), (0.0, 0.0, True), (0.0, 0.1, False), (0.0175, 0.0, False),
+])
+def test_orientation_stddevs_are_all_known_or_all_unknown(tilt, yaw, consistent):
+    values = {s.name: s.default for s in PARAMETERS}
+    values['orientation_stddev_rad'], values['yaw_stddev_rad'] = tilt, yaw
+    assert (check_combination(values) is None) == consistent
+
+
+@pytest.mark.parametrize('status, fault', [(0, False), (int(Status.IMU_FAULT), True),
+                                           (int(Status.IMU_FAULT | Status.LOW_BATTERY), True)])
+def test_an_imu_fault_marks_every_imu_covariance_as_no_data(status, fault):
+    telemetry = Telemetry(board_time_ms=1, roll=0.1, pitch=0.0, yaw=0.0, gyro=(0.0, 0.0, 0.0),
+                          accel=(0.0, 0.0, 9.8), servo_1=0.0, servo_2=0.0, battery_v=8.0,
+                          status=status)
+    msg = imu_message(telemetry, Time(), 'imu_link', (0.01, 0.01, 0.1), 0.005, 0.05)
+    covariances = (msg.orientation_covariance, msg.angular_velocity_covariance,
+                   msg.linear_acceleration_covariance)
+    assert all((c[0] == -1.0) == fault for c in covariances)
+    assert msg.orientation.x != 0.0  # the values themselves are still passed on
 
 
 def test_backoff_doubles_up_to_the_maximum():

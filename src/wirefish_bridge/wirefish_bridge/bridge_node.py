@@ -84,6 +84,11 @@ def check_combination(values: dict[str, object]) -> str | None:
     """Return why a full set of parameter values is inconsistent, or None."""
     if values['reconnect_backoff_max_s'] < values['reconnect_backoff_min_s']:
         return 'reconnect_backoff_max_s must be >= reconnect_backoff_min_s'
+    # An all-zero covariance means "unknown"; one zero beside non-zero ones would claim that
+    # angle perfectly known.
+    if (values['orientation_stddev_rad'] == 0.0) != (values['yaw_stddev_rad'] == 0.0):
+        return ('orientation_stddev_rad and yaw_stddev_rad must both be > 0, or both 0 '
+                '(orientation covariance unknown)')
     return None
 
 

@@ -14,8 +14,8 @@ from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
-from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy
-from wirefish_bridge.protocol import Telemetry
+from wirefish_bridge.conversions import diagonal_covariance, NOT_PROVIDED, quaternion_from_rpy
+from wirefish_bridge.protocol import Status, Telemetry
 
 SERVO_NAMES = ('servo_1', 'servo_2')
 
@@ -23,7 +23,12 @@ SERVO_NAMES = ('servo_1', 'servo_2')
 def imu_message(telemetry: Telemetry, stamp: Time, frame_id: str,
                 orientation_stddev: tuple[float, float, float], gyro_stddev: float,
                 accel_stddev: float) -> Imu:
-    """Return the sensor_msgs/Imu of ``telemetry`` (orientation, rates, specific force)."""
+    """
+    Return the sensor_msgs/Imu of ``telemetry`` (orientation, rates, specific force).
+
+    When the board flags IMU_FAULT the values are passed on but every covariance says "no
+    data" (element 0 = -1), so a filter that fuses imu/data ignores them.
+    """
     msg = Imu()
     msg.header.stamp = stamp
     msg.header.frame_id = frame_id
@@ -36,6 +41,10 @@ def imu_message(telemetry: Telemetry, stamp: Time, frame_id: str,
     ax, ay, az = telemetry.accel
     msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, az
     msg.linear_acceleration_covariance = diagonal_covariance((accel_stddev,) * 3)
+    if telemetry.status & Status.IMU_FAULT:
+        msg.orientation_covariance = list(NOT_PROVIDED)
+        msg.angular_velocity_covariance = list(NOT_PROVIDED)
+        msg.linear_acceleration_covariance = list(NOT_PROVIDED)
     return msg
 
 
