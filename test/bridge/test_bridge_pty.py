@@ -3,6 +3,8 @@
 import math
 import os
 from pathlib import Path
+import select
+import subprocess
 import time
 
 from ament_index_python.packages import get_package_prefix
@@ -245,3 +247,49 @@ def test_a_stalled_fish_shows_as_a_gap_and_the_stream_resumes(spawn, probe, tmp_
     assert 0.9 < longest < 1.3
     assert bridge.poll() is None
     assert probe.last_diagnostics()['link_state'] == 'connected'
+
+
+def test_bridge_commands_neutral_as_it_shuts_down(spawn, probe, tmp_path):
+    # This test plays the fish: it holds the pty's master side and decodes what arrives.
+    from wirefish_bridge.codec import StreamDecoder
+    from wirefish_bridge.protocol import ServoCommand
+    master, slave = os.openpty()
+    link = tmp_path / 'tty'
+    os.symlink(os.ttyname(slave), link)
+    bridge = _start_bridge(spawn, link)
+    commands = []
+    decoder = StreamDecoder()
+
+    def read_available() -> None:
+        while True:
+            ready, _, _ = select.select([master], [], [], 0.0)
+            if not ready:
+                return
+            for frame in decoder.feed(os.read(master, 4096)):
+                if isinstance(frame.message, ServoCommand):
+                    commands.append((frame.message.servo_1, frame.message.servo_2))
+
+    deadline = time.monotonic() + 20.0
+    while not any(c == pytest.approx((0.4, 0.3), abs=1e-6) for c in commands):
+        assert time.monotonic() < deadline, 'no servo command reached the fish'
+        probe.spin_for(0.05, command=[0.4, 0.3])
+        read_available()
+    assert stop_process(bridge) == 0
+    read_available()
+    os.close(master)
+    os.close(slave)
+    assert commands[-1] == (0.0, 0.0)
+
+
+@pytest.mark.parametrize('flag, value, reason', [
+    ('--telemetry-hz', '0', '--telemetry-hz must be finite and > 0'),
+    ('--ground-truth-hz', 'nan', '--ground-truth-hz must be finite and > 0'),
+    ('--corrupt-fraction', '1.5', '--corrupt-fraction must be in [0, 1]'),
+    ('--servo-rate-limit', '-2', 'rate_limit_rad_s must be finite and > 0'),
+])
+def test_fish_sim_refuses_bad_flags_with_one_line(tmp_path, ros_env, flag, value, reason):
+    result = subprocess.run([str(BIN / 'fish_sim'), '--link', str(tmp_path / 'tty'), flag,
+                             value], env=ros_env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert reason in result.stderr and 'Traceback' not in result.stderr, result.stderr
+    assert not (tmp_path / 'tty').exists()

@@ -35,7 +35,7 @@ from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.command_gate import CommandGate
+from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.protocol import (DEFAULT_BAUDRATE, ErrorCode, ErrorReport, Heartbeat,
                                       PROTOCOL_VERSION, Role, ServoCommand, Status, Telemetry)
 from wirefish_bridge.ros_messages import (attitude_message, battery_message,
@@ -305,7 +305,7 @@ class BridgeNode(Node):
             'drops': decoder.seq_gaps, 'last_heartbeat_age_s': heartbeat_age,
             'last_telemetry_age_s': telemetry_age, 'reconnects': link.reconnects,
             'disconnects': link.disconnects, 'open_failures': link.open_failures,
-            'last_link_error': link.last_error,
+            'last_link_error': link.last_error, 'reader_errors': link.callback_errors,
             'fish_protocol_version': self._fish_version if self._fish_version is not None
             else 'unknown',
             'fish_status': f'0x{self._fish_status:04x} ({_status_names(self._fish_status)})',
@@ -331,7 +331,9 @@ class BridgeNode(Node):
         return DiagnosticStatus.OK, 'connected'
 
     def destroy_node(self) -> None:
-        """Stop the serial link (joins its thread, closes the port), then the node."""
+        """Command neutral, stop the serial link (joins its thread, closes the port), the node."""
+        # The fish would otherwise hold the last angle until its own command timeout.
+        self._send(ServoCommand(*NEUTRAL))
         self._link.stop()
         super().destroy_node()
 

@@ -193,8 +193,34 @@ def main(argv: list[str] | None = None) -> int:
         plain = remove_ros_args(argv)[1:]
     except ImportError:
         plain = argv[1:]
-    args = build_parser().parse_args(plain)
+    parser = build_parser()
+    args = parser.parse_args(plain)
+    problem = flags_problem(args)
+    if problem is not None:
+        parser.error(problem)  # one line and exit code 2, before a device is opened
     return run(args, ros_args)
+
+
+def flags_problem(args: argparse.Namespace) -> str | None:
+    """Return why the flags cannot make a virtual fish, or None."""
+    for name in ('ground_truth_hz', 'telemetry_hz', 'heartbeat_hz', 'speed_time_constant',
+                 'command_timeout', 'heartbeat_timeout'):
+        value = getattr(args, name)
+        if not (math.isfinite(value) and value > 0.0):
+            return f'--{name.replace("_", "-")} must be finite and > 0, got {value}'
+    for name in ('corrupt_fraction', 'drop_fraction'):
+        value = getattr(args, name)
+        if not 0.0 <= value <= 1.0:
+            return f'--{name.replace("_", "-")} must be in [0, 1], got {value}'
+    for name in ('imu_noise_scale', 'stall_every', 'stall_for', 'reopen_every', 'reopen_delay'):
+        value = getattr(args, name)
+        if not (math.isfinite(value) and value >= 0.0):
+            return f'--{name.replace("_", "-")} must be finite and >= 0, got {value}'
+    try:
+        config_from(args)
+    except ValueError as error:  # the servo model's own checks
+        return str(error)
+    return None
 
 
 if __name__ == '__main__':

@@ -52,6 +52,7 @@ class LinkStats:
     bytes_out: int = 0
     write_failures: int = 0
     last_error: str = ''
+    callback_errors: int = 0  # exceptions raised by on_data (the reader goes on)
 
 
 def next_backoff(current_s: float, minimum_s: float, maximum_s: float) -> float:
@@ -191,7 +192,11 @@ class SerialLink:
                 continue
             if chunk:
                 self.stats.bytes_in += len(chunk)
-                self._on_data(chunk)
+                try:
+                    self._on_data(chunk)
+                except Exception as error:  # noqa: B902 (a consumer's bug must not end reading)
+                    self.stats.callback_errors += 1
+                    self.stats.last_error = f'on_data failed: {error!r}'
         self._close()
 
 

@@ -157,6 +157,10 @@ class TunerNode(Node):
         except ValueError as error:  # e.g. a geometry FishGeometry refuses
             response.success, response.message = False, f'rejected: {error}'
             return response
+        except Exception as error:  # noqa: B902 (answer, and keep serving, whatever failed)
+            self.get_logger().error(f'retune failed: {error!r}')
+            response.success, response.message = False, f'failed: {error!r}'
+            return response
         finally:
             self._busy.release()
 
