@@ -123,3 +123,11 @@ def test_node_integrator_follows_the_array_integrator():
         got_angle, got_rate = cpg.output(ti)
         np.testing.assert_allclose(got_angle, angle, rtol=0, atol=1e-12)
         np.testing.assert_allclose(got_rate, rate, rtol=0, atol=1e-10)
+
+
+def test_non_finite_times_and_states_are_refused():
+    cpg = CpgIntegrator(TABLE1, step_s=1e-3)
+    with pytest.raises(ValueError):
+        cpg.output(float('nan'))
+    with pytest.raises(ValueError):
+        cpg.state = np.full((5, 2), np.nan)

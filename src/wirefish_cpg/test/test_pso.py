@@ -87,3 +87,11 @@ def test_callback_sees_every_iteration():
 def test_invalid_options_are_rejected(kwargs):
     with pytest.raises(ValueError):
         PsoOptions(**kwargs)
+
+
+@pytest.mark.parametrize('lower, upper', [
+    ([0.0, np.nan], [1.0, 1.0]), ([0.0, 0.0], [1.0, np.inf]), ([0.0, 2.0], [1.0, 1.0]),
+])
+def test_bounds_must_be_finite_and_ordered(lower, upper):
+    with pytest.raises(ValueError):
+        minimise(lambda x: np.sum(x ** 2, axis=1), lower, upper, np.random.default_rng(0))

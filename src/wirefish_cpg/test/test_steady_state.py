@@ -88,3 +88,8 @@ def test_intrinsic_frequency_for_locks_the_network_to_the_target(target_hz):
 
 def test_uncoupled_network_keeps_the_phase_difference_it_starts_with():
     assert stable_phase_difference(0.3, 0.4, 0.0, 0.0, 1.0, 2.0) == 0.0
+
+
+def test_a_nan_coupling_gives_nan_not_a_plausible_phase():
+    delta = stable_phase_difference(0.38, 0.47, np.nan, 0.64, 1.76, 1.06)
+    assert np.isnan(delta)

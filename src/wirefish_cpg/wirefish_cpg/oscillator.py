@@ -255,6 +255,8 @@ class CpgIntegrator:
     @state.setter
     def state(self, value: np.ndarray) -> None:
         value = np.asarray(value, dtype=float).reshape(STATE_ROWS, NUM_SERVOS)
+        if not np.all(np.isfinite(value)):
+            raise ValueError(f'state must be finite, got {value.tolist()}')
         self._s = tuple(float(v) for row in _PAIR_ROWS for v in value[row])
 
     @property
@@ -285,6 +287,7 @@ class CpgIntegrator:
 
     def output(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Return (angles (2,) rad, rates (2,) rad/s) at ``time_s`` (within a step of now)."""
+        _finite('time_s', time_s)
         lead = min(max(time_s - self.time_s, 0.0), self.step_s)
         s = self._s if lead == 0.0 else _pair_rk4(self._s, lead, self._c)
         d = _pair_derivative(s, self._c)

@@ -87,8 +87,9 @@ def minimise(loss: SwarmLoss, lower: np.ndarray, upper: np.ndarray,
     """
     lower = np.asarray(lower, dtype=float)
     upper = np.asarray(upper, dtype=float)
-    if lower.shape != upper.shape or lower.ndim != 1 or np.any(upper < lower):
-        raise ValueError('lower and upper must be equal-length vectors with lower <= upper')
+    if (lower.shape != upper.shape or lower.ndim != 1 or not np.all(np.isfinite(lower))
+            or not np.all(np.isfinite(upper)) or np.any(upper < lower)):
+        raise ValueError('lower and upper must be finite equal-length vectors, lower <= upper')
     span = upper - lower
     v_max = options.velocity_limit * span
     shape = (options.swarm_size, lower.size)

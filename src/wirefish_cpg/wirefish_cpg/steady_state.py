@@ -37,11 +37,14 @@ def stable_phase_difference(r1: np.ndarray, r2: np.ndarray, w12: np.ndarray,
     """
     Return the stable root Delta* in (-pi, pi] of the phase-difference equation (from eq 1).
 
-    Arguments broadcast together (rad, 1/s); the result has their broadcast shape.
+    Arguments broadcast together (rad, 1/s); the result has their broadcast shape. Where the
+    other root is Delta = 0 (B = 0, A > 0), a network started exactly in phase with bit-equal
+    oscillators can sit on that unstable equilibrium forever; any perturbation (and every
+    real start-up) leaves it for Delta*, which is what is returned. NaN in, NaN out.
     """
     a = -r1 * w21 * np.cos(phi21) - r2 * w12 * np.cos(phi12)
     b = -r1 * w21 * np.sin(phi21) + r2 * w12 * np.sin(phi12)
-    coupled = np.hypot(a, b) > 1e-12
+    coupled = ~(np.hypot(a, b) <= 1e-12)  # NaN counts as coupled, so NaN comes out
     delta = np.pi - np.arctan2(b, a)
     delta = np.pi - np.mod(np.pi - delta, 2.0 * np.pi)  # wrap into (-pi, pi]
     return np.where(coupled, delta, 0.0)
