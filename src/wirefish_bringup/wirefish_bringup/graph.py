@@ -68,6 +68,9 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     namespace = validate_namespace(namespace)
     if not sim and not port:
         raise ValueError('a real fish needs its serial port (e.g. --port /dev/ttyUSB0)')
+    if sim and port:  # e.g. `ros2 launch ... port:=/dev/ttyUSB0` without sim:=false
+        raise ValueError(f'a serial port ({port}) was given for the virtual fish: '
+                         'choose sim or a port (sim:=false port:=...)')
     params = str(params_file or default_params_file())
     tty = str(sim_tty_link(namespace)) if sim else port
 
