@@ -96,6 +96,9 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2
+    if args.port is not None and not Path(args.port).exists():
+        print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
+              'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
     stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
     run_dir = (args.out / f'run_{stamp}').resolve()
     supervisor = Supervisor(run_dir / 'logs')
