@@ -1,6 +1,9 @@
 """SIGINT to `wirefish up` (Ctrl-C in `make run`) stops every process with 0, leaving none."""
 
+import os
 import signal
+import subprocess
+import sys
 
 from e2e_utils import descendants, start_graph
 import pytest
@@ -30,3 +33,28 @@ def test_sigint_stops_every_process_cleanly_and_leaves_none(e2e_domain_id, tmp_p
     assert not [p for p in children if p.is_running() and p.status() != 'zombie']
     for log in (tmp_path).glob('run_*/logs/*.log'):
         assert 'Traceback' not in log.read_text(), log.name
+
+
+def test_sigint_during_start_up_stops_every_process_cleanly(e2e_domain_id, tmp_path):
+    env = dict(os.environ, ROS_DOMAIN_ID=str(e2e_domain_id),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+    launcher = subprocess.Popen(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--namespace', '/e2e',
+         '--out', str(tmp_path)],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        start_new_session=True)
+    try:
+        for line in launcher.stdout:  # every process is started; the status is being measured
+            if line.startswith('started'):
+                break
+        children = descendants(launcher.pid)
+        launcher.send_signal(signal.SIGINT)
+        code = launcher.wait(timeout=30.0)
+    finally:
+        if launcher.poll() is None:
+            launcher.kill()
+        output = launcher.stdout.read()
+        launcher.stdout.close()
+    assert code == 0, output
+    assert 'Traceback' not in output
+    assert not [p for p in children if p.is_running() and p.status() != 'zombie']

@@ -19,6 +19,7 @@ from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, sim
 from wirefish_bringup.supervisor import remove_stale_link, Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
+STOP_GRACE_S = 10.0  # after a Ctrl-C during start-up, how long the nodes may take to be up
 DEVICE_TIMEOUT_S = 15.0
 
 
@@ -66,14 +67,25 @@ def _wait_ready(namespace: str, node_names: list[str], show_status: bool,
     try:
         deadline = time.monotonic() + timeout_s
         while not expected <= discovered():
-            if stop_requested or time.monotonic() > deadline:
+            if stop_requested and deadline > time.monotonic() + STOP_GRACE_S:
+                # A node interrupted while still importing dies of the SIGINT (exit -2, a
+                # KeyboardInterrupt trace): let every node finish starting, then stop them all.
+                print('wirefish up: stopping as soon as every node has started',
+                      file=sys.stderr)
+                deadline = time.monotonic() + STOP_GRACE_S
+            if time.monotonic() > deadline:
                 missing = ', '.join(sorted(expected - discovered()))
                 return None if stop_requested else f'not up after {timeout_s:g} s: {missing}'
             executor.spin_once(timeout_sec=0.1)
+        if stop_requested:
+            return None
         if not show_status:
             return ''
-        settle_discovery(node, executor, namespace)
-        rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S)
+        settle_discovery(node, executor, namespace, should_stop=lambda: bool(stop_requested))
+        rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S,
+                              should_stop=lambda: bool(stop_requested))
+        if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
+            return None
     finally:
         executor.shutdown()
         node.destroy_node()
@@ -135,7 +147,9 @@ def run(args: argparse.Namespace) -> int:
             raise RuntimeError(status)
         if status:
             print(status)
-        if bag_path is not None:
+        if stop_requested:
+            pass  # Ctrl-C during start-up: straight to stopping
+        elif bag_path is not None:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
         else:
             print('running: Ctrl-C stops everything')

@@ -1,5 +1,6 @@
 """Measure the rate of every topic of the graph (what `ros2 topic hz` shows, for all at once)."""
 
+from collections.abc import Callable
 import time
 
 from rclpy.executors import SingleThreadedExecutor
@@ -8,12 +9,21 @@ from rclpy.node import Node
 from wirefish_bringup.topics import graph_topics, matching_qos, message_class
 
 
+def _never() -> bool:
+    return False
+
+
 def settle_discovery(node: Node, executor: SingleThreadedExecutor, namespace: str,
-                     quiet_s: float = 1.5, timeout_s: float = 10.0) -> None:
-    """Spin until the graph's topic set has not changed for ``quiet_s`` (or ``timeout_s``)."""
+                     quiet_s: float = 1.5, timeout_s: float = 10.0,
+                     should_stop: Callable[[], bool] = _never) -> None:
+    """
+    Spin until the graph's topic set has not changed for ``quiet_s`` (or ``timeout_s``).
+
+    Returns early as soon as ``should_stop()`` is true (a Ctrl-C of the caller).
+    """
     start = changed = time.monotonic()
     seen = graph_topics(node, namespace)
-    while time.monotonic() - start < timeout_s:
+    while time.monotonic() - start < timeout_s and not should_stop():
         executor.spin_once(timeout_sec=0.25)
         now = graph_topics(node, namespace)
         if now != seen:
@@ -23,8 +33,13 @@ def settle_discovery(node: Node, executor: SingleThreadedExecutor, namespace: st
 
 
 def measure_rates(node: Node, executor: SingleThreadedExecutor, namespace: str,
-                  window_s: float) -> dict[str, tuple[str, float]]:
-    """Return {topic: (type, messages per second)} received over ``window_s`` seconds."""
+                  window_s: float, should_stop: Callable[[], bool] = _never
+                  ) -> dict[str, tuple[str, float]]:
+    """
+    Return {topic: (type, messages per second)} received over ``window_s`` seconds.
+
+    A true ``should_stop()`` ends the window early (the rates are then over what was seen).
+    """
     topics = graph_topics(node, namespace)
     counts = dict.fromkeys(topics, 0)
     subscriptions = []
@@ -39,13 +54,13 @@ def measure_rates(node: Node, executor: SingleThreadedExecutor, namespace: str,
             msg_class, topic, count, matching_qos(node, topic, 100), raw=True))
     # Let the subscriptions match their publishers (and latched samples arrive) before counting.
     settle_until = time.monotonic() + 0.5
-    while time.monotonic() < settle_until:
+    while time.monotonic() < settle_until and not should_stop():
         executor.spin_once(timeout_sec=0.05)
     counts = dict.fromkeys(topics, 0)
     start = time.monotonic()
-    while time.monotonic() - start < window_s:
+    while time.monotonic() - start < window_s and not should_stop():
         executor.spin_once(timeout_sec=0.05)
-    elapsed = time.monotonic() - start
+    elapsed = max(time.monotonic() - start, 1e-9)
     for subscription in subscriptions:
         node.destroy_subscription(subscription)
     return {topic: (topics[topic], counts[topic] / elapsed) for topic in sorted(topics)}
