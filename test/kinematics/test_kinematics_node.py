@@ -231,3 +231,24 @@ def test_use_servo_state_switches_to_the_measured_angles_and_back(start_node, pr
     send_pose_until_seen(probe, POSE_A, index, topic='servo_cmd')
     probe.wait_for(lambda: probe.publishers['servo_state'].get_subscription_count() == 0,
                    'servo_state to be unsubscribed')
+
+
+def test_markers_reach_a_reliable_subscriber_like_rviz(start_node, probe):
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from visualization_msgs.msg import MarkerArray
+    received = []
+    probe.node.create_subscription(MarkerArray, 'body_wave_markers', received.append,
+                                   QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+    start_node()
+    probe.wait_connected()
+    index = send_pose_until_seen(probe, POSE_A, 0)
+
+    def markers_arrived() -> bool:
+        nonlocal index
+        probe.send(index, POSE_A)
+        index += 1
+        probe.spin(0.02)
+        return bool(received)
+
+    probe.wait_for(markers_arrived, 'body_wave_markers on a reliable subscription')
+    assert {m.id for m in received[-1].markers} >= {0, 2, 3}

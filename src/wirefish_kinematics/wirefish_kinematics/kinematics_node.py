@@ -12,7 +12,8 @@ Publishes (frame ``tail_base`` = C0 of paper section 3.1)
     ``body_wave`` (wirefish_msgs/BodyWave, sensor data) at ``publish_rate_hz`` when a new
     sample arrived: ``station_count`` stations, eqs 2-15; ``y_desired`` (eq 23) once the tail
     beats, shown at the tail's phase (see ``desired_wave.wave_time_at_phase``).
-    ``body_wave_markers`` (visualization_msgs/MarkerArray, sensor data): tail polyline, desired
+    ``body_wave_markers`` (visualization_msgs/MarkerArray, reliable depth 5, so RViz's default
+    subscription matches): tail polyline, desired
     wave as dots, link ends O1 (sphere) and O2 (cube).
     ``speed_estimate`` (wirefish_msgs/SpeedEstimate, reliable) once per completed tail beat
     (stamped at the end of the period), eqs 16-22; all zeros while the tail is at rest.
@@ -53,6 +54,7 @@ JOINTS = ('servo_1', 'servo_2')
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+MARKERS = QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE)
 # Below this half range (m) of the tip's lateral motion the tail counts as at rest.
 REST_HALF_RANGE_M = 1e-4
 WARN_PERIOD_S = 2.0
@@ -136,8 +138,9 @@ class KinematicsNode(Node):
         self._beat_phase = 0.0  # phase (rad) of y(q1)'s fundamental at the beat's start
         self._warned: dict[str, float] = {}
         self._body_pub = self.create_publisher(BodyWave, 'body_wave', qos_profile_sensor_data)
-        self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers',
-                                                 qos_profile_sensor_data)
+        # Reliable, unlike the data streams: RViz subscribes to markers reliably by default, and
+        # a best-effort publisher would never match it. A reliable one matches both kinds.
+        self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers', MARKERS)
         self._speed_pub = self.create_publisher(SpeedEstimateMsg, 'speed_estimate', RELIABLE)
         self.create_subscription(BodyWaveSpec, 'target_wave', self._on_target, LATCHED)
         self._servo_sub = None
