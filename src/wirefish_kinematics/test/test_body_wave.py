@@ -153,12 +153,20 @@ def test_slope_on_the_fin_is_eq_19(beta1, beta2):
 
 
 @pytest.mark.parametrize('beta1, beta2', BENDS)
-def test_first_swing_angle_is_half_the_first_bend(beta1, beta2):
+def test_swing_angles_are_those_of_the_chords(beta1, beta2):
     # The chord of a circular arc makes half the arc's turn with its start tangent.
     theta1, theta2 = swing_angles(beta1, beta2, G)
     assert theta1 == pytest.approx(beta1 / 2, abs=1e-15)
-    x, y = body_positions(np.array([G.l1 + G.l2]), beta1, beta2, G)
-    assert theta2 == pytest.approx(math.atan2(y[0], x[0]), abs=1e-15)
+    # O2 from the chords instead of eqs 7-15: arc i's chord is 2 l_i sin(b_i/2) / b_i long
+    # (l_i when straight) and leaves at the start tangent plus half the arc's turn.
+
+    def chord(length: float, bend: float) -> float:
+        return length if bend == 0.0 else 2.0 * length * math.sin(bend / 2) / bend
+    o2_x = (chord(G.l1, beta1) * math.cos(beta1 / 2)
+            + chord(G.l2, beta2) * math.cos(beta1 + beta2 / 2))
+    o2_y = (chord(G.l1, beta1) * math.sin(beta1 / 2)
+            + chord(G.l2, beta2) * math.sin(beta1 + beta2 / 2))
+    assert theta2 == pytest.approx(math.atan2(o2_y, o2_x), abs=1e-12)
 
 
 def test_shapes_broadcast_bends_before_stations():
