@@ -43,6 +43,20 @@ def send_pose_until_seen(probe, pose, first_index: int, topic: str = 'servo_cmd'
     return index
 
 
+def hold_pose_until(probe, pose, first_index: int, done, what: str) -> None:
+    """Keep streaming a still pose (10 ms of sample time apart) until ``done()``."""
+    index = first_index
+
+    def sent_and_done() -> bool:
+        nonlocal index
+        probe.send(index, pose)
+        index += 1
+        probe.spin(0.01)
+        return done()
+
+    probe.wait_for(sent_and_done, what)
+
+
 def test_body_wave_and_markers_equal_the_core_for_a_pose(start_node, probe):
     start_node()
     probe.wait_connected()
@@ -133,15 +147,7 @@ def test_a_tail_at_rest_reports_zero_speed(start_node, probe):
     start_node('-p', 'max_tail_beat_period_s:=0.3')
     probe.wait_connected()
     index = send_pose_until_seen(probe, POSE_A, 0)
-
-    def zero_estimate() -> bool:
-        nonlocal index
-        probe.send(index, POSE_A)
-        index += 1
-        probe.spin(0.01)
-        return bool(probe.speed)
-
-    probe.wait_for(zero_estimate, 'a speed estimate at rest')
+    hold_pose_until(probe, POSE_A, index, lambda: bool(probe.speed), 'a speed estimate at rest')
     msg = probe.speed[-1]
     assert (msg.speed, msg.thrust, msg.drag, msg.tail_beat_hz) == (0.0, 0.0, 0.0, 0.0)
 
@@ -242,13 +248,6 @@ def test_markers_reach_a_reliable_subscriber_like_rviz(start_node, probe):
     start_node()
     probe.wait_connected()
     index = send_pose_until_seen(probe, POSE_A, 0)
-
-    def markers_arrived() -> bool:
-        nonlocal index
-        probe.send(index, POSE_A)
-        index += 1
-        probe.spin(0.02)
-        return bool(received)
-
-    probe.wait_for(markers_arrived, 'body_wave_markers on a reliable subscription')
+    hold_pose_until(probe, POSE_A, index, lambda: bool(received),
+                    'body_wave_markers on a reliable subscription')
     assert {m.id for m in received[-1].markers} >= {0, 2, 3}

@@ -42,7 +42,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, SERVO_NAMES,
                                           servo_state_message)
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
-from wirefish_common.parameter_table import (declare, InvalidParameters, ParameterSpec,
+from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
 
 PARAMETERS = (
@@ -367,12 +367,7 @@ def _status_names(status: int) -> str:
 def main(args: list[str] | None = None) -> None:
     """Run the bridge until SIGINT/SIGTERM; the port is closed and its thread joined."""
     rclpy.init(args=args)
-    try:
-        node = BridgeNode()
-    except InvalidParameters as error:  # one clear line, not a traceback
-        rclpy.logging.get_logger('wirefish').fatal(str(error))
-        rclpy.try_shutdown()
-        raise SystemExit(1) from None
+    node = create_node_or_exit(BridgeNode)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

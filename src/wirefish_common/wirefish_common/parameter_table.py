@@ -55,6 +55,23 @@ class InvalidParameters(ValueError):
     """The values a node starts with (defaults, YAML, --ros-args -p) are refused."""
 
 
+def create_node_or_exit(node_class: type):
+    """
+    Return ``node_class()``; if its parameters are refused, log one FATAL line and exit 1.
+
+    For a node's ``main()`` after ``rclpy.init``: a bad parameter file then reads as one clear
+    line, not a traceback.
+    """
+    import rclpy
+
+    try:
+        return node_class()
+    except InvalidParameters as error:
+        rclpy.logging.get_logger('wirefish').fatal(str(error))
+        rclpy.try_shutdown()
+        raise SystemExit(1) from None
+
+
 def declare(node, specs: tuple[ParameterSpec, ...], combination=None) -> None:
     """
     Declare every spec on ``node`` with a descriptor carrying its description and range.

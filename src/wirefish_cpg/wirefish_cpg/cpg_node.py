@@ -33,7 +33,7 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
-from wirefish_common.parameter_table import (declare, InvalidParameters, ParameterSpec,
+from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
@@ -211,12 +211,7 @@ class CpgNode(Node):
 def main(args: list[str] | None = None) -> None:
     """Run the CPG node until shutdown."""
     rclpy.init(args=args)
-    try:
-        node = CpgNode()
-    except InvalidParameters as error:  # one clear line, not a traceback
-        rclpy.logging.get_logger('wirefish').fatal(str(error))
-        rclpy.try_shutdown()
-        raise SystemExit(1) from None
+    node = create_node_or_exit(CpgNode)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -36,7 +36,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray
-from wirefish_common.parameter_table import (declare, InvalidParameters, ParameterSpec,
+from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
 from wirefish_cpg.cpg_node import to_message
 from wirefish_cpg.oscillator import CpgParameters
@@ -224,12 +224,7 @@ class TunerNode(Node):
 def main(args: list[str] | None = None) -> None:
     """Run the tuner node on a multi-threaded executor until shutdown."""
     rclpy.init(args=args)
-    try:
-        node = TunerNode()
-    except InvalidParameters as error:  # one clear line, not a traceback
-        rclpy.logging.get_logger('wirefish').fatal(str(error))
-        rclpy.try_shutdown()
-        raise SystemExit(1) from None
+    node = create_node_or_exit(TunerNode)
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(node)
     try:

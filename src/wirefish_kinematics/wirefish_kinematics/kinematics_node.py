@@ -36,7 +36,7 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import Marker, MarkerArray
-from wirefish_common.parameter_table import InvalidParameters
+from wirefish_common.parameter_table import create_node_or_exit
 from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
@@ -318,12 +318,7 @@ class KinematicsNode(Node):
 def main(args: list[str] | None = None) -> None:
     """Run the kinematics node until shutdown."""
     rclpy.init(args=args)
-    try:
-        node = KinematicsNode()
-    except InvalidParameters as error:  # one clear line, not a traceback
-        rclpy.logging.get_logger('wirefish').fatal(str(error))
-        rclpy.try_shutdown()
-        raise SystemExit(1) from None
+    node = create_node_or_exit(KinematicsNode)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
