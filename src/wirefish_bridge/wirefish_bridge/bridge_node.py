@@ -32,6 +32,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
@@ -44,6 +45,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
 from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
+from wirefish_common.shutdown import SignalShutdown
 
 PARAMETERS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '
@@ -366,8 +368,10 @@ def _status_names(status: int) -> str:
 
 def main(args: list[str] | None = None) -> None:
     """Run the bridge until SIGINT/SIGTERM; the port is closed and its thread joined."""
-    rclpy.init(args=args)
+    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = create_node_or_exit(BridgeNode)
+    signals.attach(node)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -26,8 +26,10 @@ def run(args: argparse.Namespace) -> int:
     """Run `wirefish record`; return the process exit code."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
+    from rclpy.signals import SignalHandlerOptions
 
     from wirefish_bringup.recorder import BagRecorder
+    from wirefish_common.shutdown import SignalShutdown
 
     try:
         namespace = validate_namespace(args.namespace)
@@ -40,8 +42,10 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish record: {bag_path} exists; choose a new -o', file=sys.stderr)
         return 2
     bag_path.parent.mkdir(parents=True, exist_ok=True)
-    rclpy.init()
+    signals = SignalShutdown()  # Ctrl-C between callbacks: the bag is closed cleanly
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     recorder = BagRecorder(bag_path, namespace)
+    signals.attach(recorder)
     if args.duration is not None:
         started_ns = recorder.get_clock().now().nanoseconds
 

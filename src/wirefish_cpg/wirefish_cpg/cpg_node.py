@@ -31,10 +31,12 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
+from wirefish_common.shutdown import SignalShutdown
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_msgs.msg import CpgParams
@@ -210,8 +212,10 @@ class CpgNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the CPG node until shutdown."""
-    rclpy.init(args=args)
+    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = create_node_or_exit(CpgNode)
+    signals.attach(node)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -35,9 +35,11 @@ from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Float64MultiArray
 from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
+from wirefish_common.shutdown import SignalShutdown
 from wirefish_cpg.cpg_node import to_message
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
@@ -223,8 +225,10 @@ class TunerNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the tuner node on a multi-threaded executor until shutdown."""
-    rclpy.init(args=args)
+    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = create_node_or_exit(TunerNode)
+    signals.attach(node)
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(node)
     try:

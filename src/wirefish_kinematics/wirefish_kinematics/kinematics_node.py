@@ -34,9 +34,11 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
                        ReliabilityPolicy)
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import Marker, MarkerArray
 from wirefish_common.parameter_table import create_node_or_exit
+from wirefish_common.shutdown import SignalShutdown
 from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
@@ -317,8 +319,10 @@ class KinematicsNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the kinematics node until shutdown."""
-    rclpy.init(args=args)
+    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = create_node_or_exit(KinematicsNode)
+    signals.attach(node)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
