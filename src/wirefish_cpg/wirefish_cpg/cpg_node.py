@@ -105,7 +105,7 @@ class CpgNode(Node):
     """Integrates eq 1 on the node clock and publishes the servo commands."""
 
     def __init__(self, **kwargs) -> None:
-        """Declare the parameters, wire the topics, services and the publish timer."""
+        """Declare the parameters, wire the topics and services, start the publish loop."""
         super().__init__('cpg_node', **kwargs)
         declare(self, NODE_PARAMETERS, parameters_from)
         self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
@@ -143,6 +143,7 @@ class CpgNode(Node):
 
     def _apply(self, parameters: list[Parameter]) -> None:
         names = {p.name for p in parameters if p.name in SPECS}
+        params = None
         with self._lock:
             for name in names:
                 self._values[name] = self.get_parameter(name).value
@@ -153,7 +154,7 @@ class CpgNode(Node):
             if names & {s.name for s in CPG_PARAMETERS}:
                 params = parameters_from(self._values)
                 self._cpg.set_parameters(params if self._running else at_rest(params))
-        if names & {s.name for s in CPG_PARAMETERS}:
+        if params is not None:  # announced outside the lock: the loop must not wait on DDS
             self._params_pub.publish(to_message(params))
 
     def _on_start(self, request: Trigger.Request, response: Trigger.Response
