@@ -125,11 +125,11 @@ def run(args: argparse.Namespace) -> int:
     code = 0
     try:
         for spec in specs:
-            if spec.executable == 'fish_sim':
-                link = sim_tty_link(namespace)
+            link = sim_tty_link(namespace) if spec.executable == 'fish_sim' else None
+            if link is not None:
                 remove_stale_link(link)
             proc = supervisor.start(spec)
-            if spec.executable == 'fish_sim':
+            if link is not None:
                 if not wait_for_path(link, [proc], DEVICE_TIMEOUT_S):
                     raise RuntimeError('the virtual fish did not open its pseudo-terminal:\n'
                                        + supervisor.log_tail(spec.name))
