@@ -14,6 +14,7 @@ import time
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 
 BAR_WIDTH = 30
+PROGRESS_DRAIN_S = 1.0  # how long the last progress messages may trail the answer
 UINT32_MAX = 2**32 - 1
 
 
@@ -87,13 +88,13 @@ def run(args: argparse.Namespace) -> int:
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     client = node.create_client(RetuneGait, 'retune_gait')
-    shown = []
+    shown: list[int] = []  # iterations drawn
 
     def on_progress(msg: Float64MultiArray) -> None:
         if len(msg.data) >= 3:
             print('\r' + progress_line(msg.data[0], msg.data[1], msg.data[2]), end='',
                   file=sys.stderr, flush=True)
-            shown.append(True)
+            shown.append(int(msg.data[0]))
 
     node.create_subscription(Float64MultiArray, 'retune_progress', on_progress, 10)
     try:
@@ -113,6 +114,12 @@ def run(args: argparse.Namespace) -> int:
         deadline = time.monotonic() + args.timeout
         while not future.done() and time.monotonic() < deadline:
             executor.spin_once(timeout_sec=0.1)
+        if future.done() and future.result().success:
+            # The answer can overtake the last progress messages: draw them before the table.
+            drain_until = time.monotonic() + PROGRESS_DRAIN_S
+            while (not shown or shown[-1] < future.result().iterations) \
+                    and time.monotonic() < drain_until:
+                executor.spin_once(timeout_sec=0.05)
         if shown:
             print(file=sys.stderr)
         if not future.done():
