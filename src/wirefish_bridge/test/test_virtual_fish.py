@@ -51,16 +51,26 @@ def test_force_scale_gives_tau_from_the_linearised_drag():
         pytest.approx(0.75)
 
 
-def test_speed_rises_then_falls_where_the_servo_cannot_follow():
-    runs = speed_sweep(np.arange(1.0, 10.01, 0.5))
-    speeds = [r.speed for r in runs]
+def test_speed_rises_then_falls_where_the_servo_cannot_follow(fig11_runs):
+    speeds = [r.speed for r in fig11_runs]
     peak = int(np.argmax(speeds))
-    print('f, speed, amplitude:', [(r.frequency_hz, round(r.speed, 3),
-                                    round(r.tail_tip_amplitude, 4)) for r in runs])
-    assert runs[0].tail_tip_amplitude == pytest.approx(0.05, rel=0.02)
+    assert fig11_runs[0].tail_tip_amplitude == pytest.approx(0.05, rel=0.02)
     assert all(b > a for a, b in zip(speeds[:peak], speeds[1:peak + 1]))
-    assert speeds[-1] < speeds[peak]
-    assert runs[-1].tail_tip_amplitude < 0.6 * runs[0].tail_tip_amplitude
+    assert all(b < a for a, b in zip(speeds[peak:], speeds[peak + 1:]))
+    assert peak < len(speeds) - 2  # falls for at least two steps (1 Hz) before 8 Hz
+
+
+def test_speed_peaks_between_5_and_7_5_hz_as_in_fig_11(fig11_runs):
+    assert 5.0 <= peak_frequency(fig11_runs) <= 7.5
+
+
+def test_tail_amplitude_falls_faster_above_5_hz(fig11_runs):
+    amplitude = {r.frequency_hz: r.tail_tip_amplitude for r in fig11_runs}
+    below = (amplitude[1.0] - amplitude[5.0]) / 4.0  # m per Hz
+    above = (amplitude[5.0] - amplitude[8.0]) / 3.0
+    print(f'tail amplitude loss: {100 * below:.2f} cm/Hz below 5 Hz, '
+          f'{100 * above:.2f} cm/Hz above')
+    assert above > 1.5 * below
 
 
 def test_a_slower_servo_peaks_at_a_lower_frequency():
@@ -75,7 +85,7 @@ def test_a_slower_servo_peaks_at_a_lower_frequency():
 
 
 def test_servo_slews_at_its_rate_limit():
-    servo = Servo(ServoParameters())
+    servo = Servo(ServoParameters(rate_limit_rad_s=12.0))
     for _ in range(10):
         servo.step(1.0, 0.001)
     assert servo.motor == pytest.approx(12.0 * 0.010)

@@ -8,6 +8,8 @@ frequency the virtual fish is driven with the CPG's locked output (sampled at 20
 cpg_node publishes it) and its mean surge speed is taken once the transient has died out. The
 servo model's rate limit and lag make the real amplitude, and with it the speed, collapse at
 high frequency; ``ideal`` is eq 18 on the commanded angles (servos that follow exactly).
+The servo's slew limit is calibrated on the paper's 3 Hz cap, not on this figure
+(``wirefish_bridge.servo_calibration``), so the peak frequency is a prediction.
 """
 
 from __future__ import annotations
@@ -74,7 +76,7 @@ def speed_sweep(frequencies_hz: np.ndarray | None = None, tip_amplitude_m: float
     Return the steady runs at ``frequencies_hz`` at ``tip_amplitude_m`` (5 cm).
 
     Default frequencies: 1..10 Hz by 0.5 Hz, beyond the paper's 1..8 Hz so that the fall-off
-    past the peak shows with the default servo model.
+    past the peak also shows with faster servos (``--servo-rate-limit 12`` peaks at 8.5 Hz).
     """
     geometry = geometry or FishGeometry()
     if frequencies_hz is None:

@@ -43,10 +43,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help='firmware: neutral after this long without a host heartbeat (s)')
     p.add_argument('--speed-time-constant', type=float, default=0.75,
                    help='surge time constant set by the force scale (s)')
-    p.add_argument('--servo-rate-limit', type=float, default=12.0, help='rad/s')
-    p.add_argument('--servo-lag', type=float, default=0.02, help='first-order lag (s)')
-    p.add_argument('--servo-update-hz', type=float, default=333.0)
-    p.add_argument('--servo-limit', type=float, default=math.pi / 2, help='+-rad')
+    p.add_argument('--servo-rate-limit', type=float,
+                   default=ServoParameters.rate_limit_rad_s, help='slew limit (rad/s)')
+    p.add_argument('--servo-lag', type=float, default=ServoParameters.time_constant_s,
+                   help='first-order lag (s)')
+    p.add_argument('--servo-update-hz', type=float, default=ServoParameters.update_hz)
+    p.add_argument('--servo-limit', type=float, default=ServoParameters.limit_rad, help='+-rad')
     p.add_argument('--imu-noise-scale', type=float, default=1.0,
                    help='factor on IMU noise and bias (0 = perfect IMU)')
     p.add_argument('--corrupt-fraction', type=float, default=0.0,

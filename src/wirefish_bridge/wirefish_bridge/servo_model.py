@@ -1,16 +1,22 @@
 """
 Servo model of the virtual fish.
 
-A model assumption: the paper only says the servos cannot follow the CPG above about 5 Hz
-(section 5.4).
+A model assumption: the paper gives no servo data; it says the servos limited its speed grid to
+3 Hz (section 5.4) and could not follow the CPG above about 5 Hz at 5 cm (Fig 11).
 
 Each servo is a cascade, advanced in fixed steps:
 
 1. the PWM set-point is refreshed at ``update_hz`` (333 Hz: a 3 ms servo frame) from the latest
    commanded angle, clamped to the mechanical limit, and held in between;
-2. the motor slews toward the set-point at no more than ``rate_limit_rad_s`` (12 rad/s);
+2. the motor slews toward the set-point at no more than ``rate_limit_rad_s`` (9.1 rad/s, see
+   below);
 3. the horn, reel and wires follow the motor with a first-order lag ``time_constant_s``
    (0.02 s). The reported (measured) angle and its rate are those of this last stage.
+
+The slew limit is calibrated on the paper's 3 Hz cap (``wirefish_bridge.servo_calibration``):
+the fastest gait of its grid, 9 cm at 3 Hz, commands a peak servo rate of 9.03 rad/s. The
+issue's first estimate, 12 rad/s, makes the 5 cm speed curve peak at 8.5 Hz (paper: 6.5 Hz);
+``--servo-rate-limit 12`` still selects it.
 
 The cascade is what makes the tail amplitude collapse at high frequency: beyond the rate limit
 the motor makes a triangle whose amplitude falls as 1/f, and the lag divides it by another
@@ -27,7 +33,7 @@ import math
 class ServoParameters:
     """Rate limit (rad/s), lag (s), PWM update rate (Hz), mechanical limit (+-rad)."""
 
-    rate_limit_rad_s: float = 12.0
+    rate_limit_rad_s: float = 9.1  # servo_calibration: the paper's 3 Hz cap
     time_constant_s: float = 0.02
     update_hz: float = 333.0
     limit_rad: float = math.pi / 2

@@ -1,12 +1,13 @@
 """
 `wirefish sweep`: model and virtual-fish swimming speed over the paper's grid (Figs 9-11).
 
-The grid of section 5.4: f = 1.0 ... 3.0 Hz in steps of 0.2 at tail-tip half amplitudes
-{4, 4.5, 6.5, 8, 9} cm, plus 5 cm from 1 to 8 Hz (Fig 11). At each point Table 1's amplitudes
-are scaled so the ideal-servo tail tip swings the stated amplitude, and the network is locked at
-f. "model" is eq 18 on the commanded angles (kinematics core); "virtual fish" is the steady mean
-surge speed of the simulated fish (servo rate limit and lag, surge dynamics) driven by the same
-commands. The paper's stated points are drawn beside them.
+The grid of section 5.4 (``wirefish_cpg.table1_gait.PAPER_GRID_*``): f = 1.0 ... 3.0 Hz in
+steps of 0.2 at tail-tip half amplitudes {4, 4.5, 6.5, 8, 9} cm, plus 5 cm from 1 to 8 Hz
+(Fig 11). At each point Table 1's amplitudes are scaled so the ideal-servo tail tip swings the
+stated amplitude, and the network is locked at f. "model" is eq 18 on the commanded angles
+(kinematics core); "virtual fish" is the steady mean surge speed of the simulated fish (servo
+rate limit and lag, surge dynamics) driven by the same commands. The paper's stated points are
+drawn beside them.
 """
 
 import argparse
@@ -14,9 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from wirefish_cpg.table1_gait import PAPER_GRID_AMPLITUDES_M, PAPER_GRID_FREQUENCIES_HZ
 
-GRID_FREQUENCIES_HZ = tuple(round(1.0 + 0.2 * k, 1) for k in range(11))
-GRID_AMPLITUDES_M = (0.04, 0.045, 0.065, 0.08, 0.09)
 FIG11_AMPLITUDE_M = 0.05
 FIG11_FREQUENCIES_HZ = tuple(float(f) for f in np.arange(1.0, 8.01, 0.5))
 # The paper's figures as stated in its text: (f Hz, tip amplitude m or None for Table 1, U m/s).
@@ -63,7 +63,8 @@ def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) ->
 
 def run_sweep(with_fish: bool = True) -> tuple[list[SweepPoint], list[SweepPoint]]:
     """Return (the Fig 9/10 grid, the Fig 11 line)."""
-    grid = [sweep_point(f, a, with_fish) for a in GRID_AMPLITUDES_M for f in GRID_FREQUENCIES_HZ]
+    grid = [sweep_point(f, a, with_fish)
+            for a in PAPER_GRID_AMPLITUDES_M for f in PAPER_GRID_FREQUENCIES_HZ]
     line = [sweep_point(f, FIG11_AMPLITUDE_M, with_fish) for f in FIG11_FREQUENCIES_HZ]
     return grid, line
 
@@ -87,7 +88,7 @@ def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> 
     paths[0].write_text('\n'.join(rows) + '\n')
     for figure, quantity in (('fig9_speed.png', 'speed'), ('fig10_swimming_number.png', 'sw')):
         fig, ax = plt.subplots(figsize=(7, 4.5))
-        for amplitude in GRID_AMPLITUDES_M:
+        for amplitude in PAPER_GRID_AMPLITUDES_M:
             points = [p for p in grid if p.tip_amplitude_m == amplitude]
             f = [p.frequency_hz for p in points]
             model = [p.model_speed if quantity == 'speed' else p.swimming_number(p.model_speed)

@@ -23,6 +23,11 @@ from wirefish_kinematics.lighthill import (estimate_speed, SpeedEstimate,
                                            tail_tip_lateral_positions)
 
 TABLE1 = CpgParameters()  # Table 1: w12, w21, phi12, phi21, R1, R2; alpha = 20, b = 0
+# The grid of the paper's speed experiments (section 5.4, Figs 9-10): f = 1.0 ... 3.0 Hz in
+# steps of 0.2 Hz at tail-tip half amplitudes {4, 4.5, 6.5, 8, 9} cm. The paper stops at 3 Hz
+# because its servos could not go faster at these amplitudes.
+PAPER_GRID_FREQUENCIES_HZ = tuple(round(1.0 + 0.2 * k, 1) for k in range(11))
+PAPER_GRID_AMPLITUDES_M = (0.04, 0.045, 0.065, 0.08, 0.09)
 SAMPLES_PER_PERIOD = 512
 AMPLITUDE_SAMPLES = 4096  # dense sampling for the tip's half amplitude (peaks between samples)
 
