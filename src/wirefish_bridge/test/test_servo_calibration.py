@@ -3,11 +3,12 @@
 import numpy as np
 import pytest
 from wirefish_bridge.fig11 import run_steady
-from wirefish_bridge.servo_calibration import (calibrated_rate_limit, grid_gait,
-                                               peak_servo_rates, slew_rate_the_paper_needs)
+from wirefish_bridge.servo_calibration import (calibrated_rate_limit, peak_servo_rates,
+                                               slew_rate_the_paper_needs)
 from wirefish_bridge.servo_model import ServoParameters
 from wirefish_bridge.virtual_fish import SimConfig
 from wirefish_cpg.oscillator import NetworkArrays, simulate
+from wirefish_cpg.table1_gait import table1_at_tip_amplitude
 from wirefish_kinematics.geometry import FishGeometry
 
 
@@ -22,7 +23,7 @@ def test_calibrated_limit_is_the_need_rounded_up_to_a_tenth():
 
 
 def test_peak_servo_rate_matches_integrating_eq_1():
-    params = grid_gait(0.09, 3.0, FishGeometry())
+    params = table1_at_tip_amplitude(0.09, 3.0, FishGeometry())
     _, _, rates, _ = simulate(NetworkArrays.from_parameters(params), 12.0, 1e-3)
     integrated = np.abs(rates[-2000:]).max(axis=0)  # the last 2 s, locked
     assert integrated == pytest.approx(peak_servo_rates(params), rel=2e-3)
@@ -31,7 +32,7 @@ def test_peak_servo_rate_matches_integrating_eq_1():
 @pytest.mark.parametrize('amplitude', [0.04, 0.09])
 def test_calibrated_servo_follows_the_papers_grid_at_3_hz(amplitude):
     geometry = FishGeometry()
-    params = grid_gait(amplitude, 3.0, geometry)
+    params = table1_at_tip_amplitude(amplitude, 3.0, geometry)
 
     def tail_amplitude(rate_limit: float) -> float:
         config = SimConfig(command_timeout_s=None, heartbeat_timeout_s=None,

@@ -23,8 +23,8 @@ import math
 
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import steady_state_phases
-from wirefish_cpg.table1_gait import (amplitude_scale_for, PAPER_GRID_AMPLITUDES_M,
-                                      PAPER_GRID_FREQUENCIES_HZ, table1_locked_at)
+from wirefish_cpg.table1_gait import (PAPER_GRID_AMPLITUDES_M, PAPER_GRID_FREQUENCIES_HZ,
+                                      table1_at_tip_amplitude)
 from wirefish_kinematics.geometry import FishGeometry
 
 ROUND_UP_TO_RAD_S = 0.1
@@ -36,44 +36,47 @@ def peak_servo_rates(params: CpgParameters) -> tuple[float, float]:
     return abs(params.amplitude[0]) * omega, abs(params.amplitude[1]) * omega
 
 
-def grid_gait(tip_amplitude_m: float, frequency_hz: float,
-              geometry: FishGeometry) -> CpgParameters:
-    """Return Table 1's gait scaled to this tail-tip half amplitude (m), locked at f (Hz)."""
-    scale = amplitude_scale_for(tip_amplitude_m, frequency_hz, geometry)
-    return table1_locked_at(frequency_hz, scale)
-
-
-def slew_rate_the_paper_needs(geometry: FishGeometry | None = None) -> float:
+def grid_peak_rates(geometry: FishGeometry | None = None
+                    ) -> dict[float, tuple[float, float]]:
     """
-    Return the highest peak servo rate (rad/s) over the paper's Fig 9-10 grid.
+    Return {tail-tip amplitude (m): peak servo rates (rad/s)} of the grid at its top frequency.
 
-    The peak rate grows with amplitude and frequency, so it is the 9 cm, 3 Hz gait's; all
-    amplitudes are evaluated at the top frequency to show it.
+    The peak rate grows with amplitude and frequency, so the grid's highest need is at its top
+    frequency (3 Hz); every amplitude is listed to show which one sets it.
     """
     geometry = geometry or FishGeometry()
     top = max(PAPER_GRID_FREQUENCIES_HZ)
-    return max(max(peak_servo_rates(grid_gait(a, top, geometry)))
-               for a in PAPER_GRID_AMPLITUDES_M)
+    return {a: peak_servo_rates(table1_at_tip_amplitude(a, top, geometry))
+            for a in PAPER_GRID_AMPLITUDES_M}
 
 
-def calibrated_rate_limit(geometry: FishGeometry | None = None) -> float:
+def slew_rate_the_paper_needs(rates: dict[float, tuple[float, float]] | None = None) -> float:
+    """Return the highest peak servo rate (rad/s) of ``rates`` (default: grid_peak_rates())."""
+    rates = grid_peak_rates() if rates is None else rates
+    return max(max(pair) for pair in rates.values())
+
+
+def rounded_up(rate: float) -> float:
+    """Return ``rate`` (rad/s) rounded up to ROUND_UP_TO_RAD_S."""
+    return math.ceil(rate / ROUND_UP_TO_RAD_S - 1e-9) * ROUND_UP_TO_RAD_S
+
+
+def calibrated_rate_limit() -> float:
     """Return the slew limit (rad/s): the grid's need rounded up to 0.1 rad/s."""
-    need = slew_rate_the_paper_needs(geometry)
-    return math.ceil(need / ROUND_UP_TO_RAD_S - 1e-9) * ROUND_UP_TO_RAD_S
+    return rounded_up(slew_rate_the_paper_needs())
 
 
 def main(argv: list[str] | None = None) -> int:
     """Print the peak servo rates of the grid's top frequency and the calibrated limit."""
     argparse.ArgumentParser(description=__doc__.split('\n\n')[0]).parse_args(argv)
-    geometry = FishGeometry()
-    top = max(PAPER_GRID_FREQUENCIES_HZ)
-    print(f"peak servo rates at {top:g} Hz (the paper's cap), Table 1 gait scaled:")
-    for amplitude in PAPER_GRID_AMPLITUDES_M:
-        rate_1, rate_2 = peak_servo_rates(grid_gait(amplitude, top, geometry))
+    rates = grid_peak_rates()
+    print(f"peak servo rates at {max(PAPER_GRID_FREQUENCIES_HZ):g} Hz (the paper's cap), "
+          'Table 1 gait scaled:')
+    for amplitude, (rate_1, rate_2) in rates.items():
         print(f'  {100 * amplitude:4.1f} cm: servo 1 {rate_1:5.2f} rad/s, '
               f'servo 2 {rate_2:5.2f} rad/s')
-    print(f'needed: {slew_rate_the_paper_needs(geometry):.3f} rad/s; '
-          f'calibrated slew limit: {calibrated_rate_limit(geometry):.1f} rad/s')
+    need = slew_rate_the_paper_needs(rates)
+    print(f'needed: {need:.3f} rad/s; calibrated slew limit: {rounded_up(need):.1f} rad/s')
     return 0
 
 

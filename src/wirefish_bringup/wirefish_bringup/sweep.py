@@ -49,13 +49,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) -> SweepPoint:
     """Compute one grid point with the default geometry."""
     from wirefish_bridge.fig11 import run_steady
-    from wirefish_cpg.table1_gait import (amplitude_scale_for, locked_speed_estimate,
-                                          table1_locked_at)
+    from wirefish_cpg.table1_gait import locked_speed_estimate, table1_at_tip_amplitude
     from wirefish_kinematics.geometry import FishGeometry
 
     geometry = FishGeometry()
-    scale = amplitude_scale_for(tip_amplitude_m, frequency_hz, geometry)
-    params = table1_locked_at(frequency_hz, scale)
+    params = table1_at_tip_amplitude(tip_amplitude_m, frequency_hz, geometry)
     model = locked_speed_estimate(params, geometry).speed
     fish = run_steady(params, frequency_hz, geometry).speed if with_fish else None
     return SweepPoint(frequency_hz, tip_amplitude_m, float(model), fish, geometry.body_length)

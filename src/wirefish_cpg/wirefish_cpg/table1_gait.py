@@ -71,3 +71,10 @@ def amplitude_scale_for(tip_amplitude: float, frequency_hz: float,
         return tip_half_amplitude(table1_locked_at(frequency_hz, scale), geometry) - tip_amplitude
 
     return float(brentq(miss, 1e-6, limit, xtol=1e-12))
+
+
+def table1_at_tip_amplitude(tip_amplitude: float, frequency_hz: float,
+                            geometry: FishGeometry) -> CpgParameters:
+    """Return Table 1's gait scaled to this tail-tip half amplitude (m), locked at f (Hz)."""
+    return table1_locked_at(frequency_hz,
+                            amplitude_scale_for(tip_amplitude, frequency_hz, geometry))
