@@ -21,7 +21,7 @@ lint: setup
 	@$(WFENV) python -m pytest -m linter $(PYTEST_ARGS)
 
 bench: setup  ## benchmarks: rewrites BENCHMARKS.md
-	@$(WFENV) python -m wirefish_bringup.bench
+	@$(WFENV) python -m wirefish_analysis.bench
 
 shell: setup  ## an interactive shell with the workspace sourced
 	@$(WFENV) bash -i

@@ -20,7 +20,6 @@ setup(
     entry_points={
         'console_scripts': [
             'bridge_node = wirefish_bridge.bridge_node:main',
-            'fish_sim = wirefish_bridge.fish_sim:main',
         ],
     },
 )

@@ -20,7 +20,6 @@ setup(
     entry_points={
         'console_scripts': [
             'kinematics_node = wirefish_kinematics.kinematics_node:main',
-            'plot_body_wave = wirefish_kinematics.plot_body_wave:main',
         ],
     },
 )

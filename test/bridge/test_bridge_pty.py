@@ -18,10 +18,11 @@ from sensor_msgs.msg import Imu, JointState
 
 pytestmark = pytest.mark.ros
 BIN = Path(get_package_prefix('wirefish_bridge')) / 'lib' / 'wirefish_bridge'
+SIM_BIN = Path(get_package_prefix('wirefish_sim')) / 'lib' / 'wirefish_sim'
 
 
 def _start_fish(spawn, link: Path, *flags: str):
-    proc = spawn([str(BIN / 'fish_sim'), '--link', str(link), *flags])
+    proc = spawn([str(SIM_BIN / 'fish_sim'), '--link', str(link), *flags])
     deadline = time.monotonic() + 10.0
     while not link.is_symlink() and time.monotonic() < deadline:
         assert proc.poll() is None, proc.stdout.read()
@@ -288,7 +289,7 @@ def test_bridge_commands_neutral_as_it_shuts_down(spawn, probe, tmp_path):
     ('--servo-rate-limit', '-2', 'rate_limit_rad_s must be finite and > 0'),
 ])
 def test_fish_sim_refuses_bad_flags_with_one_line(tmp_path, ros_env, flag, value, reason):
-    result = subprocess.run([str(BIN / 'fish_sim'), '--link', str(tmp_path / 'tty'), flag,
+    result = subprocess.run([str(SIM_BIN / 'fish_sim'), '--link', str(tmp_path / 'tty'), flag,
                              value], env=ros_env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 2
     assert reason in result.stderr and 'Traceback' not in result.stderr, result.stderr

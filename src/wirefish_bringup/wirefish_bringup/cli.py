@@ -18,8 +18,20 @@ SUBCOMMANDS = {
     'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait service)'),
     'report': ('wirefish_bringup.report', 'plots and a summary table from a recorded bag'),
     'compose': ('wirefish_bringup.compose', "one fish's ROS nodes in a single process"),
-    'sweep': ('wirefish_bringup.sweep', "model and virtual-fish speed over the paper's grid"),
 }
+# Other packages add subcommands through this entry-point group ('name = module'), as ros2cli
+# extensions do: wirefish_analysis adds `sweep`, and bringup needs no import of them.
+PLUGIN_GROUP = 'wirefish.commands'
+
+
+def subcommands() -> dict[str, tuple[str, str]]:
+    """Return every subcommand: this package's and those other installed packages add."""
+    from importlib.metadata import entry_points
+
+    found = dict(SUBCOMMANDS)
+    for point in entry_points(group=PLUGIN_GROUP):
+        found.setdefault(point.name, (point.value, f'(from {point.value.split(".")[0]})'))
+    return found
 
 
 def duration_s(text: str) -> float:
@@ -33,14 +45,23 @@ def duration_s(text: str) -> float:
     return value
 
 
+_OWN = {module for module, _ in SUBCOMMANDS.values()}
+
+
+def _first_line(doc: str | None) -> str:
+    return (doc or '').strip().splitlines()[0] if (doc or '').strip() else ''
+
+
 def build_parser(argv: list[str]) -> argparse.ArgumentParser:
     """Return the parser; only the chosen subcommand's module is imported."""
     parser = argparse.ArgumentParser(prog='wirefish', description=__doc__.strip().splitlines()[0])
     commands = parser.add_subparsers(dest='command', required=True, metavar='COMMAND')
-    for name, (module_name, help_text) in SUBCOMMANDS.items():
-        sub = commands.add_parser(name, help=help_text, description=help_text)
+    for name, (module_name, help_text) in subcommands().items():
         if name in argv:
             module = importlib.import_module(module_name)
+            help_text = help_text if module_name in _OWN else _first_line(module.__doc__)
+        sub = commands.add_parser(name, help=help_text, description=help_text)
+        if name in argv:
             module.add_arguments(sub)
             sub.set_defaults(run=module.run)
     return parser

@@ -79,7 +79,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
 
     specs: list[NodeSpec] = []
     if sim:
-        specs.append(NodeSpec('wirefish_bridge', 'fish_sim', 'fish_sim',
+        specs.append(NodeSpec('wirefish_sim', 'fish_sim', 'fish_sim',
                               ('--link', tty, '--ros', *ros_args())))
     if single_process:
         specs.append(NodeSpec('wirefish_bringup', 'wirefish', 'fish_nodes', (

@@ -3,7 +3,7 @@ The fish's dimensions (SI) used by every equation of paper section 3.
 
 The paper gives no dimensions except the body length (530 mm, section 2.1). Every other default
 is an ESTIMATE from the fish's size, not a measurement; the drag coefficient is the one constant
-calibrated on the paper (``python -m wirefish_bringup.calibrate_drag``, see the README).
+calibrated on the paper (``python -m wirefish_analysis.calibrate_drag``, see the README).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass, fields
 import math
 
 # Effective C_D of eq 17: eq 18 gives 0.39 m/s (section 5.3, Fig 8) at 3 Hz with the steady
-# state of the Table 1 CPG. Printed by `python -m wirefish_bringup.calibrate_drag`; keep equal.
+# state of the Table 1 CPG. Printed by `python -m wirefish_analysis.calibrate_drag`; keep equal.
 CALIBRATED_DRAG_COEFFICIENT = 0.999663194
 
 

@@ -28,7 +28,7 @@ _GEOMETRY_DOC = {
     'fin_span': ('Caudal fin span (m); A(L_T) = pi span^2 / 4, eq 16; estimate', 1.0),
     'wetted_area': ('Wetted surface area S_c (m^2), eq 17; estimate', 10.0),
     'drag_coefficient': ('Effective drag coefficient C_D, eq 17; calibrated '
-                         '(python -m wirefish_bringup.calibrate_drag)', 10.0),
+                         '(python -m wirefish_analysis.calibrate_drag)', 10.0),
 }
 GEOMETRY_PARAMETERS = tuple(
     ParameterSpec(name, getattr(_DEFAULT, name), _GEOMETRY_DOC[name][0], 0.0,

@@ -5,7 +5,7 @@ Latency of the bridge's two paths, over a real pty and real DDS (issue 7 benchma
     side of the pty (this process plays the fish: it holds the pty master);
 (b) telemetry: TELEMETRY bytes written on the fish's side -> ``imu/data`` received here.
 bridge_node runs as its own process (the installed executable). ``python -m
-wirefish_bringup.bench_links`` prints the JSON.
+wirefish_analysis.bench_links`` prints the JSON.
 """
 
 from __future__ import annotations

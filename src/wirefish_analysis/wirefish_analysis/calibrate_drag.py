@@ -1,7 +1,7 @@
 """
 Calibrate the effective drag coefficient C_D of eq 17 on the paper, and check it.
 
-``python -m wirefish_bringup.calibrate_drag`` chooses C_D so that eq 18 gives the paper's
+``python -m wirefish_analysis.calibrate_drag`` chooses C_D so that eq 18 gives the paper's
 0.39 m/s (section 5.3, Fig 8) at a 3 Hz tail beat with the steady-state output of the Table 1
 CPG (eq 1 locked, servo angle = CPG output), on the default (estimated) geometry. eq 18 solved
 for C_D is closed form: C_D = A(L_T) (<(dy/dt)^2> / U^2 - <(dy/dq)^2>) / S_c.

@@ -9,7 +9,7 @@ import serial
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.protocol import Heartbeat, ServoCommand, Status, Telemetry
 
-BIN = Path(get_package_prefix('wirefish_bridge')) / 'lib' / 'wirefish_bridge'
+BIN = Path(get_package_prefix('wirefish_sim')) / 'lib' / 'wirefish_sim'
 
 
 def _telemetry_for(port, decoder, seconds, send=()):

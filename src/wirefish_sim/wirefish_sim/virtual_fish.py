@@ -14,15 +14,15 @@ import math
 
 import numpy as np
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.fish_dynamics import (force_scale_for_time_constant, GRAVITY,
-                                           surge_acceleration, wrap_angle, yaw_acceleration)
 from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, PROTOCOL_VERSION, Role,
                                       ServoCommand, Status, Telemetry)
-from wirefish_bridge.servo_model import Servo, ServoParameters
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust,
                                            tail_tip_lateral_positions,
                                            tail_tip_velocity_and_slope)
+from wirefish_sim.fish_dynamics import (force_scale_for_time_constant, GRAVITY,
+                                        surge_acceleration, wrap_angle, yaw_acceleration)
+from wirefish_sim.servo_model import Servo, ServoParameters
 
 
 @dataclass(frozen=True)

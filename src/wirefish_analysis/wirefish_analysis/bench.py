@@ -74,19 +74,19 @@ def _run(name: str, func, *args, **kwargs):
 
 def run_all(quick: bool = False) -> dict:
     """Run every benchmark; ``quick`` shortens the windows (for trying the harness)."""
-    from wirefish_bringup import bench_graph
+    from wirefish_analysis import bench_graph
 
     scale = 0.2 if quick else 1.0
     results: dict = {'machine': machine()}
     results['cpg_rate'] = [_run(f'cpg at {r} Hz', bench_graph.cpg_rate, r, 10.0 * scale, DOMAIN)
                            for r in (200.0, 500.0, 1000.0)]
     try:
-        from wirefish_bringup import bench_links
+        from wirefish_analysis import bench_links
         results['links'] = _run('command/telemetry latency', bench_links.run)
     except ImportError as error:
         results['links'] = {'error': f'not available: {error}'}
     try:
-        from wirefish_bringup import bench_retune
+        from wirefish_analysis import bench_retune
         results['retune'] = _run('retune', bench_retune.run)
     except ImportError as error:
         results['retune'] = {'error': f'not available: {error}'}
@@ -102,7 +102,7 @@ def run_all(quick: bool = False) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmarks, write the JSON and BENCHMARKS.md."""
-    from wirefish_bringup.bench_report import render_markdown
+    from wirefish_analysis.bench_report import render_markdown
 
     parser = argparse.ArgumentParser(prog='wirefish-bench', description=__doc__.strip())
     parser.add_argument('--quick', action='store_true', help='short windows (harness check)')

@@ -1,7 +1,7 @@
 """
 Reproduce the paper's section 5.2 point optimisation and its figures 6(a), 6(b) and 7(a).
 
-``python -m wirefish_bringup.reproduce_paper --out out/paper`` fits the CPG to the wave
+``python -m wirefish_analysis.reproduce_paper --out out/paper`` fits the CPG to the wave
 c1 = 0.15, c2 = 1, k = 8, omega = 2 pi (alpha = 20, b = 0) with the tuner's PSO and default
 geometry, prints the swing-angle RMSEs against the paper's (1.7165 deg, 1.2817 deg), the loss
 of Table 1's parameters beside ours (under both readings of eq 23's sign), the iterations and

@@ -2,14 +2,14 @@
 
 import numpy as np
 import pytest
-from wirefish_bridge.fig11 import run_steady
-from wirefish_bridge.servo_calibration import (calibrated_rate_limit, peak_servo_rates,
-                                               slew_rate_the_paper_needs)
-from wirefish_bridge.servo_model import ServoParameters
-from wirefish_bridge.virtual_fish import SimConfig
+from wirefish_analysis.fig11 import run_steady
+from wirefish_analysis.servo_calibration import (calibrated_rate_limit, peak_servo_rates,
+                                                 slew_rate_the_paper_needs)
 from wirefish_cpg.oscillator import NetworkArrays, simulate
 from wirefish_cpg.table1_gait import table1_at_tip_amplitude
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_sim.servo_model import ServoParameters
+from wirefish_sim.virtual_fish import SimConfig
 
 
 def test_default_slew_limit_is_the_calibrated_one():

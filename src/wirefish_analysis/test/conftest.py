@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from wirefish_bridge.fig11 import speed_sweep, SteadyRun
+from wirefish_analysis.fig11 import speed_sweep, SteadyRun
 
 
 @pytest.fixture(scope='session')

@@ -21,10 +21,10 @@ import time
 
 import numpy as np
 
-from wirefish_bridge.faults import FaultInjector
-from wirefish_bridge.pty_device import PtyDevice
-from wirefish_bridge.servo_model import ServoParameters
-from wirefish_bridge.virtual_fish import ImuNoise, SimConfig, VirtualFish
+from wirefish_sim.faults import FaultInjector
+from wirefish_sim.pty_device import PtyDevice
+from wirefish_sim.servo_model import ServoParameters
+from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -10,9 +10,9 @@ servo rate that gait commands: R_i * Omega of the locked network (9.03 rad/s, se
 ``ServoParameters.rate_limit_rad_s`` is that value rounded up to 0.1 rad/s (9.1 rad/s).
 
 Fig 11 (5 cm, speed peaks at 6.5 Hz) is not used here: where the virtual fish's speed peaks is
-a prediction of this calibration, checked by ``wirefish_bridge.fig11`` and the tests.
+a prediction of this calibration, checked by ``wirefish_analysis.fig11`` and the tests.
 
-``python -m wirefish_bridge.servo_calibration`` prints the peak servo rate of every amplitude
+``python -m wirefish_analysis.servo_calibration`` prints the peak servo rate of every amplitude
 of the grid at its top frequency and the slew limit they call for.
 """
 

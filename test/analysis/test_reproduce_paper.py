@@ -4,11 +4,11 @@ import json
 import subprocess
 import sys
 
-from wirefish_bringup import bench_retune
+from wirefish_analysis import bench_retune
 
 
 def test_reproduce_paper_meets_the_paper_rmse_and_writes_the_figures(tmp_path):
-    result = subprocess.run([sys.executable, '-m', 'wirefish_bringup.reproduce_paper',
+    result = subprocess.run([sys.executable, '-m', 'wirefish_analysis.reproduce_paper',
                              '--out', str(tmp_path)], capture_output=True, text=True,
                             timeout=300)
     assert result.returncode == 0, result.stdout + result.stderr

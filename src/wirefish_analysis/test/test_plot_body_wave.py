@@ -1,9 +1,9 @@
 """plot_body_wave writes the Fig 7(b-d) PNGs and the swing-angle RMSEs."""
 
 import pytest
+from wirefish_analysis.plot_body_wave import (main, TABLE1_AMPLITUDES,
+                                              TABLE1_PHASE_DIFFERENCE, write_figures)
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.plot_body_wave import (main, TABLE1_AMPLITUDES,
-                                                TABLE1_PHASE_DIFFERENCE, write_figures)
 
 
 def test_writes_both_figures(tmp_path):

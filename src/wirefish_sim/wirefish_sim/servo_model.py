@@ -13,7 +13,7 @@ Each servo is a cascade, advanced in fixed steps:
 3. the horn, reel and wires follow the motor with a first-order lag ``time_constant_s``
    (0.02 s). The reported (measured) angle and its rate are those of this last stage.
 
-The slew limit is calibrated on the paper's 3 Hz cap (``wirefish_bridge.servo_calibration``):
+The slew limit is calibrated on the paper's 3 Hz cap (``wirefish_analysis.servo_calibration``):
 the fastest gait of its grid, 9 cm at 3 Hz, commands a peak servo rate of 9.03 rad/s. The
 issue's first estimate, 12 rad/s, makes the 5 cm speed curve peak at 8.5 Hz (paper: 6.5 Hz);
 ``--servo-rate-limit 12`` still selects it.

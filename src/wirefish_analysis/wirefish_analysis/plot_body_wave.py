@@ -2,7 +2,7 @@
 Plot the paper's Fig 7(b-d) for a locked pair of servo sinusoids.
 
 ``ros2 run wirefish_kinematics plot_body_wave --out DIR`` (or ``python -m
-wirefish_kinematics.plot_body_wave``) writes
+wirefish_analysis.plot_body_wave``) writes
 
 * ``fig7bc_swing_angles.png``: expected swing angles theta-bar_i (eq 23) and the predicted
   theta_i (eqs 2-15) over one period, with their RMSE (paper: 1.7165 deg, 1.2817 deg);

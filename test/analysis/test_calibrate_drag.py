@@ -1,10 +1,10 @@
-"""The C_D calibration command (wirefish_bringup.calibrate_drag) and the paper's figures."""
+"""The C_D calibration command (wirefish_analysis.calibrate_drag) and the paper's figures."""
 
 import subprocess
 import sys
 
 import pytest
-from wirefish_bringup.calibrate_drag import calibrated_drag_coefficient, PAPER_POINTS, predict
+from wirefish_analysis.calibrate_drag import calibrated_drag_coefficient, PAPER_POINTS, predict
 from wirefish_cpg.table1_gait import table1_locked_at, tip_half_amplitude
 from wirefish_kinematics.geometry import FishGeometry
 
@@ -39,7 +39,7 @@ def test_paper_points_are_evaluated_at_the_stated_tip_amplitude_and_frequency(po
 
 
 def test_the_command_prints_the_calibration_and_the_paper_points():
-    result = subprocess.run([sys.executable, '-m', 'wirefish_bringup.calibrate_drag'],
+    result = subprocess.run([sys.executable, '-m', 'wirefish_analysis.calibrate_drag'],
                             capture_output=True, text=True, check=True)
     assert f'calibrated C_D = {FishGeometry().drag_coefficient:.9f}' in result.stdout
     assert 'differs' not in result.stdout

@@ -1,7 +1,7 @@
 """
 Speed of the virtual fish against tail-beat frequency at 5 cm tail-tip amplitude (paper Fig 11).
 
-``python -m wirefish_bridge.fig11 --out out/fig11.png`` runs the sweep (faster than real time,
+``python -m wirefish_analysis.fig11 --out out/fig11.png`` runs the sweep (faster than real time,
 no ROS) and writes the PNG and the numbers. The gait is Table 1's CPG with both amplitudes
 scaled so that the kinematic tail-tip half amplitude with ideal servos is 5 cm; at each
 frequency the virtual fish is driven with the CPG's locked output (sampled at 200 Hz, as
@@ -9,7 +9,7 @@ cpg_node publishes it) and its mean surge speed is taken once the transient has 
 servo model's rate limit and lag make the real amplitude, and with it the speed, collapse at
 high frequency; ``ideal`` is eq 18 on the commanded angles (servos that follow exactly).
 The servo's slew limit is calibrated on the paper's 3 Hz cap, not on this figure
-(``wirefish_bridge.servo_calibration``), so the peak frequency is a prediction.
+(``wirefish_analysis.servo_calibration``), so the peak frequency is a prediction.
 """
 
 from __future__ import annotations
@@ -20,12 +20,12 @@ import json
 from pathlib import Path
 
 import numpy as np
-from wirefish_bridge.servo_model import ServoParameters
-from wirefish_bridge.virtual_fish import SimConfig, VirtualFish
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import steady_state_servo_angles
 from wirefish_cpg.table1_gait import amplitude_scale_for, locked_speed_estimate, table1_locked_at
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_sim.servo_model import ServoParameters
+from wirefish_sim.virtual_fish import SimConfig, VirtualFish
 
 SCALE_FREQUENCY_HZ = 3.0  # amplitudes are scaled once, with ideal servos, at this frequency
 COMMAND_RATE_HZ = 200.0

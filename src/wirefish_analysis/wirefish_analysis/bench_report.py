@@ -1,4 +1,4 @@
-"""Render benchmark results (the dict of `wirefish_bringup.bench`) as BENCHMARKS.md."""
+"""Render benchmark results (the dict of `wirefish_analysis.bench`) as BENCHMARKS.md."""
 
 import json
 
@@ -112,7 +112,8 @@ def render_markdown(results: dict) -> str:
     """Return the whole BENCHMARKS.md text."""
     m = results['machine']
     lines = ['# Benchmarks', '',
-             'Written by `make bench` (`python -m wirefish_bringup.bench`); figures from one run.',
+             'Written by `make bench` (`python -m wirefish_analysis.bench`); figures from one '
+             'run.',
              f'Machine: {m["cpu"]}, {m["cores"]} cores, Python {m["python"]}, numpy '
              f'{m["numpy"]}, kernel {m["kernel"]}; {m["date"]}. Shared and noisy: medians and '
              'p99 from one run, ratios within that run.', '',

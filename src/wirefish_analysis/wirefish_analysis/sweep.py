@@ -48,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) -> SweepPoint:
     """Compute one grid point with the default geometry."""
-    from wirefish_bridge.fig11 import run_steady
+    from wirefish_analysis.fig11 import run_steady
     from wirefish_cpg.table1_gait import locked_speed_estimate, table1_at_tip_amplitude
     from wirefish_kinematics.geometry import FishGeometry
 

@@ -1,0 +1,1 @@
+"""Reproduce, sweep, calibrate and plot the paper's results; the benchmarks."""

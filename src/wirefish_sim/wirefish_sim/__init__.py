@@ -1,0 +1,1 @@
+"""The virtual fish: firmware, physics and servos on a pseudo-terminal."""
