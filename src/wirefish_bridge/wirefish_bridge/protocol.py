@@ -5,14 +5,24 @@ Pure data: no I/O, no rclpy. A frame body is ``type (u8) | seq (u16 LE) | payloa
 LE)``; this module packs and unpacks the payloads, ``codec`` does framing, CRC and streaming.
 All multi-byte fields are little-endian; angles in rad, rates in rad/s, accelerations in m/s^2,
 voltages in V, times in ms of the sender's clock.
+
+One registry: a message is one class that subclasses ``ProtocolMessage`` with its type byte and
+payload layout (``class X(ProtocolMessage, kind=MsgType.X, layout='<ff')``) and says how its
+fields map to the layout (``to_wire``) and back (``from_wire``, which also judges validity).
+``message_type``, ``pack_payload``, ``unpack_payload`` and ``PAYLOAD_SIZES`` read the registry;
+a class that is not registered is refused with ``UnknownMessageError``, a type byte that is
+not registered decodes to None (the codec counts it as ``unknown_type``). Adding a message: a
+``MsgType`` member and its class (the import fails if either is missing), then PROTOCOL.md.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 import enum
 import math
 import struct
+from typing import Any, ClassVar, TypeVar
 
 PROTOCOL_VERSION = 1
 DEFAULT_BAUDRATE = 115200
@@ -57,25 +67,93 @@ class Status(enum.IntFlag):
     VERSION_MISMATCH = 0x0020   # the host's heartbeat announced another protocol version
 
 
+class UnknownMessageError(TypeError):
+    """An object that is not a registered protocol message was given to be sent."""
+
+
+_M = TypeVar('_M', bound='ProtocolMessage')
+_BY_KIND: dict[int, type[ProtocolMessage]] = {}
+
+
+class ProtocolMessage:
+    """
+    Base of every message; subclassing it with ``kind`` and ``layout`` registers the message.
+
+    ``kind`` is the type byte (a ``MsgType``); ``layout`` the ``struct`` format of the payload
+    (little-endian, fixed size). ``to_wire`` returns the values in ``layout`` order;
+    ``from_wire`` builds the message from the unpacked values or returns None when they are not
+    a valid message (it must not raise: it judges bytes from the wire).
+    """
+
+    KIND: ClassVar[MsgType]
+    WIRE: ClassVar[struct.Struct]
+
+    def __init_subclass__(cls, *, kind: MsgType, layout: str, **kwargs: Any) -> None:
+        """Register ``cls`` as the message of type ``kind``; a type has one class only."""
+        super().__init_subclass__(**kwargs)
+        if not isinstance(kind, MsgType):
+            raise TypeError(f'{cls.__name__}: kind must be a MsgType, got {kind!r}')
+        if kind in _BY_KIND:
+            raise ValueError(f'{cls.__name__}: type {kind.name} (0x{kind:02x}) is already '
+                             f'the message {_BY_KIND[kind].__name__}')
+        cls.KIND = kind
+        cls.WIRE = struct.Struct(layout)
+        _BY_KIND[kind] = cls
+
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return the payload values in ``layout`` order."""
+        raise NotImplementedError(type(self).__name__)
+
+    @classmethod
+    def from_wire(cls: type[_M], values: tuple[Any, ...]) -> _M | None:
+        """Return the message of the unpacked ``values``, or None if they are not valid."""
+        raise NotImplementedError(cls.__name__)
+
+
+def _finite(values: Sequence[float]) -> bool:
+    return all(map(math.isfinite, values))
+
+
 @dataclass(frozen=True)
-class Heartbeat:
+class Heartbeat(ProtocolMessage, kind=MsgType.HEARTBEAT, layout='<BBI'):
     """Both ways, a few Hz: protocol version, sender role, sender uptime (ms, wraps)."""
 
     version: int = PROTOCOL_VERSION
     role: Role = Role.HOST
     uptime_ms: int = 0
 
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return version, role, uptime (wrapped to u32)."""
+        return self.version, int(self.role), self.uptime_ms & 0xFFFFFFFF
+
+    @classmethod
+    def from_wire(cls, values: tuple[Any, ...]) -> Heartbeat | None:
+        """Return the heartbeat, or None for an unknown role."""
+        version, role, uptime = values
+        if role not in (Role.HOST, Role.FISH):
+            return None
+        return cls(version, Role(role), uptime)
+
 
 @dataclass(frozen=True)
-class ServoCommand:
+class ServoCommand(ProtocolMessage, kind=MsgType.SERVO_CMD, layout='<ff'):
     """Host -> fish: target angles of servo 1 and 2 (rad, reel angle phi_D,i of eq 2)."""
 
     servo_1: float
     servo_2: float
 
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return the two target angles."""
+        return self.servo_1, self.servo_2
+
+    @classmethod
+    def from_wire(cls, values: tuple[Any, ...]) -> ServoCommand | None:
+        """Return the command, or None if an angle is not finite."""
+        return cls(*values) if _finite(values) else None
+
 
 @dataclass(frozen=True)
-class Telemetry:
+class Telemetry(ProtocolMessage, kind=MsgType.TELEMETRY, layout='<I' + 'f' * 12 + 'H'):
     """
     Fish -> host, 100 Hz: board time, attitude, IMU, measured servos, battery, status.
 
@@ -95,87 +173,81 @@ class Telemetry:
     battery_v: float
     status: int = 0
 
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return board time (wrapped to u32), the 12 floats in order, status."""
+        return (self.board_time_ms & 0xFFFFFFFF, self.roll, self.pitch, self.yaw, *self.gyro,
+                *self.accel, self.servo_1, self.servo_2, self.battery_v, int(self.status))
+
+    @classmethod
+    def from_wire(cls, values: tuple[Any, ...]) -> Telemetry | None:
+        """Return the telemetry, or None if a float is not finite (ranges: telemetry_limits)."""
+        floats = values[1:13]
+        if not _finite(floats):
+            return None
+        return cls(board_time_ms=values[0], roll=floats[0], pitch=floats[1], yaw=floats[2],
+                   gyro=tuple(floats[3:6]), accel=tuple(floats[6:9]), servo_1=floats[9],
+                   servo_2=floats[10], battery_v=floats[11], status=values[13])
+
 
 @dataclass(frozen=True)
-class ErrorReport:
+class ErrorReport(ProtocolMessage, kind=MsgType.ERROR, layout='<BH'):
     """Fish -> host: ``code`` (ErrorCode) about the received frame with sequence ``ref_seq``."""
 
     code: int
     ref_seq: int = 0
 
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return code and ref_seq (wrapped to u16)."""
+        return int(self.code), self.ref_seq & 0xFFFF
 
-Message = Heartbeat | ServoCommand | Telemetry | ErrorReport
-
-_HEARTBEAT = struct.Struct('<BBI')
-_SERVO_CMD = struct.Struct('<ff')
-_TELEMETRY = struct.Struct('<I' + 'f' * 12 + 'H')
-_ERROR = struct.Struct('<BH')
-
-PAYLOAD_SIZES = {
-    MsgType.HEARTBEAT: _HEARTBEAT.size,
-    MsgType.SERVO_CMD: _SERVO_CMD.size,
-    MsgType.TELEMETRY: _TELEMETRY.size,
-    MsgType.ERROR: _ERROR.size,
-}
+    @classmethod
+    def from_wire(cls, values: tuple[Any, ...]) -> ErrorReport | None:
+        """Return the report (any code: an unknown one is still worth reporting)."""
+        return cls(*values)
 
 
-def message_type(message: Message) -> MsgType:
-    """Return the type byte of ``message``."""
-    if isinstance(message, Heartbeat):
-        return MsgType.HEARTBEAT
-    if isinstance(message, ServoCommand):
-        return MsgType.SERVO_CMD
-    if isinstance(message, Telemetry):
-        return MsgType.TELEMETRY
-    if isinstance(message, ErrorReport):
-        return MsgType.ERROR
-    raise TypeError(f'not a protocol message: {message!r}')
+Message = ProtocolMessage  # any registered message (the registry, not a list, says which)
+
+_missing = [kind.name for kind in MsgType if kind not in _BY_KIND]
+if _missing:  # a MsgType without its class would decode to nothing: fail at import instead
+    raise ImportError(f'protocol: no message class for {", ".join(_missing)}')
+
+PAYLOAD_SIZES: dict[MsgType, int] = {kind: _BY_KIND[kind].WIRE.size for kind in MsgType}
 
 
-def pack_payload(message: Message) -> bytes:
-    """Return the payload bytes of ``message``; raises ``struct.error``/``ValueError``."""
-    if isinstance(message, Heartbeat):
-        return _HEARTBEAT.pack(message.version, int(message.role),
-                               message.uptime_ms & 0xFFFFFFFF)
-    if isinstance(message, ServoCommand):
-        return _SERVO_CMD.pack(message.servo_1, message.servo_2)
-    if isinstance(message, Telemetry):
-        return _TELEMETRY.pack(message.board_time_ms & 0xFFFFFFFF, message.roll, message.pitch,
-                               message.yaw, *message.gyro, *message.accel, message.servo_1,
-                               message.servo_2, message.battery_v, int(message.status))
-    if isinstance(message, ErrorReport):
-        return _ERROR.pack(int(message.code), message.ref_seq & 0xFFFF)
-    raise TypeError(f'not a protocol message: {message!r}')
+def message_class(kind: int) -> type[ProtocolMessage] | None:
+    """Return the registered class of type byte ``kind``, or None if there is none."""
+    return _BY_KIND.get(kind)
 
 
-def unpack_payload(kind: int, payload: bytes) -> Message | None:
+def _registered(message: object) -> type[ProtocolMessage]:
+    cls = type(message)
+    if not isinstance(message, ProtocolMessage) or _BY_KIND.get(cls.KIND) is not cls:
+        known = ', '.join(c.__name__ for c in _BY_KIND.values())
+        raise UnknownMessageError(f'not a protocol message: {message!r} (the messages are '
+                                  f'{known})')
+    return cls
+
+
+def message_type(message: ProtocolMessage) -> MsgType:
+    """Return the type byte of ``message``; raises ``UnknownMessageError`` if unregistered."""
+    return _registered(message).KIND
+
+
+def pack_payload(message: ProtocolMessage) -> bytes:
+    """Return the payload bytes of ``message``; raises ``UnknownMessageError``/``struct.error``."""
+    cls = _registered(message)
+    return cls.WIRE.pack(*message.to_wire())
+
+
+def unpack_payload(kind: int, payload: bytes) -> ProtocolMessage | None:
     """
     Return the message of type ``kind`` in ``payload``, or None if it is not a valid one.
 
-    Valid means: known type, exact payload size, finite floats, known role. Never raises.
+    Valid means: registered type, exact payload size, and the class's own checks (finite floats,
+    known role). Never raises.
     """
-    try:
-        kind = MsgType(kind)
-    except ValueError:
+    cls = _BY_KIND.get(kind)
+    if cls is None or len(payload) != cls.WIRE.size:
         return None
-    if len(payload) != PAYLOAD_SIZES[kind]:
-        return None
-    if kind is MsgType.HEARTBEAT:
-        version, role, uptime = _HEARTBEAT.unpack(payload)
-        if role not in (Role.HOST, Role.FISH):
-            return None
-        return Heartbeat(version, Role(role), uptime)
-    if kind is MsgType.SERVO_CMD:
-        values = _SERVO_CMD.unpack(payload)
-        return ServoCommand(*values) if all(map(math.isfinite, values)) else None
-    if kind is MsgType.TELEMETRY:
-        fields = _TELEMETRY.unpack(payload)
-        floats = fields[1:13]
-        if not all(map(math.isfinite, floats)):
-            return None
-        return Telemetry(board_time_ms=fields[0], roll=floats[0], pitch=floats[1],
-                         yaw=floats[2], gyro=tuple(floats[3:6]), accel=tuple(floats[6:9]),
-                         servo_1=floats[9], servo_2=floats[10], battery_v=floats[11],
-                         status=fields[13])
-    code, ref_seq = _ERROR.unpack(payload)
-    return ErrorReport(code, ref_seq)
+    return cls.from_wire(cls.WIRE.unpack(payload))
