@@ -1,9 +1,20 @@
-"""Pure validation of ROS parameter values against their specs."""
+"""The CPG's flat ROS parameters: their one mapping to CpgParameters and their validation."""
 
 import math
+import subprocess
+import sys
 
 import pytest
-from wirefish_cpg.cpg_node import SPECS
+from wirefish_common.parameter_table import check_value
+from wirefish_cpg.cpg_messages import to_message
+from wirefish_cpg.cpg_node_parameters import SPECS
+from wirefish_cpg.cpg_parameter_names import (CPG_PARAMETER_NAMES, CPG_PARAMETERS, flat_values,
+                                              parameters_from)
+from wirefish_cpg.oscillator import at_rest, CpgParameters
+from wirefish_cpg.wave_loss import PARAMETER_NAMES as TUNED_NAMES
+
+TURNING = CpgParameters(frequency_hz=2.5, amplitude=(0.3, -0.2), offset=(0.1, -0.05),
+                        w12=1.5, w21=-2.0, phi12=-0.5, phi21=2.0, alpha=30.0)
 
 
 @pytest.mark.parametrize('name, value', [
@@ -14,7 +25,6 @@ from wirefish_cpg.cpg_node import SPECS
     ('amplitude_2', True),
 ])
 def test_invalid_values_are_refused_with_a_reason(name, value):
-    from wirefish_common.parameter_table import check_value
     reason = check_value(SPECS[name], value)
     assert reason is not None and name in reason
 
@@ -24,5 +34,55 @@ def test_invalid_values_are_refused_with_a_reason(name, value):
     ('alpha', 200.0), ('publish_rate_hz', 1000.0), ('autostart', False),
 ])
 def test_values_at_the_edges_of_the_ranges_are_accepted(name, value):
-    from wirefish_common.parameter_table import check_value
     assert check_value(SPECS[name], value) is None
+
+
+@pytest.mark.parametrize('params', [CpgParameters(), TURNING])
+def test_flat_values_map_back_to_the_same_parameters(params):
+    assert parameters_from(flat_values(params)) == params
+
+
+def test_flat_names_follow_the_fields_of_cpg_parameters():
+    assert flat_values(TURNING) == {
+        'frequency_hz': 2.5, 'amplitude_1': 0.3, 'amplitude_2': -0.2, 'offset_1': 0.1,
+        'offset_2': -0.05, 'w12': 1.5, 'w21': -2.0, 'phi12': -0.5, 'phi21': 2.0, 'alpha': 30.0}
+
+
+def test_the_parameter_defaults_are_those_of_cpg_parameters():
+    assert {spec.name: spec.default for spec in CPG_PARAMETERS} == flat_values(CpgParameters())
+
+
+def test_every_cpg_parameter_is_a_node_parameter_in_the_mapping_order():
+    assert tuple(spec.name for spec in CPG_PARAMETERS) == CPG_PARAMETER_NAMES
+    assert set(CPG_PARAMETER_NAMES) <= set(SPECS)
+
+
+def test_the_tuned_position_names_are_cpg_parameter_names():
+    assert set(TUNED_NAMES) <= set(CPG_PARAMETER_NAMES)
+
+
+def test_a_missing_name_is_a_key_error_naming_it():
+    values = flat_values(TURNING)
+    del values['offset_2']
+    with pytest.raises(KeyError, match='offset_2'):
+        parameters_from(values)
+
+
+def test_at_rest_zeroes_only_the_amplitude_and_offset_targets():
+    rest = at_rest(TURNING)
+    assert (rest.amplitude, rest.offset) == ((0.0, 0.0), (0.0, 0.0))
+    assert flat_values(rest) | {'amplitude_1': 0.3, 'amplitude_2': -0.2, 'offset_1': 0.1,
+                                'offset_2': -0.05} == flat_values(TURNING)
+
+
+def test_the_message_carries_every_parameter():
+    msg = to_message(TURNING)
+    assert (msg.frequency_hz, msg.w12, msg.w21, msg.phi12, msg.phi21, msg.alpha) == (
+        2.5, 1.5, -2.0, -0.5, 2.0, 30.0)
+    assert (list(msg.amplitude), list(msg.offset)) == ([0.3, -0.2], [0.1, -0.05])
+
+
+def test_the_parameter_modules_import_no_rclpy():
+    code = ('import sys, wirefish_cpg.cpg_node_parameters, wirefish_cpg.cpg_parameter_names; '
+            'sys.exit("rclpy" in sys.modules)')
+    assert subprocess.run([sys.executable, '-c', code]).returncode == 0

@@ -2,11 +2,12 @@
 cpg_node: the fish's two-oscillator CPG (paper eq 1) driving the servos.
 
 Publishes
-    ``servo_cmd`` (sensor_msgs/JointState, sensor-data QoS) at ``publish_rate_hz``: names
-    ``servo_1``, ``servo_2``; position (rad) and velocity (rad/s), stamped with the node clock
-    (so ``use_sim_time`` works: a tick at which simulated time has not advanced publishes
-    nothing). The ticks come from a ``FixedRateLoop`` thread, not an executor timer: at 1 kHz
-    the executor's own overhead was ~90 % of the node's CPU (see fixed_rate.py).
+    ``servo_cmd`` (sensor_msgs/JointState, sensor-data QoS) at ``publish_rate_hz``: joints
+    ``servo_1``, ``servo_2`` (``wirefish_common.servo_joints``); position (rad) and velocity
+    (rad/s), stamped with the node clock (so ``use_sim_time`` works: a tick at which simulated
+    time has not advanced publishes nothing). The ticks come from a ``FixedRateLoop`` thread,
+    not an executor timer: at 1 kHz the executor's own overhead was ~90 % of the node's CPU
+    (see fixed_rate.py).
     ``cpg_params`` (wirefish_msgs/CpgParams, reliable, transient local, depth 1): the current
     parameters, re-published whenever they change.
 Services
@@ -14,14 +15,13 @@ Services
     so the tail comes to rest along eq 1's convergence law, never by a jump; start restores
     the parameters. Parameter changes while stopped are kept and apply at start.
 Parameters (flat scalars, each with a range; invalid updates are rejected with a reason):
-    see ``CPG_PARAMETERS``. Valid updates apply smoothly: the oscillator state persists, the
-    amplitudes and offsets converge to their new targets, a new frequency only changes the
+    see ``cpg_node_parameters``. Valid updates apply smoothly: the oscillator state persists,
+    the amplitudes and offsets converge to their new targets, a new frequency only changes the
     phase velocity. Outputs beyond ``servo_limit_rad`` are clamped (rate 0) with a warning.
 """
 
 from __future__ import annotations
 
-import math
 import threading
 
 from rcl_interfaces.msg import SetParametersResult
@@ -34,71 +34,20 @@ from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
 from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
-from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
-                                             validate_update)
+from wirefish_common.parameter_table import create_node_or_exit, declare, validate_update
+from wirefish_common.servo_joints import servo_joint_state
 from wirefish_common.shutdown import SignalShutdown
+from wirefish_cpg.cpg_messages import to_message
+from wirefish_cpg.cpg_node_parameters import NODE_PARAMETERS, SPECS
+from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES, parameters_from
 from wirefish_cpg.fixed_rate import FixedRateLoop
-from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
+from wirefish_cpg.oscillator import at_rest, CpgIntegrator
 from wirefish_msgs.msg import CpgParams
 
-HALF_PI = math.pi / 2
-CPG_PARAMETERS = (
-    ParameterSpec('frequency_hz', 1.0, 'Intrinsic oscillator frequency v (Hz), eq 1', 0.0,
-                  10.0, low_exclusive=True),
-    ParameterSpec('amplitude_1', 0.38, 'Target amplitude R_1 of servo 1 (rad)', -HALF_PI,
-                  HALF_PI),
-    ParameterSpec('amplitude_2', 0.47, 'Target amplitude R_2 of servo 2 (rad)', -HALF_PI,
-                  HALF_PI),
-    ParameterSpec('offset_1', 0.0, 'Target offset b_1 of servo 1 (rad); turning', -HALF_PI,
-                  HALF_PI),
-    ParameterSpec('offset_2', 0.0, 'Target offset b_2 of servo 2 (rad); turning', -HALF_PI,
-                  HALF_PI),
-    ParameterSpec('w12', -0.41, 'Coupling weight omega_12 of oscillator 2 on 1 (1/s)', -10.0,
-                  10.0),
-    ParameterSpec('w21', 0.64, 'Coupling weight omega_21 of oscillator 1 on 2 (1/s)', -10.0,
-                  10.0),
-    ParameterSpec('phi12', 1.76, 'Phase bias phi_12 (rad)', -math.pi, math.pi),
-    ParameterSpec('phi21', 1.06, 'Phase bias phi_21 (rad)', -math.pi, math.pi),
-    ParameterSpec('alpha', 20.0, 'Convergence gain alpha of amplitude and offset (1/s)', 0.0,
-                  200.0, low_exclusive=True),
-)
-NODE_PARAMETERS = CPG_PARAMETERS + (
-    ParameterSpec('publish_rate_hz', 200.0, 'Rate of servo_cmd (Hz)', 1.0, 1000.0),
-    ParameterSpec('integration_step_s', 0.001,
-                  'Fixed RK4 step of eq 1 (s), independent of the publish rate', 1e-5, 0.01),
-    ParameterSpec('servo_limit_rad', HALF_PI, 'Servo angle limit; outputs are clamped (rad)',
-                  0.0, math.pi, low_exclusive=True),
-    ParameterSpec('autostart', True, 'Start oscillating at launch (else wait for start)'),
-)
-SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 # Longest clock gap integrated step by step (s); a longer jump re-bases the clock instead.
 MAX_CATCH_UP_S = 0.5
-
-
-def parameters_from(values: dict[str, object]) -> CpgParameters:
-    """Return the CpgParameters of a flat name -> value mapping (the node's parameters)."""
-    return CpgParameters(
-        frequency_hz=values['frequency_hz'],
-        amplitude=(values['amplitude_1'], values['amplitude_2']),
-        offset=(values['offset_1'], values['offset_2']), w12=values['w12'],
-        w21=values['w21'], phi12=values['phi12'], phi21=values['phi21'],
-        alpha=values['alpha'])
-
-
-def at_rest(params: CpgParameters) -> CpgParameters:
-    """Return ``params`` with amplitude and offset targets 0 (what stop converges to)."""
-    return CpgParameters(frequency_hz=params.frequency_hz, amplitude=(0.0, 0.0),
-                         offset=(0.0, 0.0), w12=params.w12, w21=params.w21,
-                         phi12=params.phi12, phi21=params.phi21, alpha=params.alpha)
-
-
-def to_message(params: CpgParameters) -> CpgParams:
-    """Return ``params`` as a wirefish_msgs/CpgParams."""
-    return CpgParams(frequency_hz=params.frequency_hz, amplitude=list(params.amplitude),
-                     offset=list(params.offset), w12=params.w12, w21=params.w21,
-                     phi12=params.phi12, phi21=params.phi21, alpha=params.alpha)
 
 
 class CpgNode(Node):
@@ -151,7 +100,7 @@ class CpgNode(Node):
                 self._cpg.step_s = float(self._values['integration_step_s'])
             if 'publish_rate_hz' in names:
                 self._loop.period_s = 1.0 / self._values['publish_rate_hz']
-            if names & {s.name for s in CPG_PARAMETERS}:
+            if names & set(CPG_PARAMETER_NAMES):
                 params = parameters_from(self._values)
                 self._cpg.set_parameters(params if self._running else at_rest(params))
         if params is not None:  # announced outside the lock: the loop must not wait on DDS
@@ -203,12 +152,8 @@ class CpgNode(Node):
                 ' clamped', throttle_duration_sec=2.0)
             angles = angles.clip(-limit, limit)
             rates = rates * ~clamped
-        msg = JointState()
-        msg.header.stamp = now.to_msg()
-        msg.name = ['servo_1', 'servo_2']
-        msg.position = angles.tolist()
-        msg.velocity = rates.tolist()
-        self._servo_pub.publish(msg)
+        self._servo_pub.publish(servo_joint_state(angles.tolist(), rates.tolist(),
+                                                  now.to_msg()))
 
 
 def main(args: list[str] | None = None) -> None:

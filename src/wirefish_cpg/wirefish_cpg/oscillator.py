@@ -20,7 +20,7 @@ same code integrates one network or a whole PSO swarm (``NetworkArrays`` with sh
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import math
 
 import numpy as np
@@ -79,6 +79,11 @@ class CpgParameters:
     def phase_biases(self) -> np.ndarray:
         """Return Phi (2, 2) with Phi[i, j] = phi_ij (rad) and a zero diagonal."""
         return np.array([[0.0, self.phi12], [self.phi21, 0.0]])
+
+
+def at_rest(params: CpgParameters) -> CpgParameters:
+    """Return ``params`` with amplitude and offset targets 0: what eq 1 converges to on stop."""
+    return replace(params, amplitude=(0.0, 0.0), offset=(0.0, 0.0))
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,7 @@ from std_msgs.msg import Float64MultiArray
 from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
                                              validate_update)
 from wirefish_common.shutdown import SignalShutdown
-from wirefish_cpg.cpg_node import to_message
+from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait
