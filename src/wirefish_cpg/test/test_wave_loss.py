@@ -2,14 +2,20 @@
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
+from wirefish_cpg.from_rest import phases_from_rest
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.reference_loss import simulated_body_wave_loss
-from wirefish_cpg.steady_state import steady_state_phases
+from wirefish_cpg.steady_state import stable_phase_difference, steady_state_phases
 from wirefish_cpg.tuning import fit_gait
-from wirefish_cpg.wave_loss import (body_wave_loss, FREQUENCY_PENALTY, PAPER_LOWER,
-                                    PAPER_UPPER, parameters_at, position_of, swarm_waveforms,
-                                    WaveFitProblem, waveform_loss, WaveSpec)
+from wirefish_cpg.wave_loss import (body_wave_loss, desired_swing_angles, FREQUENCY_PENALTY,
+                                    literal_body_wave_loss, literal_swing_rmse_deg,
+                                    literal_waveforms, PAPER_LOWER, PAPER_UPPER,
+                                    parameters_at, position_of, swarm_waveforms,
+                                    swing_angle_rmse_deg, WaveFitProblem, waveform_loss,
+                                    WaveSpec)
+from wirefish_kinematics.body_wave import body_positions
 
 PAPER_RMSE_DEG = (1.7165, 1.2817)
 TABLE1 = position_of(CpgParameters())
@@ -113,3 +119,89 @@ def test_few_iterations_already_give_a_usable_fit():
 def test_invalid_waves_are_rejected(kwargs):
     with pytest.raises(ValueError):
         WaveSpec(**kwargs)
+
+
+# --- the paper-literal mode (issue 16): v = the wave's frequency, eq 1 from rest, [t_s, t_o] ---
+
+def _eq1_from_rest_by_dop853(position, times, frequency_hz, alpha=20.0):
+    """Integrate the six states of eq 1 from rest with scipy; return Theta (T, 2) at times."""
+    w12, w21, phi12, phi21, big_r1, big_r2 = position
+
+    def rhs(_, s):
+        xi1, xi2, r1, r2, dr1, dr2 = s
+        return [2 * np.pi * frequency_hz + r2 * w12 * np.sin(xi2 - xi1 - phi12),
+                2 * np.pi * frequency_hz + r1 * w21 * np.sin(xi1 - xi2 - phi21),
+                dr1, dr2, alpha * (alpha / 4 * (big_r1 - r1) - dr1),
+                alpha * (alpha / 4 * (big_r2 - r2) - dr2)]
+
+    sol = solve_ivp(rhs, (0.0, times[-1]), [0.0] * 6, method='DOP853', rtol=1e-11, atol=1e-12,
+                    t_eval=times)
+    return np.stack([sol.y[2] * np.cos(sol.y[0]), sol.y[3] * np.cos(sol.y[1])], axis=-1)
+
+
+@pytest.mark.parametrize('position', POSITIONS, ids=range(len(POSITIONS)))
+def test_literal_loss_equals_an_independent_time_domain_integration(position):
+    times = PROBLEM.window_times()
+    angles = _eq1_from_rest_by_dop853(position, times, PROBLEM.wave.frequency_hz)
+    g = PROBLEM.geometry
+    beta1 = g.rd1 * angles[:, 0] / g.r1
+    beta2 = g.rd2 * angles[:, 1] / g.r2 - beta1
+    stations = np.array([g.l1, g.l1 + g.l2])
+    _, y = body_positions(stations, beta1, beta2, g)
+    envelope = 0.15 * stations + stations ** 2
+    y_body = envelope * np.sin(8.0 * stations - 2 * np.pi * times[:, None])
+    independent = np.trapezoid(np.abs(y_body - y).sum(axis=1), times)
+    literal = literal_body_wave_loss(position[None], PROBLEM)[0]
+    assert literal == pytest.approx(independent, rel=1e-7)
+
+
+def test_literal_waveforms_are_eq1_from_rest_at_the_wave_frequency():
+    times = PROBLEM.window_times()
+    angles = literal_waveforms(POSITIONS[1][None], PROBLEM)[0]
+    np.testing.assert_allclose(angles, _eq1_from_rest_by_dop853(POSITIONS[1], times, 1.0),
+                               atol=1e-8)
+
+
+def test_literal_swarm_loss_equals_the_particle_by_particle_loss():
+    swarm = np.random.default_rng(6).uniform(PAPER_LOWER, PAPER_UPPER, (25, 6))
+    together = literal_body_wave_loss(swarm, PROBLEM)
+    apart = [literal_body_wave_loss(x[None], PROBLEM)[0] for x in swarm]
+    np.testing.assert_allclose(together, apart, rtol=1e-12)
+
+
+def test_literal_window_defaults_start_after_table1_has_locked():
+    xi1, xi2 = phases_from_rest(PROBLEM.window_start_s, 1.0, 0.38, 0.47, -0.41, 0.64, 1.76,
+                                1.06)
+    assert abs(xi2 - xi1 - stable_phase_difference(0.38, 0.47, -0.41, 0.64, 1.76, 1.06)) < 1e-3
+
+
+def test_literal_fit_reaches_the_paper_swing_angle_rmse():
+    result = fit_gait(PROBLEM, np.random.default_rng(0), PsoOptions(max_iterations=300),
+                      mode='literal')
+    assert result.params.frequency_hz == PROBLEM.wave.frequency_hz
+    assert np.all(result.rmse_theta_deg <= PAPER_RMSE_DEG)
+    assert result.loss == pytest.approx(
+        literal_body_wave_loss(result.pso.best_position[None], PROBLEM)[0], rel=1e-12)
+
+
+def test_table1_scores_worse_literally_than_phase_free():
+    literal = literal_swing_rmse_deg(TABLE1[None], PROBLEM)[0]
+    assert np.all(literal > swing_angle_rmse_deg(TABLE1[None], PROBLEM)[0])
+
+
+def test_chord_theta_bar_is_the_arcsine_of_the_wave_over_q():
+    chord = desired_swing_angles(PROBLEM, 'chord')
+    y = PROBLEM.desired()
+    np.testing.assert_allclose(np.sin(chord) * PROBLEM.stations(), y, atol=1e-15)
+    assert np.all(np.abs(chord) >= np.abs(desired_swing_angles(PROBLEM, 'axial')))
+
+
+def test_unknown_fit_mode_is_refused():
+    with pytest.raises(ValueError, match='mode'):
+        fit_gait(PROBLEM, np.random.default_rng(0), mode='paper')
+
+
+@pytest.mark.parametrize('window', [(5.0, 5.0), (-1.0, 4.0), (10.0, 2.0), (0.0, float('nan'))])
+def test_invalid_literal_windows_are_refused(window):
+    with pytest.raises(ValueError, match='window'):
+        WaveFitProblem(window_start_s=window[0], window_end_s=window[1])

@@ -8,8 +8,8 @@ import time
 import numpy as np
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import minimise, ProgressCallback, PsoOptions, PsoResult
-from wirefish_cpg.wave_loss import (body_wave_loss, PAPER_LOWER, PAPER_UPPER, parameters_at,
-                                    swing_angle_rmse_deg, WaveFitProblem)
+from wirefish_cpg.wave_loss import (check_mode, PAPER_LOWER, PAPER_UPPER, parameters_at,
+                                    swarm_loss, swarm_swing_rmse_deg, WaveFitProblem)
 
 
 @dataclass(frozen=True)
@@ -32,19 +32,25 @@ class FitResult:
 def fit_gait(problem: WaveFitProblem, rng: np.random.Generator,
              options: PsoOptions = PsoOptions(), lower: np.ndarray = PAPER_LOWER,
              upper: np.ndarray = PAPER_UPPER, alpha: float = 20.0,
-             callback: ProgressCallback | None = None) -> FitResult:
+             callback: ProgressCallback | None = None, mode: str = 'phase_free'
+             ) -> FitResult:
     """
-    Return the CPG parameters whose locked output best follows ``problem``'s wave.
+    Return the CPG parameters whose output best follows ``problem``'s wave.
 
     Searches (w12, w21, phi12, phi21, R1, R2) in [lower, upper] (6,) (default: the paper's
-    bounds) with alpha fixed and offsets 0, as in paper section 4.1.
+    bounds) with alpha fixed and offsets 0, as in paper section 4.1. ``mode`` (``FIT_MODES``
+    of wave_loss): 'phase_free' scores the locked output with v chosen to lock at the wave's
+    frequency; 'literal' is the paper's problem (v = the wave's frequency, eq 1 from rest,
+    eq 24 over [t_s, t_o]). Raises ``ValueError`` for an unknown mode.
     """
+    check_mode(mode)
     start = time.perf_counter()
-    result = minimise(lambda x: body_wave_loss(x, problem), lower, upper, rng, options,
-                      callback)
+    result = minimise(lambda x: swarm_loss(x, problem, mode, alpha), lower, upper, rng,
+                      options, callback)
     elapsed = time.perf_counter() - start
     best = result.best_position
-    return FitResult(params=parameters_at(best, problem, alpha=alpha),
+    return FitResult(params=parameters_at(best, problem, alpha=alpha, mode=mode),
                      loss=float(result.best_loss),
-                     rmse_theta_deg=swing_angle_rmse_deg(best[None, :], problem)[0],
+                     rmse_theta_deg=swarm_swing_rmse_deg(best[None, :], problem, mode,
+                                                         alpha=alpha)[0],
                      iterations=result.iterations, elapsed_s=elapsed, pso=result)

@@ -19,6 +19,16 @@ window [t_s, t_o] are known without integrating eq 1. Two decisions make the los
 The window is ``window_periods`` whole periods of the desired wave (default 1), sampled at
 ``samples_per_period`` instants; the rectangle rule is the natural quadrature of a periodic
 integrand. The loss is in m*s.
+
+Two fit modes (``FIT_MODES``). ``'phase_free'`` (the default, above) is the engineering problem:
+the robot's phase is arbitrary and v is whatever locks the network to the wave. ``'literal'`` is
+the paper's own problem (sections 4.1 and 5.2): v = omega / 2 pi (the wave's frequency), eq 1
+started from rest with alpha = 20 (``from_rest``, exact), the same clock t in y_body and in the
+CPG, and eq 24 integrated over [t_s, t_o] = [``window_start_s``, ``window_end_s``] by the
+trapezoid rule (the integrand is not periodic: a network locked off the wave's frequency
+drifts). Default window [20 s, 25 s]: from rest, Table 1's phase difference is still 0.17 rad
+from its lock at 5 s and within 3e-4 rad of it at 20 s (lock rate C = 0.43 1/s); five periods
+show a 0.01 Hz frequency error as 0.3 rad of drift.
 """
 
 from __future__ import annotations
@@ -27,6 +37,7 @@ from dataclasses import dataclass, field
 import math
 
 import numpy as np
+from wirefish_cpg.from_rest import outputs_from_rest
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import intrinsic_frequency_for, stable_phase_difference
 from wirefish_kinematics.body_wave import body_positions, swing_angles
@@ -43,6 +54,11 @@ PAPER_UPPER = -PAPER_LOWER
 # Loss added (m*s) when the locked frequency cannot be reached with an admissible v: far above
 # any real fit (a perfect miss of the section 5.2 wave costs about 0.08 m*s per period).
 FREQUENCY_PENALTY = 10.0
+FIT_MODES = ('phase_free', 'literal')
+# Expected swing angle theta-bar_i of section 5.2 (unstated in the paper): 'axial' puts the wave
+# point at x = q_i (atan2(y_body, q_i), the project's); 'chord' at distance q_i from O0
+# (x = sqrt(q_i^2 - y_body^2), i.e. asin(y_body / q_i)).
+THETA_BAR_DEFINITIONS = ('axial', 'chord')
 
 
 @dataclass(frozen=True)
@@ -85,6 +101,16 @@ class WaveFitProblem:
     window_periods: int = 1
     max_frequency_hz: float = 10.0
     reverse_wave: bool = False
+    window_start_s: float = 20.0  # t_s of eq 24 in the literal mode (module docstring)
+    window_end_s: float = 25.0  # t_o
+
+    def __post_init__(self) -> None:
+        """Check the literal window: 0 <= t_s < t_o <= t_s + 1000 s (ValueError)."""
+        start, end = float(self.window_start_s), float(self.window_end_s)
+        if not (math.isfinite(start) and math.isfinite(end) and 0.0 <= start < end
+                and end - start <= 1000.0):
+            raise ValueError(f'window [{start}, {end}] s must satisfy 0 <= t_s < t_o '
+                             '<= t_s + 1000 s')
 
     def stations(self) -> np.ndarray:
         """Return q1 = l1 and q2 = l1 + l2 (m), the link ends O1 and O2 of eq 25, (2,)."""
@@ -99,12 +125,19 @@ class WaveFitProblem:
         """Return the sign of omega t in eq 23 used here (the project's, or the reverse)."""
         return -WAVE_TIME_SIGN if self.reverse_wave else WAVE_TIME_SIGN
 
-    def desired(self) -> np.ndarray:
-        """Return y_body(q_i, t_n) of eq 23 at the stations, (N, 2) m."""
+    def desired(self, times: np.ndarray | None = None) -> np.ndarray:
+        """Return y_body(q_i, t_n) of eq 23 at the stations, (N, 2) m (default: ``times()``)."""
         w = self.wave
+        times = self.times() if times is None else times
         return np.asarray(desired_lateral_position(
-            self.stations()[None, :], self.times()[:, None], w.c1, w.c2, w.k, w.frequency_hz,
+            self.stations()[None, :], times[:, None], w.c1, w.c2, w.k, w.frequency_hz,
             time_sign=self.time_sign()))
+
+    def window_times(self) -> np.ndarray:
+        """Return the literal mode's instants on [t_s, t_o], both ends, (N,) s."""
+        span = self.window_end_s - self.window_start_s
+        count = max(int(round(self.samples_per_period * self.wave.frequency_hz * span)), 2)
+        return np.linspace(self.window_start_s, self.window_end_s, count + 1)
 
 
 @dataclass(frozen=True)
@@ -186,29 +219,122 @@ def admissible_frequency(intrinsic_hz: np.ndarray, problem: WaveFitProblem) -> n
     return (intrinsic_hz > 0.0) & (intrinsic_hz <= problem.max_frequency_hz)
 
 
-def desired_swing_angles(problem: WaveFitProblem) -> np.ndarray:
+def desired_swing_angles(problem: WaveFitProblem, theta_bar: str = 'axial',
+                         times: np.ndarray | None = None) -> np.ndarray:
     """
     Return the expected swing angles theta-bar_i (N, 2) rad of section 5.2, from eq 23.
 
-    theta-bar_i = atan2(y_body(q_i, t), q_i) (``wirefish_kinematics.desired_wave``).
+    'axial': theta-bar_i = atan2(y_body(q_i, t), q_i) (``wirefish_kinematics.desired_wave``);
+    'chord': asin(y_body / q_i) (``THETA_BAR_DEFINITIONS``). Default times: ``times()``.
     """
     w = problem.wave
-    return np.stack(wave_swing_angles(problem.times(), w.c1, w.c2, w.k, w.frequency_hz,
-                                      problem.geometry, time_sign=problem.time_sign()),
-                    axis=-1)
+    times = problem.times() if times is None else times
+    if theta_bar == 'axial':
+        return np.stack(wave_swing_angles(times, w.c1, w.c2, w.k, w.frequency_hz,
+                                          problem.geometry, time_sign=problem.time_sign()),
+                        axis=-1)
+    if theta_bar == 'chord':
+        ratio = problem.desired(times) / problem.stations()[None, :]
+        return np.arcsin(np.clip(ratio, -1.0, 1.0))
+    raise ValueError(f'theta_bar must be one of {THETA_BAR_DEFINITIONS}, got {theta_bar!r}')
 
 
-def swing_angle_rmse_deg(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+def swing_angle_rmse_deg(positions: np.ndarray, problem: WaveFitProblem,
+                         theta_bar: str = 'axial') -> np.ndarray:
     """Return the RMSE of theta_1, theta_2 against theta-bar over one period, (P, 2) degrees."""
-    return waveform_swing_rmse_deg(swarm_waveforms(positions, problem).angles, problem)
+    return waveform_swing_rmse_deg(swarm_waveforms(positions, problem).angles, problem,
+                                   theta_bar)
 
 
-def waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+def waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem,
+                            theta_bar: str = 'axial') -> np.ndarray:
     """Return the swing-angle RMSE (P, 2) degrees of servo angles (P, N, 2) (section 5.2)."""
-    beta1, beta2 = bend_angles(angles[..., 0], angles[..., 1], problem.geometry)
-    theta = np.stack(swing_angles(beta1, beta2, problem.geometry), axis=-1)
-    error = theta - desired_swing_angles(problem)[None]
+    error = _swing_angles_of(angles, problem) - desired_swing_angles(problem, theta_bar)[None]
     return np.degrees(np.sqrt(np.mean(error ** 2, axis=-2)))
+
+
+def _swing_angles_of(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """Return theta_1, theta_2 (..., 2) rad of servo angles (..., 2) (eqs 3-15, section 5.2)."""
+    beta1, beta2 = bend_angles(angles[..., 0], angles[..., 1], problem.geometry)
+    return np.stack(swing_angles(beta1, beta2, problem.geometry), axis=-1)
+
+
+def literal_waveforms(positions: np.ndarray, problem: WaveFitProblem, alpha: float = 20.0
+                      ) -> np.ndarray:
+    """
+    Return the servo angles (P, N, 2) rad on ``window_times()`` of the literal mode.
+
+    eq 1 from rest (``from_rest``) with v = the wave's frequency, alpha, b = 0; t is the same
+    clock as eq 23's (module docstring).
+    """
+    w12, w21, phi12, phi21, r1, r2 = (v[:, None] for v in
+                                      np.moveaxis(np.atleast_2d(positions), -1, 0))
+    return outputs_from_rest(problem.window_times()[None, :], problem.wave.frequency_hz,
+                             r1, r2, w12, w21, phi12, phi21, alpha)
+
+
+def literal_waveform_loss(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
+    """
+    Return eq 24 over [t_s, t_o] (m*s) for servo angles (P, N, 2) on ``window_times()``, (P,).
+
+    e(t) of eq 25 against y_body at the same instants; trapezoid rule.
+    """
+    times = problem.window_times()
+    error = np.abs(problem.desired(times)[None] - lateral_positions(angles, problem))
+    return _trapezoid(error.sum(axis=-1), times)
+
+
+def literal_body_wave_loss(positions: np.ndarray, problem: WaveFitProblem,
+                           alpha: float = 20.0) -> np.ndarray:
+    """Return the paper-literal loss of eqs 24-25 (m*s) of every particle (P, 6), (P,)."""
+    return literal_waveform_loss(literal_waveforms(positions, problem, alpha), problem)
+
+
+def literal_swing_rmse_deg(positions: np.ndarray, problem: WaveFitProblem,
+                           theta_bar: str = 'axial', alpha: float = 20.0) -> np.ndarray:
+    """Return the theta_1, theta_2 RMSE (P, 2) degrees over [t_s, t_o] in the literal mode."""
+    return literal_waveform_swing_rmse_deg(literal_waveforms(positions, problem, alpha),
+                                           problem, theta_bar)
+
+
+def literal_waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem,
+                                    theta_bar: str = 'axial') -> np.ndarray:
+    """Return the swing RMSE (P, 2) degrees of servo angles (P, N, 2) on ``window_times()``."""
+    times = problem.window_times()
+    expected = desired_swing_angles(problem, theta_bar, times)
+    error = _swing_angles_of(angles, problem) - expected[None]
+    mean_square = _trapezoid(np.moveaxis(error ** 2, -2, -1), times) / (times[-1] - times[0])
+    return np.degrees(np.sqrt(mean_square))
+
+
+def _trapezoid(values: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Return the trapezoid rule over the last axis of ``values`` sampled at ``times``."""
+    step = np.diff(times)
+    return np.sum(0.5 * (values[..., 1:] + values[..., :-1]) * step, axis=-1)
+
+
+def check_mode(mode: str) -> str:
+    """Return ``mode`` if it is one of ``FIT_MODES``; else raise ``ValueError``."""
+    if mode not in FIT_MODES:
+        raise ValueError(f'mode must be one of {FIT_MODES}, got {mode!r}')
+    return mode
+
+
+def swarm_loss(positions: np.ndarray, problem: WaveFitProblem, mode: str = 'phase_free',
+               alpha: float = 20.0) -> np.ndarray:
+    """Return the loss (P,) m*s of every particle (P, 6) in fit ``mode`` (``FIT_MODES``)."""
+    if check_mode(mode) == 'literal':
+        return literal_body_wave_loss(positions, problem, alpha)
+    return body_wave_loss(positions, problem)
+
+
+def swarm_swing_rmse_deg(positions: np.ndarray, problem: WaveFitProblem,
+                         mode: str = 'phase_free', theta_bar: str = 'axial',
+                         alpha: float = 20.0) -> np.ndarray:
+    """Return the swing-angle RMSE (P, 2) degrees of every particle in fit ``mode``."""
+    if check_mode(mode) == 'literal':
+        return literal_swing_rmse_deg(positions, problem, theta_bar, alpha)
+    return swing_angle_rmse_deg(positions, problem, theta_bar)
 
 
 def position_of(params: CpgParameters) -> np.ndarray:
@@ -217,10 +343,19 @@ def position_of(params: CpgParameters) -> np.ndarray:
 
 
 def parameters_at(position: np.ndarray, problem: WaveFitProblem, alpha: float = 20.0,
-                  offset: tuple[float, float] = (0.0, 0.0)) -> CpgParameters:
-    """Return the CPG parameters of a position, with v chosen to lock to the wave's frequency."""
-    forms = swarm_waveforms(np.asarray(position)[None, :], problem)
+                  offset: tuple[float, float] = (0.0, 0.0), mode: str = 'phase_free'
+                  ) -> CpgParameters:
+    """
+    Return the CPG parameters of a position in fit ``mode``.
+
+    'phase_free': v chosen to lock to the wave's frequency; 'literal': v = the wave's frequency.
+    """
+    if check_mode(mode) == 'literal':
+        frequency = problem.wave.frequency_hz
+    else:
+        frequency = float(swarm_waveforms(np.asarray(position)[None, :],
+                                          problem).intrinsic_hz[0])
     w12, w21, phi12, phi21, r1, r2 = (float(v) for v in position)
-    return CpgParameters(frequency_hz=float(forms.intrinsic_hz[0]), amplitude=(r1, r2),
+    return CpgParameters(frequency_hz=frequency, amplitude=(r1, r2),
                          offset=offset, w12=w12, w21=w21, phi12=phi12, phi21=phi21,
                          alpha=alpha)
