@@ -29,3 +29,23 @@ def test_a_node_refuses_to_start_on_invalid_values(ros_env, package, node, overr
     assert result.returncode == 1, output
     assert reason in output and node in output, output
     assert 'Traceback' not in output, output
+
+
+@pytest.mark.parametrize('package, node, override, expected, given', [
+    ('wirefish_bridge', 'bridge_node', 'baudrate:=fast', 'an integer', "a string 'fast'"),
+    ('wirefish_bridge', 'bridge_node', 'baudrate:=115200.0', 'an integer',
+     "a double '115200.0'"),
+    ('wirefish_cpg', 'cpg_node', 'frequency_hz:=2', 'a double', "an integer '2'"),
+    ('wirefish_cpg', 'tuner_node', 'swarm_size:=true', 'an integer', "a bool 'True'"),
+    ('wirefish_kinematics', 'kinematics_node', 'l1:=long', 'a double', "a string 'long'"),
+])
+def test_a_value_of_the_wrong_type_gives_one_fatal_line(ros_env, package, node, override,
+                                                         expected, given):
+    result = subprocess.run([executable(package, node), '--ros-args', '-p', override],
+                            env=ros_env, capture_output=True, text=True, timeout=60)
+    lines = (result.stdout + result.stderr).strip().splitlines()
+    name = override.split(':=')[0]
+    assert result.returncode == 1, lines
+    assert len(lines) == 1 and '[FATAL]' in lines[0], lines
+    assert f'{node}: parameter {name} must be {expected}' in lines[0], lines
+    assert f'given {given}' in lines[0], lines

@@ -27,12 +27,8 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import Vector3Stamped
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
@@ -43,9 +39,9 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, SERVO_NAMES,
                                           servo_state_message)
 from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, SerialLink
-from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
-                                             validate_update)
-from wirefish_common.shutdown import SignalShutdown
+from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.qos import RELIABLE, SENSOR_DATA
 
 PARAMETERS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '
@@ -79,7 +75,6 @@ PARAMETERS = (
 )
 SPECS = {spec.name: spec for spec in PARAMETERS}
 LINK_PARAMETERS = {'port', 'baudrate', 'reconnect_backoff_min_s', 'reconnect_backoff_max_s'}
-RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 
 
 def check_combination(values: dict[str, object]) -> str | None:
@@ -119,16 +114,16 @@ class BridgeNode(Node):
         self._last_telemetry: float | None = None
         self._rate_window = (time.monotonic(), 0, 0)
 
-        self._imu_pub = self.create_publisher(Imu, 'imu/data', qos_profile_sensor_data)
+        self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
         self._attitude_pub = self.create_publisher(Vector3Stamped, 'attitude',
-                                                   qos_profile_sensor_data)
+                                                   SENSOR_DATA)
         self._servo_pub = self.create_publisher(JointState, 'servo_state',
-                                                qos_profile_sensor_data)
+                                                SENSOR_DATA)
         self._battery_pub = self.create_publisher(BatteryState, 'battery',
-                                                  qos_profile_sensor_data)
+                                                  SENSOR_DATA)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
-                                 qos_profile_sensor_data)
+                                 SENSOR_DATA)
         self._wake = self.create_guard_condition(self._drain_inbox)
         self._bridge_timers = {}
         self._make_timers()
@@ -368,14 +363,4 @@ def _status_names(status: int) -> str:
 
 def main(args: list[str] | None = None) -> None:
     """Run the bridge until SIGINT/SIGTERM; the port is closed and its thread joined."""
-    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    node = create_node_or_exit(BridgeNode)
-    signals.attach(node)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(BridgeNode, args)

@@ -3,8 +3,10 @@
 import math
 
 import pytest
+from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.parameter import Parameter
 from wirefish_common.parameter_table import (check_value, merged_update, ParameterSpec,
-                                             validate_update)
+                                             validate_update, wrong_type_reason)
 
 RATE = ParameterSpec('rate', 50.0, 'a rate (Hz)', 0.0, 100.0, low_exclusive=True)
 COUNT = ParameterSpec('count', 5, 'a count', 1, 10)
@@ -64,3 +66,26 @@ def test_validate_update_judges_values_then_their_combination(updates, successfu
     result = validate_update({'rate': RATE, 'count': COUNT}, {'rate': 50.0, 'count': 5},
                              [_Param(*u) for u in updates], _geometry)
     assert result.successful == successful and reason_has in result.reason
+
+
+def rclpy_wrong_type(name: str, value: object, expected: str) -> str:
+    """Return the text of the exception rclpy raises for a start-up value of the wrong type."""
+    return str(InvalidParameterTypeException(Parameter(name, value=value), expected).args[0])
+
+
+@pytest.mark.parametrize('spec, value, expected, given', [
+    (RATE, 2, 'must be a double (default 50.0)', "given an integer '2' (write 2.0)"),
+    (COUNT, 'five', 'must be an integer (default 5)', "given a string 'five'"),
+    (COUNT, 5.0, 'must be an integer (default 5)', "given a double '5.0'"),
+    (FLAG, 1, 'must be a bool (default False)', "given an integer '1'"),
+    (PORT, 3, "must be a string (default '/dev/ttyUSB0')", "given an integer '3'"),
+])
+def test_a_wrong_type_is_named_with_the_expected_and_the_given_type(spec, value, expected, given):
+    line = wrong_type_reason('a_node', spec, rclpy_wrong_type(spec.name, value, 'X'))
+    assert line == f'a_node: parameter {spec.name} {expected}, {given}'
+
+
+def test_a_wrong_type_message_of_another_form_is_kept_whole():
+    line = wrong_type_reason('a_node', RATE, 'something else went wrong')
+    assert line == ('a_node: parameter rate must be a double (default 50.0): '
+                    'something else went wrong')

@@ -1,5 +1,5 @@
 """
-Ctrl-C and SIGTERM stop a node between two callbacks, never in the middle of one.
+Ctrl-C and SIGTERM stop a process between two callbacks, never in the middle of one.
 
 With rclpy's own signal handling, a signal either raises KeyboardInterrupt wherever the main
 thread is (inside a pybind11 call that surfaces as ``RuntimeError: Unable to convert call
@@ -8,19 +8,36 @@ argument ...``) or shuts the context down from rclpy's signal thread while a cal
 a busy node was interrupted. ``SignalShutdown`` replaces that: the C-level signal handler only
 writes to a socket (``signal.set_wakeup_fd``), a watcher thread wakes on it and triggers a guard
 condition of the node, and the executor runs that guard's callback like any other, between the
-others: it shuts the context down, so ``rclpy.spin`` returns (or raises
-ExternalShutdownException, which the Jazzy ``main()`` idiom catches).
+others: it shuts the context down, so the executor's spin returns.
 
-In ``main()``: ``SignalShutdown()`` and then ``rclpy.init(..., signal_handler_options=
-SignalHandlerOptions.NO)``; ``attach(node)`` once the node exists. A signal that arrives before
-``attach`` is kept and acted on as soon as the node is attached.
+However many signals arrive, the process stops once and exits 0:
+
+- a signal that arrives while the node is being destroyed finds its guard condition gone
+  (rclpy's ``InvalidHandle``): the stop is already under way, so it is dropped;
+- Python's own finalisation puts the default action (die of the signal: exit -2 / -15) back on
+  every signal that has a Python handler, so a late Ctrl-C used to kill a process that had
+  already stopped cleanly; from ``atexit`` on, SIGINT and SIGTERM are ignored instead.
+
+Nodes use it through ``wirefish_common.node_main.run_node``. Processes without a node to attach
+(a loop of their own) poll ``requested``. A signal that arrives before ``attach`` is kept and
+acted on as soon as a node is attached.
 """
 
 from __future__ import annotations
 
+import atexit
 import signal
 import socket
 import threading
+from typing import Any
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def ignore_stop_signals() -> None:
+    """Ignore SIGINT and SIGTERM from now on (the process is on its way out)."""
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, signal.SIG_IGN)
 
 
 class SignalShutdown:
@@ -29,26 +46,38 @@ class SignalShutdown:
     def __init__(self) -> None:
         """Route both signals to a watcher thread (call from the main thread)."""
         self.requested = False
-        self._guard = None
+        self._guard: Any = None
         self._receiver, sender = socket.socketpair()
         sender.setblocking(False)
         self._sender = sender  # kept open for the life of the process
-        signal.set_wakeup_fd(sender.fileno())
-        for signum in (signal.SIGINT, signal.SIGTERM):
+        # A full buffer only means signals are already waiting to be read: nothing to report.
+        signal.set_wakeup_fd(sender.fileno(), warn_on_full_buffer=False)
+        for signum in STOP_SIGNALS:
             # A Python handler must exist for the wakeup fd to be written; it does nothing.
             signal.signal(signum, lambda _signum, _frame: None)
+        atexit.register(ignore_stop_signals)
         threading.Thread(target=self._watch, name='signals', daemon=True).start()
 
-    def attach(self, node) -> None:
+    def attach(self, node: Any) -> None:
         """Give ``node`` the guard condition that shuts rclpy down once a signal came."""
         import rclpy
 
         self._guard = node.create_guard_condition(lambda: rclpy.try_shutdown())
         if self.requested:
-            self._guard.trigger()
+            self._trigger()
 
     def _watch(self) -> None:
         while self._receiver.recv(64):
             self.requested = True
-            if self._guard is not None:
-                self._guard.trigger()
+            self._trigger()
+
+    def _trigger(self) -> None:
+        from rclpy.exceptions import InvalidHandle
+
+        guard = self._guard
+        if guard is None:
+            return
+        try:
+            guard.trigger()
+        except InvalidHandle:  # the node is being destroyed: its stop is already under way
+            pass

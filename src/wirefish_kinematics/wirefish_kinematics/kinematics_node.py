@@ -28,17 +28,12 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
-                       ReliabilityPolicy)
-from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import Marker, MarkerArray
-from wirefish_common.parameter_table import create_node_or_exit
-from wirefish_common.shutdown import SignalShutdown
+from wirefish_common.node_main import run_node
+from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA
 from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_lateral_position, wave_time_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
@@ -53,10 +48,7 @@ from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate as SpeedEsti
 
 FRAME = 'tail_base'
 JOINTS = ('servo_1', 'servo_2')
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
-RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-MARKERS = QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE)
+MARKERS = reliable(depth=5)
 # Below this half range (m) of the tip's lateral motion the tail counts as at rest.
 REST_HALF_RANGE_M = 1e-4
 WARN_PERIOD_S = 2.0
@@ -139,7 +131,7 @@ class KinematicsNode(Node):
         self._beat: TailBeat | None = None
         self._beat_phase = 0.0  # phase (rad) of y(q1)'s fundamental at the beat's start
         self._warned: dict[str, float] = {}
-        self._body_pub = self.create_publisher(BodyWave, 'body_wave', qos_profile_sensor_data)
+        self._body_pub = self.create_publisher(BodyWave, 'body_wave', SENSOR_DATA)
         # Reliable, unlike the data streams: RViz subscribes to markers reliably by default, and
         # a best-effort publisher would never match it. A reliable one matches both kinds.
         self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers', MARKERS)
@@ -187,7 +179,7 @@ class KinematicsNode(Node):
         self._latest, self._fresh = None, False
         self._last_beat_end = self._last_rest_t = self._last_detection_t = self._beat = None
         self._servo_sub = self.create_subscription(JointState, topic, self._on_servo,
-                                                   qos_profile_sensor_data)
+                                                   SENSOR_DATA)
 
     # --- inputs ---------------------------------------------------------------------------
     def _on_servo(self, msg: JointState) -> None:
@@ -319,14 +311,4 @@ class KinematicsNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the kinematics node until shutdown."""
-    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    node = create_node_or_exit(KinematicsNode)
-    signals.attach(node)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(KinematicsNode, args)

@@ -1,0 +1,27 @@
+"""
+The QoS profiles of every wirefish topic and service client, defined once.
+
+- ``SENSOR_DATA``: streams where only the latest sample matters (servo_cmd, imu/data, body_wave,
+  servo_state...): best effort, shallow; rclpy's ``qos_profile_sensor_data``.
+- ``RELIABLE``: commands, results and status a reader must not miss (/diagnostics,
+  speed_estimate, retune results): reliable, volatile, depth 10. ``reliable(depth)`` for
+  another depth.
+- ``LATCHED``: state a node announces once and a late joiner still needs (cpg_params,
+  target_wave): reliable, transient local, depth 1 (the last value).
+"""
+
+from __future__ import annotations
+
+from rclpy.qos import DurabilityPolicy, qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+
+SENSOR_DATA: QoSProfile = qos_profile_sensor_data
+
+
+def reliable(depth: int) -> QoSProfile:
+    """Return a reliable, volatile profile keeping ``depth`` samples."""
+    return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
+
+
+RELIABLE = reliable(10)
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
