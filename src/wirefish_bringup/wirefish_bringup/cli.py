@@ -17,6 +17,7 @@ SUBCOMMANDS = {
     'record': ('wirefish_bringup.record', 'record the graph into a rosbag2 (MCAP) bag'),
     'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait service)'),
     'report': ('wirefish_bringup.report', 'plots and a summary table from a recorded bag'),
+    'bag': ('wirefish_bringup.bag_command', 'reindex a killed recording; bag info'),
     'compose': ('wirefish_bringup.compose', "one fish's ROS nodes in a single process"),
 }
 # Other packages add subcommands through this entry-point group ('name = module'), as ros2cli

@@ -15,7 +15,11 @@ NOTHING_TIMEOUT_S = 30.0
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish record`."""
     parser.add_argument('-o', '--output', type=Path, default=None,
-                        help='bag directory (default: out/bags/wirefish_<time>); must not exist')
+                        help='bag directory (default: out/bags/wirefish_<time>); must not exist '
+                        'unless --resume')
+    parser.add_argument('--resume', action='store_true',
+                        help='if the bag exists (left by a killed recorder), reindex it and '
+                        'record on into its next file')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
     parser.add_argument('--duration', type=duration_s, default=None,
                         help='record this many seconds from the first message received '
@@ -38,13 +42,19 @@ def run(args: argparse.Namespace) -> int:
         return 2
     bag_path = args.output or Path('out', 'bags',
                                    datetime.now().strftime('wirefish_%Y%m%d_%H%M%S'))
-    if bag_path.exists():
-        print(f'wirefish record: {bag_path} exists; choose a new -o', file=sys.stderr)
+    if bag_path.exists() and not args.resume:
+        print(f'wirefish record: {bag_path} exists; choose a new -o (or --resume)',
+              file=sys.stderr)
         return 2
     bag_path.parent.mkdir(parents=True, exist_ok=True)
     signals = SignalShutdown()  # Ctrl-C between callbacks: the bag is closed cleanly
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    recorder = BagRecorder(bag_path, namespace)
+    try:
+        recorder = BagRecorder(bag_path, namespace, resume=args.resume)
+    except (OSError, ValueError) as error:  # not a bag, or one that cannot be recovered
+        rclpy.try_shutdown()
+        print(f'wirefish record: {error}', file=sys.stderr)
+        return 2
     signals.attach(recorder)
     if args.duration is not None:
         started_ns = recorder.get_clock().now().nanoseconds
