@@ -16,7 +16,7 @@ import numpy as np
 import psutil
 
 from wirefish_bringup.graph import fish_graph, NodeSpec
-from wirefish_bringup.supervisor import remove_stale_link, Supervisor, wait_for_path
+from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 READY_TIMEOUT_S = 60.0
 
@@ -58,13 +58,9 @@ def processes(specs: list[NodeSpec], domain_id: int, log_dir: Path | None = None
     supervisor = Supervisor(log_dir, env=env)
     try:
         for spec in specs:
-            link = None
-            if spec.executable == 'fish_sim':
-                link = Path(spec.arguments[spec.arguments.index('--link') + 1])
-                remove_stale_link(link)
-            proc = supervisor.start(spec)
-            if link is not None:
-                wait_for_path(link, [proc], 15.0)
+            proc = supervisor.start(spec)  # removes a stale device link first
+            if spec.link is not None:
+                wait_for_path(spec.link, [proc], 15.0)
         yield supervisor
     finally:
         supervisor.stop()

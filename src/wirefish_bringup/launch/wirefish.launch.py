@@ -4,15 +4,29 @@ Start one fish's graph on a full ROS 2 Jazzy install.
     ros2 launch wirefish_bringup wirefish.launch.py sim:=true namespace:=/wirefish
     ros2 launch wirefish_bringup wirefish.launch.py sim:=false port:=/dev/ttyUSB0
 
-The nodes, names and arguments come from `wirefish_bringup.graph`, the same description that
-`wirefish up` (the launcher for machines without ros2 launch) uses.
+The nodes, names, parameters, start order and restart policies come from the registry in
+`wirefish_bringup.graph`, the one `wirefish up` (the launcher for machines without ros2 launch)
+uses. launch has no back-off: a node is respawned after its policy's first delay, at most
+``max_restarts`` times over the run; a required node that exits once more shuts the launch down.
 """
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph
+
+
+def _shutdown_after_last_retry(spec):
+    """Return an on_exit callback: Shutdown once the node's respawn retries are spent."""
+    exits = [0]
+
+    def on_exit(_event, _context):
+        exits[0] += 1
+        if exits[0] > spec.restart.max_restarts:
+            return [Shutdown(reason=f'{spec.name} (required) exited {exits[0]} times')]
+        return None
+    return on_exit
 
 
 def _nodes(context):
@@ -22,11 +36,16 @@ def _nodes(context):
     params_file = LaunchConfiguration('params_file').perform(context) or None
     actions = []
     for spec in fish_graph(namespace, sim=sim, port=port, params_file=params_file):
-        # graph.py builds the whole command line (namespace, parameter file and remaps as
-        # --ros-args), so launch_ros gets it verbatim and adds nothing of its own.
-        actions.append(Node(package=spec.package, executable=spec.executable,
-                            arguments=list(spec.arguments), output='screen',
-                            emulate_tty=True))
+        # The recorder (the only entry that parses its own options) runs with --duration
+        # under `wirefish up` only: fish_graph adds it only when given a bag.
+        actions.append(Node(
+            package=spec.package, executable=spec.executable, name=spec.name,
+            namespace=spec.namespace, arguments=list(spec.arguments),
+            parameters=[spec.params_file, dict(spec.parameters)],
+            respawn=spec.restart.respawn, respawn_delay=spec.restart.delay_s,
+            respawn_max_retries=spec.restart.max_restarts,
+            on_exit=_shutdown_after_last_retry(spec) if spec.restart.required else None,
+            output='screen', emulate_tty=True))
     return actions
 
 
@@ -36,7 +55,8 @@ def generate_launch_description():
                               description='drive the virtual fish (fish_sim) on a pty'),
         DeclareLaunchArgument('port', default_value='',
                               description='serial device of a real fish (sim:=false)'),
-        DeclareLaunchArgument('namespace', default_value=DEFAULT_NAMESPACE),
+        DeclareLaunchArgument('namespace', default_value=DEFAULT_NAMESPACE,
+                              description='ROS namespace of every node and topic of the fish'),
         DeclareLaunchArgument('params_file', default_value='',
                               description='parameter YAML (default: config/wirefish.yaml)'),
         OpaqueFunction(function=_nodes),

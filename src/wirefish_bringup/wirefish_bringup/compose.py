@@ -1,11 +1,13 @@
 """
 `wirefish compose`: all of one fish's ROS nodes in one process.
 
-The single-process mode of `wirefish up --single-process`: the same node classes, names,
-namespace and parameter file as the one-process-per-node graph, but one Python interpreter and
-one DDS participant instead of four, which is what limits how many fish fit on one machine.
-The tuner spins on an executor and thread of its own: a fit then never stalls the fish's
-streams, and its apply step, which waits for cpg_node's parameter service, can be answered.
+The single-process mode of `wirefish up --single-process`: every registry entry with a node
+class (`wirefish_bringup.graph.NODES`), with the same names, namespace, parameter file and
+extra parameters as the one-process-per-node graph, but one Python interpreter and one DDS
+participant instead of four, which is what limits how many fish fit on one machine. An entry
+marked ``own_executor`` (the tuner) spins on an executor and thread of its own: a fit then
+never stalls the fish's streams, and its apply step, which waits for cpg_node's parameter
+service, can be answered.
 """
 
 import argparse
@@ -13,21 +15,15 @@ import importlib
 import sys
 import threading
 
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, default_params_file, validate_namespace
-
-# node name -> 'module:Class'; each class takes rclpy Node keyword arguments.
-NODE_CLASSES = {
-    'bridge_node': 'wirefish_bridge.bridge_node:BridgeNode',
-    'cpg_node': 'wirefish_cpg.cpg_node:CpgNode',
-    'kinematics_node': 'wirefish_kinematics.kinematics_node:KinematicsNode',
-    'tuner_node': 'wirefish_cpg.tuner_node:TunerNode',
-}
+from wirefish_bringup.graph import (composable_entries, DEFAULT_NAMESPACE, default_params_file,
+                                    resolve, ros_arguments, validate_namespace)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish compose`."""
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
-    parser.add_argument('--port', required=True, help='serial device for the bridge')
+    parser.add_argument('--port', required=True,
+                        help="the fish's serial device (the nodes' {device} parameters)")
     parser.add_argument('--params-file', default=None, help='parameter YAML')
     parser.add_argument('--executor', choices=('single', 'multi'), default='single',
                         help='executor of the bridge, CPG and kinematics nodes: '
@@ -35,8 +31,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         'MultiThreadedExecutor; the tuner always has its own')
 
 
-def node_class(path: str) -> type:
-    """Return the class named by ``'module:Class'``."""
+def node_class(path: str | None) -> type:
+    """Return the class named by ``'module:Class'`` (None: the entry is not composable)."""
+    if path is None:
+        raise ValueError('this graph entry has no node class: it runs as a process of its own')
     module_name, class_name = path.split(':')
     return getattr(importlib.import_module(module_name), class_name)
 
@@ -67,17 +65,17 @@ def run(args: argparse.Namespace) -> int:
                 else MultiThreadedExecutor(num_threads=4))
     # As in its own process (tuner_node.main): a multi-threaded executor, so the service that
     # runs a fit can wait for the answer of cpg_node's parameter service.
-    tuner_executor = MultiThreadedExecutor(num_threads=4)
-    tuner_thread = threading.Thread(target=tuner_executor.spin, name='tuner', daemon=True)
+    own_executor = MultiThreadedExecutor(num_threads=4)
+    own_thread = threading.Thread(target=own_executor.spin, name='own_executor', daemon=True)
     try:
-        for name, path in NODE_CLASSES.items():
-            cli_args = ['--ros-args', '-r', f'__ns:={namespace}', '--params-file', params]
-            if name == 'bridge_node':
-                cli_args += ['-p', f'port:={args.port}']
-            node = node_class(path)(cli_args=cli_args)
+        for entry in composable_entries():
+            parameters = {k: resolve(v, device=args.port, namespace=namespace)
+                          for k, v in entry.parameters.items()}
+            cli_args = list(ros_arguments(entry.name, namespace, params, parameters))
+            node = node_class(entry.node_class)(cli_args=cli_args)
             nodes.append(node)
-            (tuner_executor if name == 'tuner_node' else executor).add_node(node)
-        tuner_thread.start()
+            (own_executor if entry.own_executor else executor).add_node(node)
+        own_thread.start()
         while not stop_requested:
             executor.spin_once(timeout_sec=0.1)
     except InvalidParameters as error:
@@ -85,9 +83,9 @@ def run(args: argparse.Namespace) -> int:
         return 1
     finally:
         executor.shutdown()
-        tuner_executor.shutdown()
-        if tuner_thread.is_alive():
-            tuner_thread.join(5.0)
+        own_executor.shutdown()
+        if own_thread.is_alive():
+            own_thread.join(5.0)
         for node in reversed(nodes):
             node.destroy_node()
         rclpy.try_shutdown()

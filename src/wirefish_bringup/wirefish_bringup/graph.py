@@ -1,12 +1,27 @@
 """
-The wirefish node graph as data: which executables, with which names and arguments.
+The wirefish node graph as data: the one registry of a fish's processes (``NODES``).
 
-One description serves both roads: the `wirefish up` launcher (pip-only machines) and the
-`wirefish.launch.py` launch file (full ROS 2 installs) build their processes from it, so the two
-start exactly the same nodes with exactly the same parameters.
+Everything that starts or checks the graph reads ``NODES``: the `wirefish up` launcher, the
+single-process mode (`wirefish compose`), `launch/wirefish.launch.py`, the signal tests and the
+end-to-end tests (the streams and rates below). Adding a node is one ``NodeEntry`` here plus its
+package (its setup.py entry point and its YAML section).
+
+Restart policy (issue 12 item 10). A process of the graph that exits while the graph runs is
+restarted after ``delay_s``; each further restart within ``window_s`` waits ``backoff`` times
+longer (capped at ``max_delay_s``), so a crash loop slows down instead of spinning. The exit
+after ``max_restarts`` restarts within ``window_s`` spends the budget: the launcher reports the
+node as given up and keeps the rest of the graph running; if the node is ``required`` (the
+graph is useless without it: the fish, or the bridge that talks to it), it stops the whole
+graph with exit code 1. Either way `wirefish up` ends with a non-zero code, since the graph it
+ran was not whole. `ros2 launch` honours the same policy as far as launch can express it:
+``respawn``, ``respawn_delay`` (constant: launch has no back-off) and ``respawn_max_retries``
+(counted over the whole run, not per window); a required node shuts the launch down once its
+retries are spent.
 """
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+import math
 from pathlib import Path
 import re
 
@@ -16,19 +31,179 @@ DEFAULT_NAMESPACE = '/wirefish'
 PARAMS_FILE_NAME = 'wirefish.yaml'
 _NAMESPACE_PATTERN = re.compile(r'^(/[A-Za-z][A-Za-z0-9_]*)+$|^/$')
 
+# When an entry is part of the graph: always, only with the virtual fish, only when recording.
+ALWAYS, SIM, RECORD = 'always', 'sim', 'record'
+
 
 @dataclass(frozen=True)
-class NodeSpec:
-    """One process of the graph: `ros2 run <package> <executable> <arguments>`."""
+class RestartPolicy:
+    """How the graph answers a process's exit (see the module docstring)."""
+
+    respawn: bool = True
+    delay_s: float = 1.0
+    max_restarts: int = 3
+    window_s: float = 60.0
+    backoff: float = 2.0
+    max_delay_s: float = 10.0
+    required: bool = False
+
+    def __post_init__(self) -> None:
+        """Refuse a policy that cannot be honoured (a negative delay, a backoff below 1)."""
+        for name in ('delay_s', 'window_s', 'max_delay_s'):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f'restart policy: {name} must be finite and >= 0, got {value}')
+        if not (math.isfinite(self.backoff) and self.backoff >= 1.0):
+            raise ValueError(f'restart policy: backoff must be >= 1, got {self.backoff}')
+        if self.max_restarts < 0:
+            raise ValueError(f'restart policy: max_restarts must be >= 0, '
+                             f'got {self.max_restarts}')
+
+    def delay_before(self, restart_number: int) -> float:
+        """Return the wait before the ``restart_number``-th restart (1-based) in the window."""
+        return min(self.delay_s * self.backoff ** (restart_number - 1), self.max_delay_s)
+
+
+NO_RESTART = RestartPolicy(respawn=False, max_restarts=0)
+
+
+class RestartBudget:
+    """
+    The restarts one process has had within its policy's window (pure: times are passed in).
+
+    ``on_exit(now)`` answers each exit: the delay before restarting, or None once the budget
+    is spent (or the policy never restarts).
+    """
+
+    def __init__(self, policy: RestartPolicy) -> None:
+        """Start with no restarts."""
+        self.policy = policy
+        self._restarts: list[float] = []
+        self.total = 0
+
+    def on_exit(self, now: float) -> float | None:
+        """Return the delay before the restart this exit earns, or None: not restarted."""
+        if not self.policy.respawn:
+            return None
+        recent = [t for t in self._restarts if now - t < self.policy.window_s]
+        if len(recent) >= self.policy.max_restarts:
+            return None
+        self._restarts = [*recent, now]
+        self.total += 1
+        return self.policy.delay_before(len(self._restarts))
+
+    @property
+    def in_window(self) -> int:
+        """Return how many restarts the current window holds."""
+        return len(self._restarts)
+
+
+@dataclass(frozen=True)
+class NodeEntry:
+    """
+    One process of the registry.
+
+    ``name`` is its ROS node name; ``node_class`` (``'module:Class'``, taking rclpy Node
+    keyword arguments) lets the single-process mode host it, None keeps it a process of its
+    own. ``arguments`` go before ``--ros-args`` and ``parameters`` are set on top of the
+    parameter file; both may use ``{device}`` (the fish's serial device), ``{namespace}`` and
+    ``{bag}``; ``ros_args`` False: the process parses its own options only (no ``--ros-args``
+    section). ``start_order`` is the same whatever the role (lower first). ``creates_link``:
+    the process publishes ``{device}`` as a symlink (the launcher removes a stale one before
+    each start and waits for it at start-up). ``own_executor``: in one process it spins on a
+    multi-threaded executor and a thread of its own (its service waits for another node's
+    answer). ``rates_hz`` are its streams at their nominal rates at the default parameters,
+    ``min_rates_hz`` its slow streams (at least that often); ``fed_by`` names the nodes whose
+    output its streams are computed from (they may pause while one of those is down).
+    """
 
     package: str
     executable: str
     name: str
-    arguments: tuple[str, ...] = field(default=())
+    start_order: int
+    node_class: str | None = None
+    when: str = ALWAYS
+    arguments: tuple[str, ...] = ()
+    parameters: Mapping[str, str] = field(default_factory=dict)
+    ros_args: bool = True
+    creates_link: bool = False
+    own_executor: bool = False
+    restart: RestartPolicy = RestartPolicy()
+    rates_hz: Mapping[str, float] = field(default_factory=dict)
+    min_rates_hz: Mapping[str, float] = field(default_factory=dict)
+    fed_by: tuple[str, ...] = ()
+
+
+NODES: tuple[NodeEntry, ...] = (
+    NodeEntry('wirefish_sim', 'fish_sim', 'fish_sim', start_order=0, when=SIM,
+              arguments=('--link', '{device}', '--ros'), creates_link=True,
+              restart=RestartPolicy(required=True), rates_hz={'sim/ground_truth': 50.0}),
+    NodeEntry('wirefish_bridge', 'bridge_node', 'bridge_node', start_order=10,
+              node_class='wirefish_bridge.bridge_node:BridgeNode',
+              parameters={'port': '{device}'}, restart=RestartPolicy(required=True),
+              rates_hz={'imu/data': 100.0, 'attitude': 100.0, 'servo_state': 100.0},
+              min_rates_hz={'/diagnostics': 0.5, 'battery': 0.5}, fed_by=('fish_sim',)),
+    NodeEntry('wirefish_cpg', 'cpg_node', 'cpg_node', start_order=20,
+              node_class='wirefish_cpg.cpg_node:CpgNode', rates_hz={'servo_cmd': 200.0}),
+    NodeEntry('wirefish_kinematics', 'kinematics_node', 'kinematics_node', start_order=30,
+              node_class='wirefish_kinematics.kinematics_node:KinematicsNode',
+              rates_hz={'body_wave': 50.0, 'body_wave_markers': 50.0},
+              min_rates_hz={'speed_estimate': 0.5}, fed_by=('cpg_node',)),
+    NodeEntry('wirefish_cpg', 'tuner_node', 'tuner_node', start_order=40,
+              node_class='wirefish_cpg.tuner_node:TunerNode', own_executor=True),
+    # `wirefish up --duration`: not restarted, since `wirefish record` refuses an existing bag
+    # and a second bag of the run is not written yet; its exit is reported, the rest runs on.
+    NodeEntry('wirefish_bringup', 'wirefish', 'wirefish_recorder', start_order=50, when=RECORD,
+              arguments=('record', '-o', '{bag}', '--namespace', '{namespace}'),
+              ros_args=False, restart=NO_RESTART),
+)
+
+# The process that hosts every entry with a node_class in single-process mode.
+COMPOSED_NAME = 'fish_nodes'
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """
+    One process to start: `ros2 run <package> <executable> <arguments> [--ros-args ...]`.
+
+    ``arguments`` come first, verbatim; when ``namespace`` is set, a ``--ros-args`` section
+    follows with the node name, namespace, ``params_file`` and ``parameters``. ``ros_nodes``
+    are the ROS node names the process hosts; ``link`` the device symlink it creates.
+    """
+
+    package: str
+    executable: str
+    name: str
+    arguments: tuple[str, ...] = ()
+    namespace: str | None = None
+    params_file: str | None = None
+    parameters: Mapping[str, str] = field(default_factory=dict)
+    restart: RestartPolicy = NO_RESTART
+    ros_nodes: tuple[str, ...] = ()
+    link: Path | None = None
 
     def executable_path(self) -> Path:
         """Return the installed executable, where `ros2 run` finds it (lib/<package>/)."""
         return Path(get_package_prefix(self.package), 'lib', self.package, self.executable)
+
+    def command_arguments(self) -> tuple[str, ...]:
+        """Return the arguments after the executable (what `ros2 run` would pass)."""
+        if self.namespace is None:
+            return self.arguments
+        return (*self.arguments, *ros_arguments(self.name, self.namespace, self.params_file,
+                                                self.parameters))
+
+
+def ros_arguments(name: str, namespace: str, params_file: str | None,
+                  parameters: Mapping[str, str]) -> tuple[str, ...]:
+    """Return the ``--ros-args`` of one node: its name, namespace, parameter file and values."""
+    args = ['--ros-args', '-r', f'__node:={name}', '-r', f'__ns:={namespace}']
+    if params_file is not None:
+        args += ['--params-file', params_file]
+    for key, value in parameters.items():
+        args += ['-p', f'{key}:={value}']
+    return tuple(args)
 
 
 def validate_namespace(namespace: str) -> str:
@@ -53,16 +228,66 @@ def sim_tty_link(namespace: str) -> Path:
     return Path('/tmp', f'wirefish-{token}-tty')
 
 
+def entries(*, sim: bool, record: bool = False) -> list[NodeEntry]:
+    """Return the registry entries of a graph with or without the virtual fish, in start order."""
+    active = {ALWAYS, *([SIM] if sim else []), *([RECORD] if record else [])}
+    return sorted((e for e in NODES if e.when in active), key=lambda e: e.start_order)
+
+
+def composable_entries() -> list[NodeEntry]:
+    """Return the entries the single-process mode hosts (those with a node class), in order."""
+    return sorted((e for e in NODES if e.node_class is not None), key=lambda e: e.start_order)
+
+
+def entry(name: str) -> NodeEntry:
+    """Return the registry entry of node ``name``, or raise KeyError."""
+    for candidate in NODES:
+        if candidate.name == name:
+            return candidate
+    raise KeyError(f'no node {name!r} in the graph registry')
+
+
+def resolve(template: str, **values: str) -> str:
+    """Fill the ``{device}``/``{namespace}``/``{bag}`` placeholders of a registry value."""
+    try:
+        return template.format(**values)
+    except KeyError as error:
+        missing = error.args[0]
+        raise ValueError(f'{template!r} needs {missing!r}, which this graph lacks') from error
+
+
+def combined_policy(policies: list[RestartPolicy]) -> RestartPolicy:
+    """Return the policy of one process hosting several nodes: the strictest of theirs."""
+    return RestartPolicy(respawn=all(p.respawn for p in policies),
+                         delay_s=max(p.delay_s for p in policies),
+                         max_restarts=min(p.max_restarts for p in policies),
+                         window_s=max(p.window_s for p in policies),
+                         backoff=max(p.backoff for p in policies),
+                         max_delay_s=max(p.max_delay_s for p in policies),
+                         required=any(p.required for p in policies))
+
+
+def expected_rates(*, sim: bool = True) -> tuple[dict[str, float], dict[str, float]]:
+    """Return the graph's streams: ({topic: nominal Hz}, {slow topic: minimum Hz})."""
+    nominal: dict[str, float] = {}
+    minimum: dict[str, float] = {}
+    for e in entries(sim=sim):
+        nominal.update(e.rates_hz)
+        minimum.update(e.min_rates_hz)
+    return nominal, minimum
+
+
 def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
-               port: str | None = None, params_file: Path | None = None,
-               single_process: bool = False) -> list[NodeSpec]:
+               port: str | None = None, params_file: Path | str | None = None,
+               single_process: bool = False, bag: Path | None = None) -> list[NodeSpec]:
     """
     Return the processes of one fish's graph, in start order (the virtual fish first).
 
     ``namespace`` holds every node and (relative) topic; ``sim`` starts the virtual fish and
     points the bridge at its pseudo-terminal, otherwise ``port`` names the real fish's serial
     device; ``params_file`` is the parameter YAML (the installed default when None);
-    ``single_process`` runs the four ROS nodes in one process (`wirefish compose`).
+    ``single_process`` runs the ROS nodes with a node class in one process (`wirefish
+    compose`); ``bag`` adds the recorder, writing there.
 
     """
     namespace = validate_namespace(namespace)
@@ -72,24 +297,36 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
         raise ValueError(f'a serial port ({port}) was given for the virtual fish: '
                          'choose sim or a port (sim:=false port:=...)')
     params = str(params_file or default_params_file())
-    tty = str(sim_tty_link(namespace)) if sim else port
-
-    def ros_args(*extra: str) -> tuple[str, ...]:
-        return ('--ros-args', '-r', f'__ns:={namespace}', '--params-file', params, *extra)
-
+    device = str(sim_tty_link(namespace)) if sim else str(port)
+    values = {'device': device, 'namespace': namespace, **({'bag': str(bag)} if bag else {})}
     specs: list[NodeSpec] = []
-    if sim:
-        specs.append(NodeSpec('wirefish_sim', 'fish_sim', 'fish_sim',
-                              ('--link', tty, '--ros', *ros_args())))
-    if single_process:
-        specs.append(NodeSpec('wirefish_bringup', 'wirefish', 'fish_nodes', (
-            'compose', '--namespace', namespace, '--port', tty, '--params-file', params)))
-        return specs
-    specs += [
-        NodeSpec('wirefish_bridge', 'bridge_node', 'bridge_node',
-                 ros_args('-p', f'port:={tty}')),
-        NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node', ros_args()),
-        NodeSpec('wirefish_kinematics', 'kinematics_node', 'kinematics_node', ros_args()),
-        NodeSpec('wirefish_cpg', 'tuner_node', 'tuner_node', ros_args()),
-    ]
+    composed: list[NodeEntry] = []
+    for e in entries(sim=sim, record=bag is not None):
+        if single_process and e.node_class is not None:
+            composed.append(e)
+            continue
+        specs.append(NodeSpec(
+            e.package, e.executable, e.name,
+            arguments=tuple(resolve(a, **values) for a in e.arguments),
+            namespace=namespace if e.ros_args else None,
+            params_file=params,
+            parameters={k: resolve(v, **values) for k, v in e.parameters.items()},
+            # A process that parses its own options names its node itself (the recorder's
+            # is outside the namespace): nothing to wait for or to look for there.
+            restart=e.restart, ros_nodes=(e.name,) if e.ros_args else (),
+            link=Path(device) if e.creates_link else None))
+    if composed:
+        specs.append(NodeSpec(
+            'wirefish_bringup', 'wirefish', COMPOSED_NAME,
+            arguments=('compose', '--namespace', namespace, '--port', device,
+                       '--params-file', params),
+            restart=combined_policy([e.restart for e in composed]),
+            ros_nodes=tuple(e.name for e in composed)))
+        specs.sort(key=lambda s: _start_order(s, composed))
     return specs
+
+
+def _start_order(spec: NodeSpec, composed: list[NodeEntry]) -> int:
+    if spec.name == COMPOSED_NAME:
+        return min(e.start_order for e in composed)
+    return entry(spec.name).start_order

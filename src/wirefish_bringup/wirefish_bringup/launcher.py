@@ -2,25 +2,33 @@
 `wirefish up`: start one fish's whole graph, show its status, run until Ctrl-C, stop cleanly.
 
 The launcher for machines without `ros2 launch`; `launch/wirefish.launch.py` starts the same
-graph (see `wirefish_bringup.graph`) on a full install.
+graph (see `wirefish_bringup.graph`) on a full install. A node that exits is restarted by its
+restart policy (graph.py) while the others run on; a second `wirefish up` in a namespace whose
+nodes are already discovered on this ROS domain refuses to start (--allow-duplicate overrides).
 """
 
 import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
 from datetime import datetime
+import os
 from pathlib import Path
 import signal
 import sys
 import time
 
 from wirefish_bringup.cli import duration_s
-from wirefish_bringup.compose import NODE_CLASSES as COMPOSED_NODES
-from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, sim_tty_link,
-                                    validate_namespace)
-from wirefish_bringup.supervisor import remove_stale_link, Supervisor, wait_for_path
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, NodeSpec, validate_namespace
+from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
 STOP_GRACE_S = 10.0  # after a Ctrl-C during start-up, how long the nodes may take to be up
 DEVICE_TIMEOUT_S = 15.0
+# Start-up may include restarts with back-off (1 + 2 + 4 s) of a node that fails at once.
+READY_TIMEOUT_S = 60.0
+# How long a new `wirefish up` listens for the registry's nodes already in its namespace:
+# discovery on one host answers well within this, even on a loaded machine.
+DUPLICATE_CHECK_S = 2.0
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,58 +47,55 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--single-process', action='store_true',
                         help="run the fish's four ROS nodes in one process (wirefish compose)")
     parser.add_argument('--no-status', action='store_true', help='skip the topic-rate table')
+    parser.add_argument('--allow-duplicate', action='store_true',
+                        help='start even if nodes of the graph already run in this namespace '
+                        '(e.g. a graph that just died is still discovered)')
 
 
-def _wait_ready(namespace: str, node_names: list[str], show_status: bool,
-                stop_requested: list, timeout_s: float = 30.0) -> str | None:
+def _registry_nodes(specs: list[NodeSpec]) -> list[str]:
+    return [name for spec in specs for name in spec.ros_nodes]
+
+
+def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], supervisor: Supervisor,
+                show_status: bool, stop_requested: list,
+                timeout_s: float = READY_TIMEOUT_S) -> str | None:
     """
     Wait until every node of the graph is on the ROS graph; return the status table or None.
 
     A node is "up" once it is discoverable (its rclpy.init and constructor are done), so a
-    Ctrl-C after "running:" always reaches nodes that handle it cleanly.
+    Ctrl-C after "running:" always reaches nodes that handle it cleanly. Exits while waiting
+    are answered by the restart policies; a node given up on is no longer waited for.
     """
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.signals import SignalHandlerOptions
+    from wirefish_bringup.monitor import discovered_nodes, measure_rates, settle_discovery
 
-    from wirefish_bringup.monitor import measure_rates, settle_discovery
+    def expected() -> set[str]:
+        given_up = {name for key in supervisor.given_up
+                    for name in supervisor.specs[key].ros_nodes}
+        return {f'{namespace.rstrip("/")}/{name}'
+                for name in _registry_nodes(specs) if name not in given_up}
 
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node('wirefish_status', namespace=namespace)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    expected = {f'{namespace.rstrip("/")}/{name}' for name in node_names}
-
-    def discovered() -> set[str]:
-        return {f'{ns.rstrip("/")}/{name}' for name, ns in node.get_node_names_and_namespaces()}
-
-    try:
-        deadline = time.monotonic() + timeout_s
-        while not expected <= discovered():
-            if stop_requested and deadline > time.monotonic() + STOP_GRACE_S:
-                # A node interrupted while still importing dies of the SIGINT (exit -2, a
-                # KeyboardInterrupt trace): let every node finish starting, then stop them all.
-                print('wirefish up: stopping as soon as every node has started',
-                      file=sys.stderr)
-                deadline = time.monotonic() + STOP_GRACE_S
-            if time.monotonic() > deadline:
-                missing = ', '.join(sorted(expected - discovered()))
-                return None if stop_requested else f'not up after {timeout_s:g} s: {missing}'
-            executor.spin_once(timeout_sec=0.1)
-        if stop_requested:
-            return None
-        if not show_status:
-            return ''
-        settle_discovery(node, executor, namespace, should_stop=lambda: bool(stop_requested))
-        rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S,
-                              should_stop=lambda: bool(stop_requested))
-        if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
-            return None
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
-    lines = [f'nodes: {", ".join(sorted(expected))}',
+    deadline = time.monotonic() + timeout_s
+    while not expected() <= discovered_nodes(node):
+        _report(supervisor.supervise())
+        if stop_requested and deadline > time.monotonic() + STOP_GRACE_S:
+            # A node interrupted while still importing dies of the SIGINT (exit -2, a
+            # KeyboardInterrupt trace): let every node finish starting, then stop them all.
+            print('wirefish up: stopping as soon as every node has started', file=sys.stderr)
+            deadline = time.monotonic() + STOP_GRACE_S
+        if time.monotonic() > deadline:
+            missing = ', '.join(sorted(expected() - discovered_nodes(node)))
+            return None if stop_requested else f'not up after {timeout_s:g} s: {missing}'
+        executor.spin_once(timeout_sec=0.1)
+    if stop_requested:
+        return None
+    if not show_status:
+        return ''
+    settle_discovery(node, executor, namespace, should_stop=lambda: bool(stop_requested))
+    rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S,
+                          should_stop=lambda: bool(stop_requested))
+    if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
+        return None
+    lines = [f'nodes: {", ".join(sorted(expected()))}',
              f'{"topic":<40} {"type":<38} {"rate":>9}']
     for topic, (type_name, rate) in rates.items():
         shown = f'{rate:7.1f} Hz' if rate > 0 else 'no msgs'  # idle, or latched only
@@ -98,21 +103,46 @@ def _wait_ready(namespace: str, node_names: list[str], show_status: bool,
     return '\n'.join(lines)
 
 
+def _report(lines: list[str]) -> None:
+    for line in lines:
+        print(f'wirefish up: {line}', file=sys.stderr, flush=True)
+
+
+@contextmanager
+def _graph_probe(namespace: str) -> Iterator[tuple]:
+    """Yield (node, executor) of the launcher's own look at the ROS graph, then close them."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
+
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node('wirefish_status', namespace=namespace)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        yield node, executor
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish up`; return the process exit code."""
+    stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
+    run_dir = (args.out / f'run_{stamp}').resolve()
+    bag_path = run_dir / 'bag' if args.duration else None
     try:
         namespace = validate_namespace(args.namespace)
         sim = args.port is None
         specs = fish_graph(namespace, sim=sim, port=args.port, params_file=args.params_file,
-                           single_process=args.single_process)
+                           single_process=args.single_process, bag=bag_path)
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
-    stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
-    run_dir = (args.out / f'run_{stamp}').resolve()
     supervisor = Supervisor(run_dir / 'logs')
     stop_requested = []
 
@@ -121,28 +151,35 @@ def run(args: argparse.Namespace) -> int:
 
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)
-    bag_path = run_dir / 'bag' if args.duration else None
     code = 0
+    codes: dict[str, int | None] = {}
     try:
-        for spec in specs:
-            link = sim_tty_link(namespace) if spec.executable == 'fish_sim' else None
-            if link is not None:
-                remove_stale_link(link)
-            proc = supervisor.start(spec)
-            if link is not None:
-                if not wait_for_path(link, [proc], DEVICE_TIMEOUT_S):
-                    raise RuntimeError('the virtual fish did not open its pseudo-terminal:\n'
-                                       + supervisor.log_tail(spec.name))
-                print(f'virtual fish on {link} -> {link.resolve()}')
-        if bag_path is not None:
-            supervisor.start(NodeSpec('wirefish_bringup', 'wirefish', 'recorder', (
-                'record', '-o', str(bag_path), '--namespace', namespace)))
-        print(f'started {len(supervisor.processes)} processes in {namespace}; '
-              f'logs in {run_dir / "logs"}')
-        node_names = [spec.name for spec in specs if spec.name != 'fish_nodes']
-        if args.single_process:
-            node_names += list(COMPOSED_NODES)
-        status = _wait_ready(namespace, node_names, not args.no_status, stop_requested)
+        with _graph_probe(namespace) as (node, executor):
+            if not args.allow_duplicate:
+                from wirefish_bringup.monitor import registry_nodes_present
+                present = registry_nodes_present(node, executor, namespace,
+                                                 _registry_nodes(specs), DUPLICATE_CHECK_S,
+                                                 should_stop=lambda: bool(stop_requested))
+                if present:
+                    domain = os.environ.get('ROS_DOMAIN_ID', '0')
+                    print(f'wirefish up: namespace {namespace} is in use on ROS domain {domain} '
+                          f'({", ".join(present)} already running there): stop that graph, '
+                          'choose another --namespace, or pass --allow-duplicate',
+                          file=sys.stderr)
+                    return 1
+                if stop_requested:
+                    return 0
+            for spec in specs:
+                proc = supervisor.start(spec)
+                if spec.link is not None:
+                    if not wait_for_path(spec.link, [proc], DEVICE_TIMEOUT_S):
+                        raise RuntimeError('the virtual fish did not open its pseudo-terminal:\n'
+                                           + supervisor.log_tail(spec.name))
+                    print(f'virtual fish on {spec.link} -> {spec.link.resolve()}')
+            print(f'started {len(supervisor.processes)} processes in {namespace}; '
+                  f'logs in {run_dir / "logs"}', flush=True)
+            status = _wait_ready(node, executor, namespace, specs, supervisor,
+                                 not args.no_status, stop_requested)
         if status and status.startswith('not up'):
             raise RuntimeError(status)
         if status:
@@ -152,14 +189,10 @@ def run(args: argparse.Namespace) -> int:
         elif bag_path is not None:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
         else:
-            print('running: Ctrl-C stops everything')
+            print('running: Ctrl-C stops everything', flush=True)
         started = time.monotonic()
         while not stop_requested:
-            exited = supervisor.exited()
-            if exited:
-                name, rc = next(iter(exited.items()))
-                raise RuntimeError(f'{name} exited with code {rc}:\n'
-                                   + supervisor.log_tail(name))
+            _report(supervisor.supervise())
             if args.duration is not None and time.monotonic() - started >= args.duration:
                 break
             time.sleep(0.1)
@@ -168,6 +201,9 @@ def run(args: argparse.Namespace) -> int:
         code = 1
     finally:
         codes = supervisor.stop()
+    summary = supervisor.summary()
+    if summary:
+        print(f'wirefish up: {summary}', file=sys.stderr)
     unclean = {name: rc for name, rc in codes.items() if rc != 0}
     if unclean:
         print(f'wirefish up: processes that did not exit cleanly: {unclean}', file=sys.stderr)

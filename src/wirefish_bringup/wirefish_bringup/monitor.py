@@ -1,4 +1,4 @@
-"""Measure the rate of every topic of the graph (what `ros2 topic hz` shows, for all at once)."""
+"""Watch the ROS graph: which nodes run, and every topic's rate (`ros2 topic hz` for all)."""
 
 from collections.abc import Callable
 import time
@@ -11,6 +11,29 @@ from wirefish_bringup.topics import graph_topics, matching_qos, message_class
 
 def _never() -> bool:
     return False
+
+
+def discovered_nodes(node: Node) -> set[str]:
+    """Return the fully qualified names of the nodes ``node`` discovers now."""
+    return {f'{ns.rstrip("/")}/{name}' for name, ns in node.get_node_names_and_namespaces()}
+
+
+def registry_nodes_present(node: Node, executor: SingleThreadedExecutor, namespace: str,
+                           names: list[str], listen_s: float,
+                           should_stop: Callable[[], bool] = _never) -> list[str]:
+    """
+    Return which of ``names`` already run in ``namespace`` (sorted), listening ``listen_s``.
+
+    Answers as soon as one is discovered; an empty list after ``listen_s`` (or a true
+    ``should_stop()``) means none was.
+    """
+    wanted = {f'{namespace.rstrip("/")}/{name}': name for name in names}
+    deadline = time.monotonic() + listen_s
+    while True:
+        present = sorted(wanted[fq] for fq in discovered_nodes(node) & wanted.keys())
+        if present or time.monotonic() >= deadline or should_stop():
+            return present
+        executor.spin_once(timeout_sec=0.1)
 
 
 def settle_discovery(node: Node, executor: SingleThreadedExecutor, namespace: str,

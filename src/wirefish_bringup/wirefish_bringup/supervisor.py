@@ -4,7 +4,8 @@ Start the graph's processes, watch them, and stop every one of them cleanly.
 What `ros2 launch` does for a full install, in plain subprocess calls: each node is a child in
 its own session (so a terminal's Ctrl-C reaches only the supervisor, which then sends exactly one
 SIGINT to each child, in reverse start order), with a parent-death signal (so no child outlives
-a supervisor that was killed), its output in a log file of its own.
+a supervisor that was killed), its output in a log file of its own, restarted by its restart
+policy when it exits while the graph runs.
 """
 
 from collections.abc import Sequence
@@ -14,8 +15,9 @@ from pathlib import Path
 import signal
 import subprocess
 import time
+from typing import TextIO
 
-from wirefish_bringup.graph import NodeSpec
+from wirefish_bringup.graph import NodeSpec, RestartBudget
 
 _PR_SET_PDEATHSIG = 1
 
@@ -26,11 +28,17 @@ def _die_with_parent() -> None:  # runs in the child between fork and exec
 
 
 class ProcessExitedError(RuntimeError):
-    """A process of the graph exited while the graph was supposed to run."""
+    """A required process of the graph exited and its restart budget is spent."""
 
 
 class Supervisor:
-    """Owns the graph's child processes from start to clean stop."""
+    """
+    Owns the graph's child processes from start to clean stop, restarting them by policy.
+
+    ``supervise()`` answers the exits since its last call with each process's restart policy
+    (see ``wirefish_bringup.graph``); call it from the thread that started the processes (the
+    parent-death signal is tied to that thread).
+    """
 
     def __init__(self, log_dir: Path, env: dict[str, str] | None = None) -> None:
         self._log_dir = log_dir
@@ -38,7 +46,11 @@ class Supervisor:
         self._env.setdefault('PYTHONUNBUFFERED', '1')
         self._env.setdefault('RCUTILS_COLORIZED_OUTPUT', '0')
         self.processes: dict[str, subprocess.Popen] = {}
-        self._logs: list = []
+        self.specs: dict[str, NodeSpec] = {}
+        self.budgets: dict[str, RestartBudget] = {}
+        self.given_up: dict[str, int] = {}  # key -> its last exit code
+        self._pending: dict[str, float] = {}  # key -> when (monotonic) it is restarted
+        self._logs: dict[str, TextIO] = {}
 
     def start(self, spec: NodeSpec) -> subprocess.Popen:
         """
@@ -47,7 +59,6 @@ class Supervisor:
         The key is the spec's name, made unique (``bridge_node_2`` ...) when several fish run
         under one supervisor, so every process is tracked and stopped.
         """
-        self._log_dir.mkdir(parents=True, exist_ok=True)
         executable = spec.executable_path()
         if not executable.is_file():
             raise FileNotFoundError(f'{spec.package}/{spec.executable} is not installed at '
@@ -56,11 +67,24 @@ class Supervisor:
         while key in self.processes:
             n += 1
             key = f'{spec.name}_{n}'
-        log = open(self._log_dir / f'{key}.log', 'w', buffering=1)
-        self._logs.append(log)
-        proc = subprocess.Popen([str(executable), *spec.arguments], env=self._env,
-                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                start_new_session=True, preexec_fn=_die_with_parent)
+        self.specs[key] = spec
+        self.budgets[key] = RestartBudget(spec.restart)
+        return self._launch(key)
+
+    def _launch(self, key: str) -> subprocess.Popen:
+        spec = self.specs[key]
+        if spec.link is not None:
+            remove_stale_link(spec.link)
+        log = self._logs.get(key)
+        if log is None:
+            self._log_dir.mkdir(parents=True, exist_ok=True)
+            log = self._logs[key] = open(self._log_dir / f'{key}.log', 'w', buffering=1)
+        else:  # a restart: the same log, marked
+            log.write(f'--- {key} restarted by wirefish up ---\n')
+        proc = subprocess.Popen([str(spec.executable_path()), *spec.command_arguments()],
+                                env=self._env, stdin=subprocess.DEVNULL, stdout=log,
+                                stderr=subprocess.STDOUT, start_new_session=True,
+                                preexec_fn=_die_with_parent)
         self.processes[key] = proc
         return proc
 
@@ -68,6 +92,55 @@ class Supervisor:
         """Return the processes that have exited, with their exit codes."""
         return {name: proc.returncode for name, proc in self.processes.items()
                 if proc.poll() is not None}
+
+    def supervise(self, now: float | None = None) -> list[str]:
+        """
+        Answer each exit since the last call by its policy; return one report line per event.
+
+        An exited process is restarted after its policy's delay, or given up once its budget
+        is spent; a given-up ``required`` process raises ProcessExitedError (the graph stops).
+        """
+        now = time.monotonic() if now is None else now
+        lines = []
+        for key, proc in self.processes.items():
+            if key in self._pending or key in self.given_up or proc.poll() is None:
+                continue
+            spec, budget, code = self.specs[key], self.budgets[key], proc.returncode
+            if spec.link is not None:  # a killed virtual fish leaves its link behind
+                remove_stale_link(spec.link)
+            delay = budget.on_exit(now)
+            if delay is not None:
+                self._pending[key] = now + delay
+                lines.append(f'{key} exited with code {code}; restarting it in {delay:g} s '
+                             f'(restart {budget.in_window} of {spec.restart.max_restarts} '
+                             f'within {spec.restart.window_s:g} s)')
+                continue
+            self.given_up[key] = code
+            why = (f'after {budget.in_window} restarts within {spec.restart.window_s:g} s'
+                   if spec.restart.respawn else 'and is not restarted (its policy)')
+            if spec.restart.required:
+                raise ProcessExitedError(
+                    f'{key} exited with code {code} {why}; it is required: stopping the '
+                    f'graph. Its log ({self._log_dir / (key + ".log")}) ends:\n'
+                    + self.log_tail(key))
+            lines.append(f'{key} exited with code {code} {why}: given up, the rest keeps '
+                         f'running (log: {self._log_dir / (key + ".log")})')
+        for key, due in list(self._pending.items()):
+            if now >= due:
+                del self._pending[key]
+                lines.append(f'{key} restarted (pid {self._launch(key).pid})')
+        return lines
+
+    def summary(self) -> str | None:
+        """Return one line of the restarts and given-up processes of the run, or None."""
+        restarted = {key: b.total for key, b in self.budgets.items() if b.total}
+        if not restarted and not self.given_up:
+            return None
+        parts = ['restarts: ' + (', '.join(f'{k} {n}' for k, n in restarted.items()) or 'none')]
+        if self.given_up:
+            parts.append('given up: ' + ', '.join(
+                f'{k} (last exit code {code})' for k, code in self.given_up.items()))
+        return '; '.join(parts)
 
     def log_tail(self, name: str, lines: int = 15) -> str:
         """Return the last lines of one process's log (for error messages)."""
@@ -100,7 +173,8 @@ class Supervisor:
                     self._signal(proc, signal.SIGKILL)
                     proc.wait()
                     codes[name] = None
-        for log in self._logs:
+        self._pending.clear()  # stopping: a restart that was due never happens
+        for log in self._logs.values():
             log.close()
         self._logs.clear()
         return codes
