@@ -39,8 +39,8 @@ def test_a_node_refuses_to_start_on_invalid_values(ros_env, package, node, overr
     ('wirefish_cpg', 'tuner_node', 'swarm_size:=true', 'an integer', "a bool 'True'"),
     ('wirefish_kinematics', 'kinematics_node', 'l1:=long', 'a double', "a string 'long'"),
 ])
-def test_a_value_of_the_wrong_type_gives_one_fatal_line(ros_env, package, node, override,
-                                                         expected, given):
+def test_a_value_of_the_wrong_type_gives_one_fatal_line(
+        ros_env, package, node, override, expected, given):
     result = subprocess.run([executable(package, node), '--ros-args', '-p', override],
                             env=ros_env, capture_output=True, text=True, timeout=60)
     lines = (result.stdout + result.stderr).strip().splitlines()
