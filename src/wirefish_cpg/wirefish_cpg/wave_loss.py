@@ -45,6 +45,7 @@ from wirefish_kinematics.desired_wave import (desired_lateral_position,
                                               desired_swing_angles as wave_swing_angles,
                                               WAVE_TIME_SIGN)
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.wave_spec import WaveSpec  # the one wave type (eq 23)
 from wirefish_kinematics.wire_coupling import bend_angles
 
 PARAMETER_NAMES = ('w12', 'w21', 'phi12', 'phi21', 'amplitude_1', 'amplitude_2')
@@ -59,31 +60,6 @@ FIT_MODES = ('phase_free', 'literal')
 # point at x = q_i (atan2(y_body, q_i), the project's); 'chord' at distance q_i from O0
 # (x = sqrt(q_i^2 - y_body^2), i.e. asin(y_body / q_i)).
 THETA_BAR_DEFINITIONS = ('axial', 'chord')
-
-
-@dataclass(frozen=True)
-class WaveSpec:
-    """
-    A desired Lighthill body wave (eq 23): envelope c1 (m/m), c2 (1/m), k (rad/m), f (Hz).
-
-    Raises ``ValueError`` unless all are finite, k > 0 and f in (0, 10].
-    """
-
-    c1: float = 0.15
-    c2: float = 1.0
-    k: float = 8.0
-    frequency_hz: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name in ('c1', 'c2', 'k', 'frequency_hz'):
-            value = float(getattr(self, name))
-            if not math.isfinite(value):
-                raise ValueError(f'{name} must be finite, got {value}')
-            object.__setattr__(self, name, value)
-        if self.k <= 0.0:
-            raise ValueError(f'k must be > 0, got {self.k}')
-        if not 0.0 < self.frequency_hz <= 10.0:
-            raise ValueError(f'frequency_hz must be in (0, 10] Hz, got {self.frequency_hz}')
 
 
 @dataclass(frozen=True)

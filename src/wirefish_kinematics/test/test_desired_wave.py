@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 from wirefish_kinematics.desired_wave import (desired_lateral_position, desired_swing_angles,
-                                              wave_time_at_phase, WAVE_TIME_SIGN)
+                                              desired_wave_at_phase, wave_time_at_phase,
+                                              WAVE_TIME_SIGN)
 from wirefish_kinematics.geometry import FishGeometry
 
 G = FishGeometry()
@@ -57,3 +58,12 @@ def test_wave_time_at_phase_puts_the_wave_at_q1_in_phase(time_sign, phase):
     assert y == pytest.approx(envelope * math.cos(phase), abs=1e-15)
     later = wave_time_at_phase(phase + 0.1, G.l1, 8.0, 1.0, time_sign)
     assert later > tau
+
+
+@pytest.mark.parametrize('c1, c2', [(0.15, 1.0), (-0.15, -1.0)])
+@pytest.mark.parametrize('phase', [0.0, 1.0, -2.5])
+def test_the_overlay_at_q1_has_the_sign_of_the_tail_at_its_phase(c1, c2, phase):
+    stations = np.array([G.l1, G.tail_length])
+    y = desired_wave_at_phase(stations, phase, G.l1, c1, c2, 8.0, 1.0)
+    envelope = abs(c1 * G.l1 + c2 * G.l1 ** 2)
+    assert y[0] == pytest.approx(envelope * math.cos(phase), abs=1e-15)

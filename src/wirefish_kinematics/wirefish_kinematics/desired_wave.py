@@ -65,3 +65,19 @@ def wave_time_at_phase(phase_at_q1: ArrayLike, q1: float, k: float, frequency_hz
     omega = 2.0 * math.pi * frequency_hz
     phase = np.asarray(phase_at_q1, dtype=float)
     return (phase + time_sign * (0.5 * math.pi - k * q1)) / omega
+
+
+def desired_wave_at_phase(q: ArrayLike, phase_at_q1: float, q1: float, c1: float, c2: float,
+                          k: float, frequency_hz: float, time_sign: float = WAVE_TIME_SIGN
+                          ) -> np.ndarray:
+    """
+    Return y_body(q, tau) (m) of eq 23 shown at the tail's phase: it peaks at q1 with it.
+
+    tau is ``wave_time_at_phase``'s; where the envelope c1 q1 + c2 q1^2 is negative the wave
+    is shifted by half a period, so that y_body(q1) = |envelope(q1)| cos(phase_at_q1) always
+    has the sign of the tail's own y(q1).
+    """
+    if c1 * q1 + c2 * q1 * q1 < 0.0:
+        phase_at_q1 += math.pi
+    tau = wave_time_at_phase(phase_at_q1, q1, k, frequency_hz, time_sign)
+    return desired_lateral_position(q, tau, c1, c2, k, frequency_hz, time_sign)

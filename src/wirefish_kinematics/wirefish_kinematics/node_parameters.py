@@ -1,17 +1,26 @@
 """
-The kinematics node's parameters as one table (no rclpy import).
+The kinematics node's parameters as one table (no rclpy import), and the geometry block.
 
-Validation and declaration are the shared ones of ``wirefish_common.parameter_table``.
+``GEOMETRY_PARAMETERS`` is the one declaration of the fish's dimensions as ROS parameters:
+every node that needs geometry declares its fields from it (``geometry_parameters``), so
+names, ranges and descriptions cannot drift apart. Defaults are ``FishGeometry()``'s and the
+``wave_*`` defaults ``WaveSpec()``'s. Validation and declaration are the shared ones of
+``wirefish_common.parameter_table``.
 """
 
 from __future__ import annotations
 
+from typing import Mapping
+
 from wirefish_common.parameter_table import (check_value, declare as declare_specs,
                                              merged_update, ParameterSpec, validate_update)
 from wirefish_kinematics.geometry import FishGeometry, GEOMETRY_FIELDS
+from wirefish_kinematics.wave_spec import WaveSpec
 
-__all__ = ['check_value', 'declare', 'geometry_from', 'merged_update', 'NODE_PARAMETERS',
-           'ParameterSpec', 'SPECS', 'validate_update']
+__all__ = ['BODY_WAVE_GEOMETRY_FIELDS', 'check_value', 'declare', 'GEOMETRY_PARAMETERS',
+           'geometry_from', 'geometry_parameters', 'merged_update', 'NODE_PARAMETERS',
+           'ParameterSpec', 'SPECS', 'validate_update', 'WAVE_PARAMETER_NAMES',
+           'wave_from']
 
 
 _DEFAULT = FishGeometry()
@@ -34,14 +43,20 @@ GEOMETRY_PARAMETERS = tuple(
     ParameterSpec(name, getattr(_DEFAULT, name), _GEOMETRY_DOC[name][0], 0.0,
                   _GEOMETRY_DOC[name][1], low_exclusive=True)
     for name in GEOMETRY_FIELDS)
+# The fields the body wave (eqs 2-15) needs: enough for a node that only fits or draws it.
+BODY_WAVE_GEOMETRY_FIELDS = ('l1', 'l2', 'l3', 'r1', 'r2', 'rd1', 'rd2')
+_WAVE = WaveSpec()
+# wave_<field> parameter -> WaveSpec field
+WAVE_PARAMETER_NAMES = {'wave_c1': 'c1', 'wave_c2': 'c2', 'wave_k': 'k',
+                        'wave_frequency_hz': 'frequency_hz'}
 WAVE_PARAMETERS = (
-    ParameterSpec('wave_c1', 0.15, 'Desired wave envelope c1 (m/m), eq 23; used until a '
+    ParameterSpec('wave_c1', _WAVE.c1, 'Desired wave envelope c1 (m/m), eq 23; used until a '
                   'target_wave arrives, and again after any wave_* change', -10.0, 10.0),
-    ParameterSpec('wave_c2', 1.0, 'Desired wave envelope c2 (1/m), eq 23', -100.0, 100.0),
-    ParameterSpec('wave_k', 8.0, 'Desired wave number k (rad/m), eq 23', 0.0, 100.0,
+    ParameterSpec('wave_c2', _WAVE.c2, 'Desired wave envelope c2 (1/m), eq 23', -100.0, 100.0),
+    ParameterSpec('wave_k', _WAVE.k, 'Desired wave number k (rad/m), eq 23', 0.0, 100.0,
                   low_exclusive=True),
-    ParameterSpec('wave_frequency_hz', 1.0, 'Desired wave frequency (Hz), eq 23', 0.0, 10.0,
-                  low_exclusive=True),
+    ParameterSpec('wave_frequency_hz', _WAVE.frequency_hz, 'Desired wave frequency (Hz), eq 23',
+                  0.0, 10.0, low_exclusive=True),
 )
 NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
     ParameterSpec('station_count', 50, 'Stations along the tail in body_wave', 2, 1000),
@@ -56,9 +71,30 @@ NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
 SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
 
 
-def geometry_from(values: dict[str, object]) -> FishGeometry:
-    """Return the FishGeometry of a name -> value mapping (raises ValueError if invalid)."""
-    return FishGeometry(**{name: values[name] for name in GEOMETRY_FIELDS})
+def geometry_parameters(names: tuple[str, ...] = GEOMETRY_FIELDS) -> tuple[ParameterSpec, ...]:
+    """Return the specs of the geometry fields ``names`` (all by default), in that order."""
+    unknown = set(names) - set(GEOMETRY_FIELDS)
+    if unknown:
+        raise ValueError(f'not FishGeometry fields: {sorted(unknown)}')
+    by_name = {spec.name: spec for spec in GEOMETRY_PARAMETERS}
+    return tuple(by_name[name] for name in names)
+
+
+def geometry_from(values: Mapping[str, object], names: tuple[str, ...] = GEOMETRY_FIELDS
+                  ) -> FishGeometry:
+    """
+    Return the FishGeometry of the fields ``names`` in a name -> value mapping.
+
+    Fields outside ``names`` keep FishGeometry's defaults: a node declaring only
+    ``BODY_WAVE_GEOMETRY_FIELDS`` never reads the others. Raises ``KeyError`` if a name is
+    missing from ``values`` and ``ValueError`` if a value is invalid.
+    """
+    return FishGeometry(**{name: values[name] for name in names})
+
+
+def wave_from(values: Mapping[str, object]) -> WaveSpec:
+    """Return the WaveSpec of the ``wave_*`` parameters in a name -> value mapping."""
+    return WaveSpec(**{field: values[name] for name, field in WAVE_PARAMETER_NAMES.items()})
 
 
 def declare(node, specs: tuple[ParameterSpec, ...] = NODE_PARAMETERS) -> None:
