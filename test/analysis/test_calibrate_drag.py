@@ -1,12 +1,16 @@
 """The C_D calibration command (wirefish_analysis.calibrate_drag) and the paper's figures."""
 
+from dataclasses import replace
 import subprocess
 import sys
 
+import numpy as np
 import pytest
-from wirefish_analysis.calibrate_drag import calibrated_drag_coefficient, PAPER_POINTS, predict
+from wirefish_analysis.calibrate_drag import (calibrated_drag_coefficient, least_squares_drag,
+                                              PAPER_POINTS, point_means, predict)
 from wirefish_cpg.table1_gait import table1_locked_at, tip_half_amplitude
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.lighthill import steady_speed
 
 
 def test_calibration_reproduces_the_default_drag_coefficient():
@@ -39,9 +43,44 @@ def test_paper_points_are_evaluated_at_the_stated_tip_amplitude_and_frequency(po
 
 
 def test_the_command_prints_the_calibration_and_the_paper_points():
-    result = subprocess.run([sys.executable, '-m', 'wirefish_analysis.calibrate_drag'],
-                            capture_output=True, text=True, check=True)
+    result = subprocess.run([sys.executable, '-m', 'wirefish_analysis.calibrate_drag',
+                             '--no-virtual-fish'], capture_output=True, text=True, check=True)
     assert f'calibrated C_D = {FishGeometry().drag_coefficient:.9f}' in result.stdout
     assert 'differs' not in result.stdout
     for point in PAPER_POINTS:
         assert point.label in result.stdout
+    fit = least_squares_drag()
+    assert f'C_D = {fit.drag_coefficient:.6f}, speed RMSE {fit.rmse:.4f} m/s' in result.stdout
+    assert 'eq 18 cannot fit' in result.stdout
+
+
+@pytest.fixture(scope='module')
+def least_squares():
+    return least_squares_drag()
+
+
+def _sum_of_squares(c_d):
+    geometry = replace(FishGeometry(), drag_coefficient=c_d)
+    means = np.array([point_means(p, geometry) for p in PAPER_POINTS])
+    speeds = steady_speed(means[:, 0], means[:, 1], geometry)
+    return float(np.sum((speeds - [p.paper_speed for p in PAPER_POINTS]) ** 2))
+
+
+@pytest.mark.parametrize('factor', [0.99, 1.01])
+def test_least_squares_drag_is_the_minimum_of_the_speed_misses(least_squares, factor):
+    best = least_squares.drag_coefficient
+    assert _sum_of_squares(best * factor) > _sum_of_squares(best)
+
+
+def test_least_squares_rmse_is_no_worse_than_the_one_point_calibration(least_squares):
+    one_point = np.sqrt(_sum_of_squares(FishGeometry().drag_coefficient) / len(PAPER_POINTS))
+    assert least_squares.rmse <= one_point
+    assert least_squares.rmse == pytest.approx(
+        np.sqrt(_sum_of_squares(least_squares.drag_coefficient) / len(PAPER_POINTS)), rel=1e-9)
+
+
+def test_eq18_swimming_number_does_not_depend_on_frequency_for_one_tail_shape():
+    slow, fast = (replace(PAPER_POINTS[1], frequency_hz=f) for f in (1.0, 6.5))
+    sw = [float(steady_speed(*point_means(p, FishGeometry()), FishGeometry())) / p.frequency_hz
+          for p in (slow, fast)]
+    assert sw[0] == pytest.approx(sw[1], rel=1e-6)
