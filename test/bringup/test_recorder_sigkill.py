@@ -1,0 +1,121 @@
+"""
+A recorder killed with SIGKILL at a random moment loses at most about its last second.
+
+The talker numbers its messages; a listener in the test process hears them beside the recorder.
+After the kill and the documented repair step (`wirefish bag reindex`), the bag must open with
+rosbags, hold an unbroken run of numbers, and reach every number the listener heard up to
+KILL_MARGIN_S before the kill (the recorder flushes every 0.5 s).
+"""
+
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+from bag_utils import assert_bag_readable, counters, reindex_bag
+import numpy as np
+import pytest
+from ros_utils import spin_until, stop_process
+from wirefish_bringup import mcap_records as rec
+from wirefish_bringup.bag_storage import read_file_info, storage_files
+import yaml
+
+pytestmark = pytest.mark.ros
+KILL_MARGIN_S = 1.0
+
+
+def _record(namespace: str, bag: Path, *options: str) -> list[str]:
+    return [sys.executable, '-m', 'wirefish_bringup.cli', 'record', '--namespace', namespace,
+            '-o', str(bag), *options]
+
+
+def _flushed(bag: Path) -> bool:
+    """Return True once a chunk is on disk (the header alone is 45 bytes)."""
+    return any(p.stat().st_size > 200 for p in bag.glob('*.mcap'))
+
+
+def _record_then_kill(spawn, listener, namespace: str, bag: Path, seed: int) -> float:
+    """Record, SIGKILL the recorder at a seeded moment after its first flush; return when."""
+    recorder = spawn(_record(namespace, bag))
+    assert spin_until(listener.executor, lambda: _flushed(bag), 60.0), 'recorder never flushed'
+    delay = float(np.random.default_rng(seed).uniform(0.3, 3.5))
+    kill_at = time.monotonic() + delay
+    spin_until(listener.executor, lambda: time.monotonic() >= kill_at, delay + 1.0)
+    killed_at = time.monotonic()
+    os.kill(recorder.pid, signal.SIGKILL)
+    recorder.wait()
+    return killed_at
+
+
+def _torn_tail(path: Path, seed: int) -> None:
+    """Append what a kill inside a write would leave: half a chunk, then stray bytes."""
+    half_chunk = rec.chunk(0, 0, rec.message(1, 0, 0, bytes(200)))[:120]
+    noise = np.random.default_rng(seed).integers(0, 256, 333, dtype=np.uint8).tobytes()
+    with path.open('ab') as file:
+        file.write(half_chunk + noise)
+
+
+def _assert_holds_all_heard_before(bag: Path, topic: str, listener,
+                                   killed_at: float) -> list[int]:
+    got = counters(bag, topic)
+    assert len(got) > 0
+    assert np.all(np.diff(got) == 1), 'numbers missing inside the recording'
+    due = [c for c, t in listener.heard if t <= killed_at - KILL_MARGIN_S and c >= got[0]]
+    assert due, 'the listener heard nothing a second before the kill'
+    assert got[-1] >= max(due), (f'bag ends at {got[-1]}, but {max(due)} was heard '
+                                 f'{KILL_MARGIN_S} s before the kill')
+    return got
+
+
+@pytest.mark.parametrize('tail', ['as the kill left it', 'torn last write'])
+def test_a_killed_recording_loses_at_most_its_last_second(tmp_path, spawn, talker_namespace,
+                                                          listener, kill_seed, ros_env, tail):
+    bag, topic = tmp_path / 'bag', f'{talker_namespace}/body_wave'
+    killed_at = _record_then_kill(spawn, listener, talker_namespace, bag, kill_seed)
+    (mcap,) = storage_files(bag)
+    assert not (bag / 'metadata.yaml').exists()  # what rosbags refused before the repair
+    if tail == 'torn last write':
+        _torn_tail(mcap, kill_seed)
+    printed = reindex_bag(bag, ros_env)
+    assert 'rebuilt from' in printed
+    counts = assert_bag_readable(bag)
+    got = _assert_holds_all_heard_before(bag, topic, listener, killed_at)
+    assert counts[topic] == len(got)
+
+
+def test_a_resumed_recorder_goes_on_in_the_same_bag(tmp_path, spawn, talker_namespace,
+                                                    listener, kill_seed, ros_env):
+    bag, topic = tmp_path / 'bag', f'{talker_namespace}/body_wave'
+    killed_at = _record_then_kill(spawn, listener, talker_namespace, bag, kill_seed)
+    result = subprocess.run(_record(talker_namespace, bag, '--resume', '--duration', '2'),
+                            env=ros_env, capture_output=True, text=True, timeout=90)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert [p.name for p in storage_files(bag)] == ['bag_0.mcap', 'bag_1.mcap']
+    assert_bag_readable(bag)
+    first = counters(bag, topic)[:read_file_info(bag / 'bag_0.mcap').message_count]
+    assert first[-1] >= max(c for c, t in listener.heard if t <= killed_at - KILL_MARGIN_S)
+    resumed = counters(bag, topic)[len(first):]
+    assert len(resumed) >= 20 and np.all(np.diff(resumed) == 1)  # ~2 s at 20 Hz, unbroken
+
+
+def test_a_clean_stop_writes_a_finished_bag(tmp_path, spawn, talker_namespace, listener,
+                                            ros_env):
+    bag, topic = tmp_path / 'bag', f'{talker_namespace}/body_wave'
+    recorder = spawn(_record(talker_namespace, bag))
+    assert spin_until(listener.executor, lambda: _flushed(bag), 60.0)
+    spin_until(listener.executor, lambda: False, 1.5)
+    assert stop_process(recorder) == 0  # SIGINT
+    info = read_file_info(bag / 'bag_0.mcap')  # summary and footer: no repair needed
+    assert info.message_count == assert_bag_readable(bag)[topic] > 0
+    meta = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    (topic,) = [t['topic_metadata'] for t in meta['topics_with_message_count']
+                if t['topic_metadata']['name'] == topic]
+    # The talker's publisher as it offered itself: rclpy's default, reliable and volatile.
+    assert [(q['reliability'], q['durability']) for q in topic['offered_qos_profiles']] == \
+        [('reliable', 'volatile')]
+    result = subprocess.run([sys.executable, '-m', 'wirefish_bringup.cli', 'bag', 'info',
+                             str(bag)], env=ros_env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert f'Count: {info.message_count}' in result.stdout
