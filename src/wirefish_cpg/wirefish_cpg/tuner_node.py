@@ -46,11 +46,12 @@ from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait
 from wirefish_cpg.wave_loss import WaveFitProblem, WaveSpec
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS, geometry_parameters
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
 
-GEOMETRY_FIELDS = ('l1', 'l2', 'l3', 'r1', 'r2', 'rd1', 'rd2')
-_GEOMETRY = FishGeometry()
+# The fit needs the body wave's geometry only; its specs are the one geometry block's.
+GEOMETRY_FIELDS = BODY_WAVE_GEOMETRY_FIELDS
 TUNER_PARAMETERS = (
     ParameterSpec('cpg_node_name', 'cpg_node',
                   'Name (relative or absolute) of the CPG node whose parameters apply sets'),
@@ -74,11 +75,7 @@ TUNER_PARAMETERS = (
     ParameterSpec('samples_per_period', 48, 'Quadrature points of the loss per period', 8,
                   2000),
     ParameterSpec('apply_timeout_s', 5.0, 'Wait for the CPG node to accept (s)', 0.1, 60.0),
-) + tuple(
-    ParameterSpec(name, float(getattr(_GEOMETRY, name)),
-                  f'Fish geometry {name} (m), as FishGeometry; keep equal to the kinematics',
-                  0.0, 1.0, low_exclusive=True)
-    for name in GEOMETRY_FIELDS)
+) + geometry_parameters(GEOMETRY_FIELDS)
 SPECS = {spec.name: spec for spec in TUNER_PARAMETERS}
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
