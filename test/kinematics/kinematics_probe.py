@@ -14,6 +14,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_utils import spin_until
 from sensor_msgs.msg import JointState
+from wirefish_common.servo_joints import SERVO_JOINTS
 from wirefish_msgs.msg import BodyWaveSpec
 
 KINEMATICS_NODE = os.path.join(get_package_prefix('wirefish_kinematics'), 'lib',
@@ -52,7 +53,7 @@ class Probe:
         self.wait_for(lambda: pub.get_subscription_count() > 0, f'a subscriber of {topic}')
 
     def send(self, index: int, angles, rates=(0.0, 0.0), topic: str = 'servo_cmd',
-             names=('servo_1', 'servo_2'), step_ns: int = 10_000_000) -> None:
+             names=SERVO_JOINTS, step_ns: int = 10_000_000) -> None:
         """Publish sample number ``index``, stamped ORIGIN_S + index * step_ns."""
         msg = JointState()
         stamp_ns = index * step_ns

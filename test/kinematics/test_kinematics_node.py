@@ -157,6 +157,7 @@ BAD_SAMPLES = [
     {'angles': (0.1, math.inf)},
     {'angles': (0.1, 0.2), 'rates': (math.nan, 0.0)},
     {'angles': (0.1, 0.2), 'names': ('joint_a', 'joint_b')},
+    {'angles': (0.1, 0.2), 'names': ()},  # unnamed positions: refused (servo_joints)
     {'angles': (0.1,), 'rates': (0.0,), 'names': ('servo_1',)},
     {'angles': (0.1, 0.2), 'names': ('servo_1', 'servo_2', 'third_joint_without_position')},
 ]
