@@ -171,7 +171,10 @@ def summary_table(stats: list[TopicStats], bag) -> str:
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish report`; return the process exit code."""
     if not (args.bag / 'metadata.yaml').is_file():
-        print(f'wirefish report: {args.bag} is not a rosbag2 directory', file=sys.stderr)
+        killed = any(args.bag.glob('*.mcap'))
+        print(f'wirefish report: {args.bag} has no metadata.yaml: '
+              + (f'its recorder was killed? `wirefish bag reindex {args.bag}` repairs it'
+                 if killed else 'not a rosbag2 directory'), file=sys.stderr)
         return 2
     out_dir = args.output or args.bag.with_name(args.bag.name + '_report')
     stats = write_report(args.bag, out_dir)
