@@ -66,6 +66,10 @@ def _assert_holds_all_heard_before(bag: Path, topic: str, listener,
     assert due, 'the listener heard nothing a second before the kill'
     assert got[-1] >= max(due), (f'bag ends at {got[-1]}, but {max(due)} was heard '
                                  f'{KILL_MARGIN_S} s before the kill')
+    last_heard = dict(listener.heard).get(got[-1])
+    if last_heard is not None:
+        print(f'the bag ends with what the listener heard {killed_at - last_heard:.2f} s '
+              'before the kill')
     return got
 
 
