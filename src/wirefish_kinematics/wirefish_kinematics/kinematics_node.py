@@ -26,37 +26,29 @@ from __future__ import annotations
 
 import math
 
-from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Point
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
-from visualization_msgs.msg import Marker, MarkerArray
+from visualization_msgs.msg import MarkerArray
 from wirefish_common.node_main import run_node
 from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_sample
-from wirefish_kinematics.body_wave import body_positions, swing_angles
 from wirefish_kinematics.desired_wave import desired_wave_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
-from wirefish_kinematics.lighthill import SpeedEstimate
+from wirefish_kinematics.kinematics_messages import (body_wave_markers, body_wave_message,
+                                                     speed_estimate_message, to_stamp)
 from wirefish_kinematics.node_parameters import (declare, geometry_from, NODE_PARAMETERS,
                                                  SPECS, validate_update, wave_from,
                                                  WAVE_PARAMETER_NAMES)
 from wirefish_kinematics.tail_beat_tracker import TailBeatTracker
+from wirefish_kinematics.tail_shape import tail_shape
 from wirefish_kinematics.wave_spec import wave_from_message
-from wirefish_kinematics.wire_coupling import bend_angles
 from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate as SpeedEstimateMsg
 
-FRAME = 'tail_base'
 MARKERS = reliable(depth=5)
 WARN_PERIOD_S = 2.0
-
-
-def to_stamp(sec: int, nanosec: int) -> Time:
-    """Return a builtin_interfaces/Time."""
-    return Time(sec=int(sec), nanosec=int(nanosec))
 
 
 class KinematicsNode(Node):
@@ -148,23 +140,14 @@ class KinematicsNode(Node):
         self._fresh = False
         sec, nanosec, angles = self._latest
         stamp = to_stamp(sec, nanosec)
-        g = self._geometry
-        stations = np.linspace(0.0, g.tail_length, self._values['station_count'])
-        beta1, beta2 = (float(b) for b in bend_angles(angles[0], angles[1], g))
-        x, y = body_positions(stations, beta1, beta2, g)
-        theta1, theta2 = swing_angles(beta1, beta2, g)
-        report = self._tracker.update(g)
+        shape = tail_shape(angles, self._geometry, self._values['station_count'])
+        report = self._tracker.update(self._geometry)
         if report is not None:
-            self._publish_speed(report.estimate, report.time_s)
-        y_desired = self._desired_wave(self._tracker.history.last_time(), stations)
-        msg = BodyWave(q=stations.tolist(), x=x.tolist(), y=y.tolist(),
-                       y_desired=[] if y_desired is None else y_desired.tolist(),
-                       beta1=beta1, beta2=beta2, theta1=float(theta1), theta2=float(theta2))
-        msg.header.stamp, msg.header.frame_id = stamp, FRAME
-        self._body_pub.publish(msg)
-        ends_x, ends_y = body_positions(np.array(g.link_end_stations), beta1, beta2, g)
-        self._marker_pub.publish(self._markers(stamp, x, y, stations, y_desired,
-                                               ends_x, ends_y))
+            self._speed_pub.publish(speed_estimate_message(
+                report.estimate, to_stamp(*self._tracker.history.stamp_of(report.time_s))))
+        y_desired = self._desired_wave(self._tracker.history.last_time(), shape.stations)
+        self._body_pub.publish(body_wave_message(shape, y_desired, stamp))
+        self._marker_pub.publish(body_wave_markers(shape, y_desired, stamp))
 
     def _desired_wave(self, t: float, stations: np.ndarray) -> np.ndarray | None:
         """Return y_body at the stations, shown at the tail's phase at t; None if unknown."""
@@ -174,41 +157,6 @@ class KinematicsNode(Node):
         w = self._target
         return desired_wave_at_phase(stations, phase, self._geometry.l1, w.c1, w.c2, w.k,
                                      w.frequency_hz)
-
-    def _publish_speed(self, estimate: SpeedEstimate, t: float) -> None:
-        msg = SpeedEstimateMsg(speed=estimate.speed, thrust=estimate.thrust,
-                               drag=estimate.drag, swimming_number=estimate.swimming_number,
-                               tail_beat_hz=estimate.tail_beat_hz,
-                               tail_tip_amplitude=float(estimate.tail_tip_amplitude))
-        msg.header.stamp = to_stamp(*self._tracker.history.stamp_of(t))
-        msg.header.frame_id = FRAME
-        self._speed_pub.publish(msg)
-
-    def _markers(self, stamp: Time, x: np.ndarray, y: np.ndarray, stations: np.ndarray,
-                 y_desired: np.ndarray | None, ends_x: np.ndarray, ends_y: np.ndarray
-                 ) -> MarkerArray:
-        def marker(marker_id: int, kind: int, points_x, points_y, scale: float,
-                   rgb: tuple[float, float, float]) -> Marker:
-            m = Marker(ns='body_wave', id=marker_id, type=kind, action=Marker.ADD)
-            m.header.stamp, m.header.frame_id = stamp, FRAME
-            m.pose.orientation.w = 1.0
-            m.scale.x = m.scale.y = m.scale.z = scale
-            m.color.r, m.color.g, m.color.b = rgb
-            m.color.a = 1.0
-            m.points = [Point(x=float(px), y=float(py)) for px, py in zip(points_x, points_y)]
-            return m
-
-        markers = [marker(0, Marker.LINE_STRIP, x, y, 0.004, (0.1, 0.3, 0.9)),
-                   marker(2, Marker.SPHERE_LIST, ends_x[:1], ends_y[:1], 0.012, (0.9, 0.5, 0.1)),
-                   marker(3, Marker.CUBE_LIST, ends_x[1:], ends_y[1:], 0.012, (0.8, 0.1, 0.1))]
-        if y_desired is None:
-            gone = Marker(ns='body_wave', id=1, action=Marker.DELETE)
-            gone.header.stamp, gone.header.frame_id = stamp, FRAME
-            markers.append(gone)
-        else:
-            markers.append(marker(1, Marker.POINTS, stations, y_desired, 0.004,
-                                  (0.2, 0.7, 0.2)))
-        return MarkerArray(markers=markers)
 
 
 def main(args: list[str] | None = None) -> None:

@@ -1,0 +1,48 @@
+"""
+The tail's shape at one pair of servo angles: what one body_wave message shows.
+
+Servo angles -> bend angles (eqs 2-4) -> positions along the tail (eqs 7-15), the swing angles
+of section 5.2 and the link ends O1, O2, in frame C0 (``tail_base``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wirefish_kinematics.body_wave import body_positions, swing_angles
+from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.wire_coupling import bend_angles
+
+
+@dataclass(frozen=True)
+class TailShape:
+    """
+    The tail at one instant: stations q (S,) m from plate I to the tip, their x, y (S,) m.
+
+    ``beta1``, ``beta2`` the bend angles and ``theta1``, ``theta2`` the swing angles (rad);
+    ``ends_x``, ``ends_y`` (2,) m the link ends O1 (q = l1) and O2 (q = l1 + l2).
+    """
+
+    stations: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    beta1: float
+    beta2: float
+    theta1: float
+    theta2: float
+    ends_x: np.ndarray
+    ends_y: np.ndarray
+
+
+def tail_shape(servo_angles: tuple[float, float], geometry: FishGeometry, station_count: int
+               ) -> TailShape:
+    """Return the tail's shape at ``servo_angles`` (rad) on ``station_count`` (>= 2) stations."""
+    beta1, beta2 = (float(b) for b in bend_angles(servo_angles[0], servo_angles[1], geometry))
+    stations = np.linspace(0.0, geometry.tail_length, station_count)
+    x, y = body_positions(stations, beta1, beta2, geometry)
+    theta1, theta2 = swing_angles(beta1, beta2, geometry)
+    ends_x, ends_y = body_positions(np.array(geometry.link_end_stations), beta1, beta2,
+                                    geometry)
+    return TailShape(stations, x, y, beta1, beta2, float(theta1), float(theta2), ends_x, ends_y)
