@@ -4,11 +4,17 @@ Fault injection of the virtual fish's serial output (pure; randomness from a Gen
 ``corrupt_fraction``: each byte is replaced (xor with a random non-zero value) with that
 probability; ``drop_fraction``: each frame is dropped whole with that probability (its sequence
 number is used, so the receiver sees a gap).
+
+``Disturbance`` (not a link fault: the water's): a constant yaw disturbance (a current that
+turns the fish, ``yaw_rate_rad_s`` = the yaw rate it gives a straight-swimming fish) and a
+constant surge force (``surge_force_n``, + pushes forward), applied to the fish's state after each
+physics step (``disturb``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
@@ -53,3 +59,36 @@ class FaultInjector:
         buffer[hit] ^= self.rng.integers(1, 256, count, dtype=np.uint8)
         self.counters.bytes_corrupted += count
         return buffer.tobytes()
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """A constant yaw disturbance (rad/s) and surge force (N) on the virtual fish."""
+
+    yaw_rate_rad_s: float = 0.0
+    surge_force_n: float = 0.0
+
+    def __post_init__(self) -> None:
+        """Check both values are finite."""
+        for name in ('yaw_rate_rad_s', 'surge_force_n'):
+            if not math.isfinite(getattr(self, name)):
+                raise ValueError(f'{name} must be finite, got {getattr(self, name)}')
+
+    @property
+    def active(self) -> bool:
+        """Return whether either disturbance is not 0."""
+        return self.yaw_rate_rad_s != 0.0 or self.surge_force_n != 0.0
+
+
+def disturb(state, disturbance: Disturbance, dt: float, yaw_time_constant_s: float,
+            total_mass: float) -> None:
+    """
+    Apply ``disturbance`` over ``dt`` s to a ``FishState`` (speed, yaw_rate) in place.
+
+    Yaw: the fish's yaw rate relaxes with its time constant tau towards its own target plus
+    the disturbance, d r / dt += d / tau, so a straight fish settles at r = d. Surge: the force
+    acts on the surge inertia ``total_mass`` (kg) beside thrust and drag, so a steady fish
+    settles where F_T = F_D - F_surge.
+    """
+    state.yaw_rate += dt * disturbance.yaw_rate_rad_s / yaw_time_constant_s
+    state.speed += dt * disturbance.surge_force_n / total_mass

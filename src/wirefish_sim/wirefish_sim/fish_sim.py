@@ -7,6 +7,8 @@ line, flushed), points the link at it and runs until SIGINT/SIGTERM (exit code 0
 (nav_msgs/Odometry, frame ``odom``, child ``base_link``). Fault flags: ``--corrupt-fraction``,
 ``--drop-fraction``, ``--stall-every/--stall-for`` (firmware freezes: no output, input lost),
 ``--reopen-every/--reopen-count/--reopen-delay`` (close the device, wait, open a new one).
+Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns the fish) and
+``--surge-disturbance`` (N along the body, + forward); see ``faults.Disturbance``.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import time
 
 import numpy as np
 
-from wirefish_sim.faults import FaultInjector
+from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
@@ -62,6 +64,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument('--reopen-count', type=int, default=0, help='how many reopens (0 = no limit)')
     p.add_argument('--reopen-delay', type=float, default=0.3,
                    help='time the device is absent during a reopen (s)')
+    p.add_argument('--yaw-disturbance', type=float, default=0.0,
+                   help='constant yaw disturbance: the yaw rate a current gives a straight '
+                   'fish (rad/s, + turns left)')
+    p.add_argument('--surge-disturbance', type=float, default=0.0,
+                   help='constant surge force of a current (N, + pushes forward)')
     return p
 
 
@@ -137,6 +144,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     fish = VirtualFish(config_from(args), rng=rng)
     faults = FaultInjector(np.random.default_rng(args.seed + 1), args.corrupt_fraction,
                            args.drop_fraction)
+    disturbance = Disturbance(args.yaw_disturbance, args.surge_disturbance)
     stalls = Schedule(args.stall_every, args.stall_for)
     reopens = Schedule(args.reopen_every, args.reopen_delay, args.reopen_count)
     device = PtyDevice(args.link)
@@ -162,6 +170,9 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
             if data and not stalled:
                 fish.receive(data)
             fish.step(now - last)
+            if disturbance.active:
+                disturb(fish.state, disturbance, now - last, fish.config.yaw_time_constant_s,
+                        fish.total_mass)
             last = now
             output = fish.take_output()
             if device.is_open and not stalled and output:
@@ -218,6 +229,10 @@ def flags_problem(args: argparse.Namespace) -> str | None:
         value = getattr(args, name)
         if not (math.isfinite(value) and value >= 0.0):
             return f'--{name.replace("_", "-")} must be finite and >= 0, got {value}'
+    for name in ('yaw_disturbance', 'surge_disturbance'):
+        value = getattr(args, name)
+        if not math.isfinite(value):
+            return f'--{name.replace("_", "-")} must be finite, got {value}'
     try:
         config_from(args)
     except ValueError as error:  # the servo model's own checks

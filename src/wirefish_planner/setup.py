@@ -1,0 +1,33 @@
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = 'wirefish_planner'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/missions', glob('missions/*.yaml')),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='wirefish maintainers',
+    maintainer_email='maintainers@wirefish.dev',
+    description='Drive the fish: cmd_vel to gait (inverse speed model) and IMU heading control.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'planner_node = wirefish_planner.planner_node:main',
+        ],
+        # Subcommands of the `wirefish` command that live here (see wirefish_bringup.cli).
+        'wirefish.commands': [
+            'drive = wirefish_planner.drive',
+            'mission = wirefish_planner.mission',
+        ],
+    },
+)

@@ -1,0 +1,189 @@
+"""
+Forward speed -> gait: eq 18 inverted over a family of gaits (pure; no rclpy).
+
+A gait family maps (tail-beat frequency f, amplitude scale s) to CPG parameters. Today's family
+is Table 1 locked at f with both R_i scaled by s (``wirefish_cpg.table1_gait``). Each gait is
+judged on one locked period of its servo commands: the eq 18 speed (eqs 16-22, servos that
+follow exactly), the peak servo rate and the peak servo angle.
+
+Feasible: peak rate <= ``slew_margin`` x the servo's slew limit (the virtual fish's 9.1 rad/s,
+``wirefish_analysis.servo_calibration``: a faster command is not followed, so eq 18 would
+over-predict) and peak angle + the largest turning offset <= the servo range. Both are linear
+in s (the locked phase difference does not depend on s), so the largest feasible scale at a
+frequency is one division.
+
+Policy: the lowest frequency that reaches the target. Below the speed of the lowest frequency at
+the largest feasible scale, the frequency stays at its minimum and the scale is solved; above,
+the scale stays at its largest feasible value and the frequency is solved (fewer tail beats,
+higher swimming number). Targets above the fastest feasible gait are clamped to it, and the
+reason names the binding limit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import functools
+import math
+from typing import Protocol
+
+import numpy as np
+from scipy.optimize import brentq
+from wirefish_cpg.oscillator import CpgParameters
+from wirefish_cpg.table1_gait import one_locked_period, table1_locked_at
+from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.lighthill import estimate_speed
+
+FRONTIER_SAMPLES = 24  # frequencies scanned for the fastest feasible gait
+SPEED_TOLERANCE_M_S = 1e-5
+
+
+class GaitFamily(Protocol):
+    """A family of gaits: CPG parameters for (tail-beat frequency Hz, amplitude scale)."""
+
+    name: str
+
+    def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
+        """Return the CPG parameters of this gait."""
+
+
+class Table1Family:
+    """Table 1 locked at f with R_i scaled by s (the analytic family, no fit needed)."""
+
+    name = 'table1'
+
+    def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
+        """Return Table 1 locked at ``frequency_hz`` with R_i scaled by ``amplitude_scale``."""
+        return table1_locked_at(frequency_hz, amplitude_scale)
+
+
+@dataclass(frozen=True)
+class GaitLimits:
+    """What a gait may ask of the servos; SI units, radians."""
+
+    min_frequency_hz: float = 0.5
+    max_frequency_hz: float = 4.0
+    max_amplitude_scale: float = 1.0  # Table 1's R_i: tail tip ~8.8 cm, the paper's largest
+    servo_rate_limit_rad_s: float = 9.1
+    slew_margin: float = 0.95
+    servo_limit_rad: float = math.pi / 2
+    max_offset_rad: float = 0.3
+
+    def __post_init__(self) -> None:
+        """Check every value is finite and the ranges are ordered."""
+        for name in self.__dataclass_fields__:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f'{name} must be finite and > 0, got {value}')
+        if self.min_frequency_hz >= self.max_frequency_hz:
+            raise ValueError(f'min_frequency_hz ({self.min_frequency_hz:g}) must be below '
+                             f'max_frequency_hz ({self.max_frequency_hz:g})')
+        if self.slew_margin > 1.0:
+            raise ValueError(f'slew_margin must be <= 1, got {self.slew_margin:g}')
+        if self.max_offset_rad >= self.servo_limit_rad:
+            raise ValueError(f'max_offset_rad ({self.max_offset_rad:g}) leaves no servo range '
+                             f'below servo_limit_rad ({self.servo_limit_rad:g})')
+
+
+@dataclass(frozen=True)
+class GaitPoint:
+    """One gait judged on a locked period: eq 18 speed (m/s), peak rate and angle (rad/s, rad)."""
+
+    frequency_hz: float
+    amplitude_scale: float
+    params: CpgParameters
+    speed: float
+    peak_rate: float
+    peak_angle: float
+
+
+@dataclass(frozen=True)
+class GaitChoice:
+    """The planner's gait for a target speed; ``clamp_reason`` is '' unless it was clamped."""
+
+    target_speed: float
+    point: GaitPoint | None  # None: rest (speed 0)
+    clamp_reason: str = ''
+
+    @property
+    def predicted_speed(self) -> float:
+        """Return the eq 18 speed of the chosen gait (0 at rest)."""
+        return 0.0 if self.point is None else self.point.speed
+
+
+def evaluate_gait(family: GaitFamily, frequency_hz: float, amplitude_scale: float,
+                  geometry: FishGeometry) -> GaitPoint:
+    """Return the gait (f, s) of ``family`` with its eq 18 speed, peak rate and peak angle."""
+    params = family.gait(frequency_hz, amplitude_scale)
+    angles, rates, dt = one_locked_period(params)
+    speed = estimate_speed(angles, rates, dt, geometry).speed
+    return GaitPoint(frequency_hz, amplitude_scale, params, float(speed),
+                     float(np.abs(rates).max()), float(np.abs(angles).max()))
+
+
+class GaitPlanner:
+    """Chooses gaits by the policy above; caches gait evaluations (they are deterministic)."""
+
+    def __init__(self, family: GaitFamily, limits: GaitLimits,
+                 geometry: FishGeometry | None = None) -> None:
+        """Scan the feasible frontier once (FRONTIER_SAMPLES gaits) for the fastest gait."""
+        self.family = family
+        self.limits = limits
+        self.geometry = geometry or FishGeometry()
+        self._point = functools.lru_cache(maxsize=4096)(self._evaluate)
+        frequencies = np.linspace(limits.min_frequency_hz, limits.max_frequency_hz,
+                                  FRONTIER_SAMPLES)
+        frontier = [self.frontier_point(float(f)) for f in frequencies]
+        self._fastest = max(frontier, key=lambda p: p.speed)
+
+    def _evaluate(self, frequency_hz: float, amplitude_scale: float) -> GaitPoint:
+        return evaluate_gait(self.family, frequency_hz, amplitude_scale, self.geometry)
+
+    def feasible_scale(self, frequency_hz: float) -> tuple[float, str]:
+        """Return the largest feasible amplitude scale at ``frequency_hz`` and what binds it."""
+        lim = self.limits
+        unit = self._point(frequency_hz, 1.0)  # rates and angles are linear in the scale
+        by_rate = lim.slew_margin * lim.servo_rate_limit_rad_s / unit.peak_rate
+        by_range = (lim.servo_limit_rad - lim.max_offset_rad) / unit.peak_angle
+        candidates = ((lim.max_amplitude_scale, 'the largest amplitude scale '
+                       f'{lim.max_amplitude_scale:g}'),
+                      (by_rate, f'the servo slew limit {lim.servo_rate_limit_rad_s:g} rad/s x '
+                       f'{lim.slew_margin:g}'),
+                      (by_range, f'the servo range {lim.servo_limit_rad:.3g} rad less the '
+                       f'turning offset {lim.max_offset_rad:g} rad'))
+        return min(candidates, key=lambda c: c[0])
+
+    def frontier_point(self, frequency_hz: float) -> GaitPoint:
+        """Return the gait at ``frequency_hz`` with its largest feasible amplitude scale."""
+        scale, _ = self.feasible_scale(frequency_hz)
+        return self._point(frequency_hz, scale)
+
+    @property
+    def fastest(self) -> GaitPoint:
+        """Return the fastest feasible gait found on the frontier scan."""
+        return self._fastest
+
+    def choose(self, target_speed: float) -> GaitChoice:
+        """Return the gait for ``target_speed`` (m/s, >= 0) by the documented policy."""
+        if not (math.isfinite(target_speed) and target_speed >= 0.0):
+            raise ValueError(f'target speed must be finite and >= 0, got {target_speed}')
+        if target_speed == 0.0:
+            return GaitChoice(0.0, None)
+        lim = self.limits
+        fastest = self._fastest
+        if target_speed >= fastest.speed:
+            _, binding = self.feasible_scale(fastest.frequency_hz)
+            reason = (f'{target_speed:.3f} m/s is above the fastest feasible gait '
+                      f'({fastest.speed:.3f} m/s at {fastest.frequency_hz:.2f} Hz, scale '
+                      f'{fastest.amplitude_scale:.2f}, bound by {binding})')
+            return GaitChoice(target_speed, fastest, '' if target_speed == fastest.speed
+                              else reason)
+        slowest = self.frontier_point(lim.min_frequency_hz)
+        if target_speed <= slowest.speed:
+            top = slowest.amplitude_scale
+            scale = brentq(lambda s: self._point(lim.min_frequency_hz, s).speed - target_speed,
+                           1e-6 * top, top, xtol=1e-9 * top)
+            return GaitChoice(target_speed, self._point(lim.min_frequency_hz, float(scale)))
+        frequency = brentq(lambda f: self.frontier_point(f).speed - target_speed,
+                           lim.min_frequency_hz, fastest.frequency_hz, xtol=1e-6,
+                           rtol=SPEED_TOLERANCE_M_S)
+        return GaitChoice(target_speed, self.frontier_point(float(frequency)))

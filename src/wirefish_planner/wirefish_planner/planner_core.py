@@ -1,0 +1,221 @@
+"""
+The planner's rules (pure; no rclpy): cmd_vel in, gait and turning offset out.
+
+Modes
+    ``rest``      no cmd_vel yet, the last one older than ``cmd_vel_timeout_s``, or speed 0:
+                  amplitudes and offsets go to 0 (the CPG converges there smoothly), the
+                  heading hold releases and the integrator empties.
+    ``turn``      angular.z != 0: the yaw-rate PI tracks angular.z (REP-103: + turns left).
+    ``hold``      angular.z = 0 with ``heading_hold``: the heading latched when the turn command
+                  ended (or when swimming started) is held on the IMU yaw.
+    ``straight``  angular.z = 0 without heading hold: the yaw-rate PI tracks 0.
+    ``open_loop`` ``yaw_control`` off, or no IMU sample for ``imu_timeout_s``: the feed-forward
+                  offset of angular.z alone.
+Speed: ``GaitPlanner.choose`` (eq 18 inverted, ``gait_family``); turning: ``yaw_control``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+from wirefish_planner.gait_family import GaitChoice, GaitPlanner
+from wirefish_planner.yaw_control import (feedforward_offset, heading_rate_reference,
+                                          PeriodMean, wrap_angle, YawGains, YawRatePi)
+
+REST_WINDOW_S = 0.5  # filter window while no gait beats (s)
+SPEED_RESOLUTION_M_S = 0.001  # targets closer than this share a gait (no re-plan per message)
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """Timeouts (s) and which loops are closed."""
+
+    cmd_vel_timeout_s: float = 0.5
+    imu_timeout_s: float = 0.5
+    heading_hold: bool = True
+    yaw_control: bool = True
+
+    def __post_init__(self) -> None:
+        """Check the timeouts are finite and > 0."""
+        for name in ('cmd_vel_timeout_s', 'imu_timeout_s'):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f'{name} must be finite and > 0, got {value}')
+
+
+@dataclass(frozen=True)
+class PlannerOutput:
+    """What the planner wants now, and why (the content of PlannerState)."""
+
+    mode: str
+    gait: GaitChoice
+    offset: float
+    yaw_rate_target: float
+    yaw_rate_measured: float
+    heading_target: float  # nan without a hold
+    heading_measured: float  # nan before the first IMU sample
+    note: str  # '' or why a command could not be followed as given
+
+
+def command_problem(speed: float, yaw_rate: float) -> str | None:
+    """Return why a cmd_vel (linear.x m/s, angular.z rad/s) is refused, or None."""
+    if not (math.isfinite(speed) and math.isfinite(yaw_rate)):
+        return f'cmd_vel must be finite, got linear.x {speed}, angular.z {yaw_rate}'
+    if speed < 0.0:
+        return f'linear.x {speed:g} m/s refused: the fish cannot swim backwards'
+    return None
+
+
+def ignored_fields(linear: tuple[float, float, float],
+                   angular: tuple[float, float, float]) -> list[str]:
+    """Return the cmd_vel fields other than linear.x and angular.z that are not 0."""
+    names = ('linear.y', 'linear.z', 'angular.x', 'angular.y')
+    values = (linear[1], linear[2], angular[0], angular[1])
+    return [name for name, value in zip(names, values) if value != 0.0]
+
+
+class Planner:
+    """Holds the latest command and IMU state; ``step`` returns what the CPG should do."""
+
+    def __init__(self, gaits: GaitPlanner, gains: YawGains, settings: PlannerSettings) -> None:
+        """Start at rest with no command and no IMU sample."""
+        self.gaits = gaits
+        self.settings = settings
+        self.pi = YawRatePi(gains)
+        self._speed = 0.0
+        self._yaw_rate_cmd = 0.0
+        self._command_s: float | None = None
+        self._choice = GaitChoice(0.0, None)
+        self._imu_s: float | None = None  # stamp of the last IMU sample
+        self._imu_wall_s: float | None = None  # receipt time of the last IMU sample
+        self._unwrapped_yaw = math.nan
+        self._rate_mean = PeriodMean(REST_WINDOW_S)
+        self._yaw_mean = PeriodMean(REST_WINDOW_S)
+        self._measured_rate = math.nan
+        self._heading = math.nan
+        self._heading_target = math.nan
+        self._reference = 0.0
+        self._was_turning = True  # swimming straight from rest latches the heading too
+
+    def reconfigure(self, other: Planner) -> None:
+        """Take ``other``'s gaits, gains and settings (new parameters); keep the run's state."""
+        self.gaits, self.settings = other.gaits, other.settings
+        self.pi.gains = other.pi.gains
+        if not self.settings.heading_hold:
+            self._heading_target = math.nan
+        if math.isnan(self._heading_target):
+            self._was_turning = True  # the next straight command latches the heading again
+        if self._choice.point is not None:
+            self._choose(self._choice.target_speed)
+
+    # --- inputs -------------------------------------------------------------------------------
+    def command(self, now_s: float, speed: float, yaw_rate: float) -> str | None:
+        """Take a cmd_vel received at ``now_s``; return why it is refused (nothing changes)."""
+        problem = command_problem(speed, yaw_rate)
+        if problem is not None:
+            return problem
+        if self._resting(now_s):
+            self._was_turning = True  # a new run latches its heading when it goes straight
+        self._command_s = now_s
+        self._speed = speed
+        self._yaw_rate_cmd = yaw_rate
+        if abs(speed - self._choice.target_speed) >= SPEED_RESOLUTION_M_S or \
+                (speed == 0.0) != (self._choice.point is None):
+            self._choose(speed)
+        if yaw_rate != 0.0:
+            self._was_turning = True
+            self._heading_target = math.nan
+        elif self._was_turning and self.settings.heading_hold:
+            self._was_turning = False
+            self._heading_target = self._heading_now()
+        return None
+
+    def imu(self, now_s: float, stamp_s: float, yaw: float, yaw_rate: float) -> None:
+        """Take an IMU sample (stamp from its header) and run the yaw loop on its dt."""
+        if not (math.isfinite(yaw) and math.isfinite(yaw_rate) and math.isfinite(stamp_s)):
+            return
+        previous = self._imu_s
+        if previous is not None and stamp_s <= previous:
+            return  # out of order or repeated: no dt
+        self._unwrapped_yaw = yaw if math.isnan(self._unwrapped_yaw) else \
+            self._unwrapped_yaw + wrap_angle(yaw - self._unwrapped_yaw)
+        self._imu_s, self._imu_wall_s = stamp_s, now_s
+        self._measured_rate = self._rate_mean.add(stamp_s, yaw_rate)
+        self._heading = self._yaw_mean.add(stamp_s, self._unwrapped_yaw)
+        if math.isnan(self._heading_target) and not self._was_turning and \
+                self.settings.heading_hold and self._swimming(now_s):
+            self._heading_target = self._heading_now()  # the first sample of a straight run
+        if previous is None or not self._swimming(now_s) or not self.settings.yaw_control:
+            return
+        self._reference = self._yaw_rate_reference()
+        self.pi.update(self._reference, self._measured_rate, stamp_s - previous,
+                       self._choice.predicted_speed)
+
+    # --- outputs ------------------------------------------------------------------------------
+    def step(self, now_s: float) -> PlannerOutput:
+        """Return the gait, offset and state for now (timeouts are judged here)."""
+        if not self._swimming(now_s):
+            self.pi.reset()
+            self._heading_target = math.nan
+            self._was_turning = True
+            note = ''
+            if self._command_s is not None and not self._resting(now_s) and \
+                    self._yaw_rate_cmd != 0.0:
+                note = 'turning needs forward speed (r = k U b): resting'
+            mode = 'rest'
+            return PlannerOutput(mode, GaitChoice(0.0, None), 0.0, 0.0, self._measured_rate,
+                                 math.nan, self._wrapped_heading(), note)
+        speed = self._choice.predicted_speed
+        if self.settings.yaw_control and self._imu_fresh(now_s):
+            mode = 'turn' if self._yaw_rate_cmd != 0.0 else (
+                'hold' if not math.isnan(self._heading_target) else 'straight')
+            offset = self.pi.offset
+            reference = self._reference
+        else:
+            mode = 'open_loop'
+            self.pi.reset()
+            reference = self._yaw_rate_cmd
+            limit = self.pi.gains.max_offset_rad
+            offset = min(limit, max(-limit, feedforward_offset(
+                reference, speed, self.pi.gains.turn_gain)))
+        target = self._heading_target
+        return PlannerOutput(mode, self._choice, offset, reference, self._measured_rate,
+                             math.nan if math.isnan(target) else wrap_angle(target),
+                             self._wrapped_heading(), '')
+
+    # --- helpers ------------------------------------------------------------------------------
+    def _choose(self, speed: float) -> None:
+        """Choose the gait for ``speed``; the filters then average over its tail-beat period."""
+        self._choice = self.gaits.choose(speed)
+        window = (REST_WINDOW_S if self._choice.point is None
+                  else 1.0 / self._choice.point.frequency_hz)
+        self._rate_mean.window_s = self._yaw_mean.window_s = window
+
+    def _resting(self, now_s: float) -> bool:
+        return self._command_s is None or \
+            now_s - self._command_s > self.settings.cmd_vel_timeout_s
+
+    def _swimming(self, now_s: float) -> bool:
+        return not self._resting(now_s) and self._choice.point is not None
+
+    def _imu_fresh(self, now_s: float) -> bool:
+        return self._imu_wall_s is not None and \
+            now_s - self._imu_wall_s <= self.settings.imu_timeout_s
+
+    def _heading_now(self) -> float:
+        """Return the heading now: the period mean lags a turning fish by half its window."""
+        if math.isnan(self._heading):
+            return math.nan
+        rate = 0.0 if math.isnan(self._measured_rate) else self._measured_rate
+        return self._heading + 0.5 * self._yaw_mean.window_s * rate
+
+    def _wrapped_heading(self) -> float:
+        return math.nan if math.isnan(self._heading) else wrap_angle(self._heading)
+
+    def _yaw_rate_reference(self) -> float:
+        if self._yaw_rate_cmd != 0.0 or math.isnan(self._heading_target):
+            return self._yaw_rate_cmd
+        g = self.pi.gains
+        return heading_rate_reference(self._heading_target, self._heading, g.heading_gain,
+                                      g.max_hold_rate)

@@ -1,0 +1,209 @@
+"""
+Fixtures of the planner's cross-process tests: one graph per module, a driver probe in-process.
+
+The graph is the virtual fish (with a constant yaw disturbance: a current), the bridge, the
+CPG and the planner, each its own process as `wirefish up` starts them, on a domain and a
+namespace of this module's own. The probe publishes cmd_vel at 20 Hz and records
+sim/ground_truth, servo_cmd and planner_state with their receive times.
+"""
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+import os
+from pathlib import Path
+import subprocess
+import threading
+import time
+
+from ament_index_python.packages import get_package_prefix, get_package_share_directory
+import pytest
+from ros_utils import stop_process
+
+NAMESPACE = '/h181_planner'
+YAW_DISTURBANCE_RAD_S = 0.05  # the current: 2.9 deg/s of yaw on a straight tail
+CMD_RATE_HZ = 20.0
+
+
+def executable(package: str, name: str) -> str:
+    """Return the installed executable ``name`` of ``package`` (where `ros2 run` finds it)."""
+    return str(Path(get_package_prefix(package), 'lib', package, name))
+
+
+@dataclass
+class PlannerGraph:
+    """The graph's processes and how to reach it."""
+
+    processes: dict[str, subprocess.Popen]
+    env: dict[str, str]
+    domain_id: int
+    namespace: str
+    link: Path
+
+
+def _ros_args(namespace: str, *extra: str) -> list[str]:
+    params = Path(get_package_share_directory('wirefish_bringup'), 'config', 'wirefish.yaml')
+    return ['--ros-args', '-r', f'__ns:={namespace}', '--params-file', str(params), *extra]
+
+
+def start_planner_graph(domain_id: int, namespace: str = NAMESPACE,
+                        fish_flags: tuple[str, ...] = ()) -> PlannerGraph:
+    """Start fish_sim, bridge_node, cpg_node and planner_node; return once the fish is up."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1',
+               RCUTILS_COLORIZED_OUTPUT='0')
+    link = Path('/tmp', f'wirefish-h8-planner-{domain_id}-tty')
+    procs: dict[str, subprocess.Popen] = {}
+
+    def start(name: str, args: list[str]) -> subprocess.Popen:
+        procs[name] = subprocess.Popen(args, env=env, stdout=subprocess.PIPE,
+                                       stderr=subprocess.STDOUT, text=True,
+                                       start_new_session=True)
+        return procs[name]
+
+    fish = start('fish_sim', [executable('wirefish_sim', 'fish_sim'), '--link', str(link),
+                              '--ros', *fish_flags, *_ros_args(namespace)])
+    if not fish.stdout.readline():
+        raise RuntimeError('fish_sim did not start: ' + fish.stdout.read())
+    start('bridge_node', [executable('wirefish_bridge', 'bridge_node'),
+                          *_ros_args(namespace, '-p', f'port:={link}')])
+    start('cpg_node', [executable('wirefish_cpg', 'cpg_node'), *_ros_args(namespace)])
+    start('planner_node', [executable('wirefish_planner', 'planner_node'),
+                           *_ros_args(namespace)])
+    return PlannerGraph(procs, env, domain_id, namespace, link)
+
+
+def stop_planner_graph(graph: PlannerGraph) -> dict[str, int | None]:
+    """Stop every process (SIGINT, then SIGKILL); return the exit codes, printing the logs."""
+    codes = {}
+    for name, proc in reversed(list(graph.processes.items())):
+        codes[name] = stop_process(proc, timeout_s=10.0)
+        output = proc.stdout.read()
+        proc.stdout.close()
+        print(f'--- {name} (exit {codes[name]}) ---\n{output[-3000:]}')
+    return codes
+
+
+@dataclass
+class Recording:
+    """What the probe heard: lists of tuples, appended from the probe's thread."""
+
+    truth: list = field(default_factory=list)  # (t, x, y, yaw, speed, yaw_rate)
+    servo: list = field(default_factory=list)  # (stamp s, p1, p2, v1, v2)
+    state: list = field(default_factory=list)  # (t, PlannerState)
+
+
+class Driver:
+    """A node in the test process: publishes cmd_vel at 20 Hz, records the graph."""
+
+    def __init__(self, context, namespace: str) -> None:
+        """Create the node, its subscriptions and the cmd_vel timer; spin on a thread."""
+        from geometry_msgs.msg import Twist
+        from nav_msgs.msg import Odometry
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.qos import qos_profile_sensor_data
+        from sensor_msgs.msg import JointState
+        from wirefish_msgs.msg import PlannerState
+
+        self._twist = Twist
+        self.node = rclpy.create_node('h8_driver', namespace=namespace, context=context)
+        self.recording = Recording()
+        self.command: tuple[float, float] | None = None  # None: publish nothing
+        self._lock = threading.Lock()
+        self._pub = self.node.create_publisher(Twist, 'cmd_vel', 10)
+        self.node.create_subscription(Odometry, 'sim/ground_truth', self._on_truth, 50)
+        self.node.create_subscription(JointState, 'servo_cmd', self._on_servo,
+                                      qos_profile_sensor_data)
+        self.node.create_subscription(PlannerState, 'planner_state', self._on_state, 50)
+        self.node.create_timer(1.0 / CMD_RATE_HZ, self._on_timer)
+        self._executor = SingleThreadedExecutor(context=context)
+        self._executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._executor.spin, daemon=True)
+        self._thread.start()
+
+    def now(self) -> float:
+        """Return the probe's clock (s)."""
+        return self.node.get_clock().now().nanoseconds * 1e-9
+
+    def _on_timer(self) -> None:
+        command = self.command
+        if command is not None:
+            msg = self._twist()
+            msg.linear.x, msg.angular.z = command
+            self._pub.publish(msg)
+
+    def _on_truth(self, msg) -> None:
+        import math
+        q = msg.pose.pose.orientation
+        yaw = 2.0 * math.atan2(q.z, q.w)
+        self.recording.truth.append((self.now(), msg.pose.pose.position.x,
+                                     msg.pose.pose.position.y, yaw, msg.twist.twist.linear.x,
+                                     msg.twist.twist.angular.z))
+
+    def _on_servo(self, msg) -> None:
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        self.recording.servo.append((stamp, *msg.position, *msg.velocity))
+
+    def _on_state(self, msg) -> None:
+        self.recording.state.append((self.now(), msg))
+
+    def set_parameters(self, node_name: str, **values) -> None:
+        """Set parameters of a node of the graph (raises if refused)."""
+        from rcl_interfaces.srv import SetParameters
+        from rclpy.parameter import Parameter
+
+        client = self.node.create_client(SetParameters, f'{node_name}/set_parameters')
+        assert client.wait_for_service(timeout_sec=10.0), f'no {client.srv_name}'
+        request = SetParameters.Request(parameters=[
+            Parameter(k, value=v).to_parameter_msg() for k, v in values.items()])
+        future = client.call_async(request)
+        deadline = time.monotonic() + 10.0
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert future.done(), f'{client.srv_name} did not answer'
+        results = future.result().results
+        assert all(r.successful for r in results), [r.reason for r in results]
+        self.node.destroy_client(client)
+
+    def close(self) -> None:
+        """Stop spinning and destroy the node."""
+        self._executor.shutdown()
+        self._thread.join(timeout=5.0)
+        self.node.destroy_node()
+
+
+@pytest.fixture(scope='module')
+def planner_domain_id() -> int:
+    """Return the ROS domain of this module's graph (outside the per-test window)."""
+    return int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21')) + 19
+
+
+@pytest.fixture(scope='module')
+def planner_graph(planner_domain_id: int) -> Iterator[PlannerGraph]:
+    """Yield the module's graph (virtual fish with a current); stop it afterwards."""
+    graph = start_planner_graph(planner_domain_id, fish_flags=(
+        '--yaw-disturbance', str(YAW_DISTURBANCE_RAD_S)))
+    try:
+        yield graph
+    finally:
+        codes = stop_planner_graph(graph)
+        assert not graph.link.exists(), 'fish_sim left its pty link behind'
+        print('exit codes:', codes)
+
+
+@pytest.fixture
+def driver(planner_graph: PlannerGraph, monkeypatch: pytest.MonkeyPatch) -> Iterator[Driver]:
+    """Yield a driver node on the graph's domain, in a context of its own."""
+    import rclpy
+    from rclpy.context import Context
+
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    context = Context()
+    rclpy.init(context=context, domain_id=planner_graph.domain_id)
+    probe = Driver(context, planner_graph.namespace)
+    try:
+        yield probe
+    finally:
+        probe.command = None
+        probe.close()
+        rclpy.try_shutdown(context=context)

@@ -1,0 +1,122 @@
+"""
+Issue 14's acceptance on the virtual fish, across processes, measured on sim/ground_truth.
+
+One graph (fish_sim with a constant yaw disturbance, bridge, CPG, planner) and one drive in
+phases, because each phase needs many seconds of swimming: rest before any cmd_vel; speed
+setpoints 0.10 / 0.20 / 0.30 m/s; yaw rate +-0.2 rad/s at 0.2 m/s; heading hold against the
+current, then the same straight run with the hold off (rate loop only) and with the yaw loop
+off (open loop), printed; cmd_vel stops. The servo commands of the whole drive are checked for
+steps at every switch. Wall time ~2.5 min.
+"""
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+SETTLE_S = 7.0  # surge ~1.5 s time constant (drag ~ U^2 about the force scale) x 4 and more
+SPEED_WINDOW_S = 5.0
+TURN_SETTLE_S = 4.0
+TURN_WINDOW_S = 5.0
+HOLD_SETTLE_S = 5.0
+HOLD_WINDOW_S = 30.0
+OFF_WINDOW_S = 15.0
+STOP_WITHIN_S = 5.0
+
+
+def _window(rows: list, start: float, end: float) -> np.ndarray:
+    data = np.array([r for r in rows if start <= r[0] < end])
+    assert len(data) > 10, f'too few samples in [{start:.1f}, {end:.1f})'
+    return data
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, float]:
+    driver.command = command
+    start = driver.now()
+    time.sleep(seconds)
+    return start, driver.now()
+
+
+@pytest.mark.ros
+def test_drive_the_virtual_fish(driver):
+    rec = driver.recording
+    deadline = time.monotonic() + 30.0
+    while len(rec.truth) < 50 or len(rec.state) < 10:  # discovery on a loaded machine
+        assert time.monotonic() < deadline, 'no ground truth / planner_state from the graph'
+        time.sleep(0.1)
+    # No cmd_vel ever received: the planner rests the fish (cpg_node starts with Table 1).
+    time.sleep(3.0)
+    t0 = driver.now()
+    resting = _window(rec.servo, t0 - 1.0 - 0.2, t0)  # servo stamps: the CPG node's clock
+    print(f'rest before any cmd_vel: max |servo_cmd| {np.abs(resting[:, 1:3]).max():.4f} rad')
+    assert np.abs(resting[:, 1:3]).max() < 0.02
+    assert rec.state[-1][1].mode == 'rest'
+
+    results = {}
+    for setpoint in (0.10, 0.20, 0.30):
+        start, end = _hold(driver, (setpoint, 0.0), SETTLE_S + SPEED_WINDOW_S)
+        speed = _window(rec.truth, start + SETTLE_S, end)[:, 4].mean()
+        results[setpoint] = speed
+        print(f'speed setpoint {setpoint:.2f} m/s: ground truth mean {speed:.4f} m/s '
+              f'({100 * (speed / setpoint - 1):+.1f} %), predicted '
+              f'{rec.state[-1][1].predicted_speed:.4f} at {rec.state[-1][1].tail_beat_hz:.2f} Hz')
+
+    turns = {}
+    for rate in (0.2, -0.2):
+        start, end = _hold(driver, (0.2, rate), TURN_SETTLE_S + TURN_WINDOW_S)
+        turns[rate] = _window(rec.truth, start + TURN_SETTLE_S, end)[:, 5].mean()
+        print(f'yaw-rate setpoint {rate:+.2f} rad/s at 0.2 m/s: ground truth mean '
+              f'{turns[rate]:+.4f} rad/s ({100 * (turns[rate] / rate - 1):+.1f} %)')
+
+    # The turn ends: the heading it had then is held against the current.
+    start, end = _hold(driver, (0.2, 0.0), HOLD_SETTLE_S + HOLD_WINDOW_S)
+    hold_target = rec.state[-1][1].heading_target
+    held = _window(rec.truth, start + HOLD_SETTLE_S, end)
+    hold_rms = math.degrees(math.sqrt(np.mean(_wrap(held[:, 3] - hold_target) ** 2)))
+    print(f'heading hold with a {0.05:.2f} rad/s current: target {math.degrees(hold_target):.1f}'
+          f' deg, RMS error over {HOLD_WINDOW_S:.0f} s {hold_rms:.2f} deg')
+
+    drifts = {}
+    for name, values in (('heading hold off (yaw-rate loop only)', {'heading_hold': False}),
+                         ('yaw loops off (open loop)', {'yaw_control': False})):
+        driver.set_parameters('planner_node', **values)
+        start, end = _hold(driver, (0.2, 0.0), OFF_WINDOW_S)
+        off = _window(rec.truth, start, end)
+        drifts[name] = math.degrees(_wrap(off[-1, 3] - off[0, 3]))
+        print(f'{name}: heading drifts {drifts[name]:+.1f} deg in {end - start:.0f} s')
+        driver.set_parameters('planner_node', heading_hold=True, yaw_control=True)
+
+    driver.command = None  # cmd_vel stops
+    stopped = driver.now()
+    time.sleep(STOP_WITHIN_S + 1.0)
+    after = np.array([r for r in rec.truth if r[0] >= stopped])
+    slow = after[after[:, 4] < 0.02]
+    stop_time = slow[0, 0] - stopped if len(slow) else math.inf
+    print(f'cmd_vel stopped: ground-truth speed < 0.02 m/s after {stop_time:.2f} s; '
+          f'mode {rec.state[-1][1].mode}')
+
+    servo = np.array(rec.servo)
+    servo = servo[np.argsort(servo[:, 0])]
+    dt = np.diff(servo[:, 0])
+    steps = np.abs(np.diff(servo[:, 1:3], axis=0))
+    # The CPG's smooth bound: between two samples the command moves no faster than the larger
+    # of the two rates it reports (plus its change over one sample), never by a jump.
+    bound = 1.5 * np.maximum(np.abs(servo[:-1, 3:5]), np.abs(servo[1:, 3:5])) * dt[:, None] \
+        + 1e-3
+    worst = float((steps - bound).max())
+    print(f'servo_cmd: {len(servo)} samples, largest change {steps.max():.4f} rad, '
+          f'largest excess over the smooth bound {worst:.5f} rad')
+
+    for setpoint, speed in results.items():
+        assert abs(speed - setpoint) <= 0.10 * setpoint, (setpoint, speed)
+    for rate, measured in turns.items():
+        assert np.sign(measured) == np.sign(rate) and abs(measured - rate) <= 0.2 * abs(rate)
+    assert hold_rms < 3.0
+    assert abs(drifts['yaw loops off (open loop)']) > 3.0 * hold_rms
+    assert stop_time <= STOP_WITHIN_S
+    assert worst <= 0.0
