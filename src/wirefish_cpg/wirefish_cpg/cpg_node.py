@@ -42,6 +42,7 @@ from wirefish_cpg.cpg_node_parameters import NODE_PARAMETERS, SPECS
 from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES, parameters_from
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import at_rest, CpgIntegrator
+from wirefish_cpg.servo_limit import clamp_to_limit
 from wirefish_msgs.msg import CpgParams
 
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -145,14 +146,12 @@ class CpgNode(Node):
             self._cpg.advance(t, max_steps=int(MAX_CATCH_UP_S / self._cpg.step_s))
             angles, rates = self._cpg.output(t)
             limit = self._values['servo_limit_rad']
-        clamped = abs(angles) > limit
-        if clamped.any():
+        commanded, rates, clamped = clamp_to_limit(angles, rates, limit)
+        if clamped:
             self.get_logger().warn(
                 f'CPG output {angles.round(3).tolist()} rad beyond servo_limit_rad = {limit:g};'
                 ' clamped', throttle_duration_sec=2.0)
-            angles = angles.clip(-limit, limit)
-            rates = rates * ~clamped
-        self._servo_pub.publish(servo_joint_state(angles.tolist(), rates.tolist(),
+        self._servo_pub.publish(servo_joint_state(commanded.tolist(), rates.tolist(),
                                                   now.to_msg()))
 
 
