@@ -2,98 +2,35 @@
 
 import math
 import os
-from pathlib import Path
-import select
 import subprocess
 import time
 
-from ament_index_python.packages import get_package_prefix
-from diagnostic_msgs.msg import DiagnosticArray
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import qos_profile_sensor_data
 from ros_utils import spin_until, stop_process
-from sensor_msgs.msg import Imu, JointState
+from sensor_msgs.msg import JointState
+from wirefish_bridge.protocol import ServoCommand
 
 pytestmark = pytest.mark.ros
-BIN = Path(get_package_prefix('wirefish_bridge')) / 'lib' / 'wirefish_bridge'
-SIM_BIN = Path(get_package_prefix('wirefish_sim')) / 'lib' / 'wirefish_sim'
-
-
-def _start_fish(spawn, link: Path, *flags: str):
-    proc = spawn([str(SIM_BIN / 'fish_sim'), '--link', str(link), *flags])
-    deadline = time.monotonic() + 10.0
-    while not link.is_symlink() and time.monotonic() < deadline:
-        assert proc.poll() is None, proc.stdout.read()
-        time.sleep(0.02)
-    assert link.is_symlink()
-    return proc
-
-
-def _start_bridge(spawn, link: Path, *params: str):
-    args = [str(BIN / 'bridge_node'), '--ros-args', '-p', f'port:={link}']
-    for param in params:
-        args += ['-p', param]
-    return spawn(args)
-
-
-class Probe:
-    """A test node recording imu/data, servo_state and /diagnostics, publishing servo_cmd."""
-
-    def __init__(self, context):
-        self.node = rclpy.create_node('bridge_probe', context=context)
-        self.imu, self.servo, self.diagnostics = [], [], []
-        self.node.create_subscription(Imu, 'imu/data', self.imu.append, qos_profile_sensor_data)
-        self.node.create_subscription(JointState, 'servo_state', self.servo.append,
-                                      qos_profile_sensor_data)
-        self.node.create_subscription(DiagnosticArray, '/diagnostics', self.diagnostics.append,
-                                      10)
-        self.cmd = self.node.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)
-        self.executor = SingleThreadedExecutor(context=context)
-        self.executor.add_node(self.node)
-
-    def spin_for(self, seconds: float, command=None, rate_hz: float = 100.0):
-        deadline = time.monotonic() + seconds
-        next_cmd = time.monotonic()
-        while time.monotonic() < deadline:
-            if command is not None and time.monotonic() >= next_cmd:
-                self.cmd.publish(JointState(name=['servo_1', 'servo_2'], position=command))
-                next_cmd += 1.0 / rate_hz
-            self.executor.spin_once(timeout_sec=0.002)
-
-    def last_diagnostics(self) -> dict[str, str]:
-        return {kv.key: kv.value for kv in self.diagnostics[-1].status[0].values}
-
-    def close(self):
-        self.executor.shutdown()
-        self.node.destroy_node()
-
-
-@pytest.fixture
-def probe(ros_context):
-    p = Probe(ros_context)
-    yield p
-    p.close()
 
 
 def _stamp(msg) -> float:
     return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
 
 
-def test_servo_commands_reach_the_fish_and_come_back_measured(spawn, probe, tmp_path):
+def test_servo_commands_reach_the_fish_and_come_back_measured(
+        start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    _start_fish(spawn, link)
-    _start_bridge(spawn, link)
+    start_fish(link)
+    start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     probe.spin_for(1.5, command=[0.3, -0.2])
     assert probe.servo[-1].position.tolist() == pytest.approx([0.3, -0.2], abs=1e-3)
 
 
-def test_imu_data_arrives_at_100_hz(spawn, probe, tmp_path):
+def test_imu_data_arrives_at_100_hz(start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    _start_fish(spawn, link)
-    _start_bridge(spawn, link)
+    start_fish(link)
+    start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     probe.imu.clear()
     probe.spin_for(6.0)
@@ -104,11 +41,11 @@ def test_imu_data_arrives_at_100_hz(spawn, probe, tmp_path):
     assert probe.imu[-1].header.frame_id == 'imu_link'
 
 
-def test_bridge_reconnects_each_time_the_fish_reopens_its_device(spawn, probe, tmp_path):
+def test_bridge_reconnects_each_time_the_fish_reopens_its_device(
+        start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    _start_fish(spawn, link, '--reopen-every', '1.5', '--reopen-count', '5',
-                '--reopen-delay', '0.3')
-    bridge = _start_bridge(spawn, link, 'reconnect_backoff_max_s:=0.5')
+    start_fish(link, '--reopen-every', '1.5', '--reopen-count', '5', '--reopen-delay', '0.3')
+    bridge = start_bridge(link, 'reconnect_backoff_max_s:=0.5')
     assert spin_until(probe.executor, lambda: len(probe.imu) > 0, 20.0)
     assert spin_until(probe.executor, lambda: probe.diagnostics and
                       probe.last_diagnostics()['reconnects'] == '5', 20.0)
@@ -122,11 +59,12 @@ def test_bridge_reconnects_each_time_the_fish_reopens_its_device(spawn, probe, t
     assert max(gaps) < 0.3 + 2.0  # device absent 0.3 s, reconnected within 2 s
 
 
-def test_corrupted_bytes_are_counted_and_never_published(spawn, probe, tmp_path):
+def test_corrupted_bytes_are_counted_and_never_published(
+        start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
     # A perfect IMU on a fish at rest: every valid telemetry carries exactly known values.
-    _start_fish(spawn, link, '--corrupt-fraction', '0.05', '--imu-noise-scale', '0')
-    _start_bridge(spawn, link)
+    start_fish(link, '--corrupt-fraction', '0.05', '--imu-noise-scale', '0')
+    start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 0, 20.0)
     probe.spin_for(5.0)
     diagnostics = probe.last_diagnostics()
@@ -143,11 +81,11 @@ def test_corrupted_bytes_are_counted_and_never_published(spawn, probe, tmp_path)
     assert all(m.position.tolist() == [0.0, 0.0] for m in probe.servo)
 
 
-def test_bridge_commands_neutral_when_servo_cmd_stops(spawn, probe, tmp_path):
+def test_bridge_commands_neutral_when_servo_cmd_stops(start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
     # The firmware's own timeout is long, so neutral here comes from the bridge.
-    _start_fish(spawn, link, '--command-timeout', '10')
-    _start_bridge(spawn, link, 'command_timeout_s:=0.3')
+    start_fish(link, '--command-timeout', '10')
+    start_bridge(link, 'command_timeout_s:=0.3')
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     probe.spin_for(1.5, command=[0.4, 0.3])
     assert probe.servo[-1].position.tolist() == pytest.approx([0.4, 0.3], abs=1e-3)
@@ -162,10 +100,10 @@ def test_bridge_commands_neutral_when_servo_cmd_stops(spawn, probe, tmp_path):
     assert probe.last_diagnostics()['failsafe'] == 'True'
 
 
-def test_bridge_and_fish_exit_cleanly_on_sigint(spawn, probe, tmp_path):
+def test_bridge_and_fish_exit_cleanly_on_sigint(start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    fish = _start_fish(spawn, link)
-    bridge = _start_bridge(spawn, link)
+    fish = start_fish(link)
+    bridge = start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     assert stop_process(bridge) == 0
     assert stop_process(fish) == 0
@@ -173,40 +111,33 @@ def test_bridge_and_fish_exit_cleanly_on_sigint(spawn, probe, tmp_path):
     assert math.isfinite(_stamp(probe.imu[-1]))
 
 
-def _set_parameters(probe, parameters):
-    from rcl_interfaces.srv import SetParameters
-    client = probe.node.create_client(SetParameters, 'bridge_node/set_parameters')
-    assert spin_until(probe.executor, client.service_is_ready, 20.0)
-    future = client.call_async(SetParameters.Request(
-        parameters=[p.to_parameter_msg() for p in parameters]))
-    assert spin_until(probe.executor, future.done, 10.0)
-    return future.result().results
-
-
-def test_invalid_parameter_is_refused_with_a_reason_and_a_valid_one_applies(spawn, probe,
-                                                                            tmp_path):
+def test_invalid_parameter_is_refused_with_a_reason_and_a_valid_one_applies(
+        start_fish, start_bridge, probe, tmp_path):
     from rclpy.parameter import Parameter
     link = tmp_path / 'tty'
-    _start_fish(spawn, link)
-    _start_bridge(spawn, link)
-    (refused,) = _set_parameters(probe, [Parameter('command_timeout_s', value=-1.0)])
+    start_fish(link)
+    start_bridge(link)
+    (refused,) = probe.set_parameters('bridge_node',
+                                      [Parameter('command_timeout_s', value=-1.0)])
     assert not refused.successful and 'command_timeout_s' in refused.reason
-    (backoff,) = _set_parameters(probe, [Parameter('reconnect_backoff_max_s', value=0.05)])
+    (backoff,) = probe.set_parameters('bridge_node',
+                                      [Parameter('reconnect_backoff_max_s', value=0.05)])
     assert not backoff.successful and 'reconnect_backoff' in backoff.reason
-    (applied,) = _set_parameters(probe, [Parameter('imu_frame_id', value='imu_test')])
+    (applied,) = probe.set_parameters('bridge_node',
+                                      [Parameter('imu_frame_id', value='imu_test')])
     assert applied.successful
     assert spin_until(probe.executor,
                       lambda: probe.imu and probe.imu[-1].header.frame_id == 'imu_test', 10.0)
 
 
 def test_fish_sim_publishes_ground_truth_of_a_fish_swimming_on_bridge_commands(
-        spawn, probe, tmp_path):
+        start_fish, start_bridge, probe, tmp_path):
     from nav_msgs.msg import Odometry
     truth = []
     probe.node.create_subscription(Odometry, 'sim/ground_truth', truth.append, 10)
     link = tmp_path / 'tty'
-    _start_fish(spawn, link, '--ros')
-    _start_bridge(spawn, link)
+    start_fish(link, '--ros')
+    start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10 and truth, 20.0)
     start = time.monotonic()
     deadline = start + 3.0
@@ -223,10 +154,10 @@ def test_fish_sim_publishes_ground_truth_of_a_fish_swimming_on_bridge_commands(
     assert last.twist.twist.linear.x > 0.1 and last.pose.pose.position.x > 0.1
 
 
-def test_dropped_frames_are_counted_as_sequence_gaps(spawn, probe, tmp_path):
+def test_dropped_frames_are_counted_as_sequence_gaps(start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    _start_fish(spawn, link, '--drop-fraction', '0.2')
-    _start_bridge(spawn, link)
+    start_fish(link, '--drop-fraction', '0.2')
+    start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     probe.spin_for(3.0)
     diagnostics = probe.last_diagnostics()
@@ -236,10 +167,11 @@ def test_dropped_frames_are_counted_as_sequence_gaps(spawn, probe, tmp_path):
     assert diagnostics['crc_errors'] == '0'
 
 
-def test_a_stalled_fish_shows_as_a_gap_and_the_stream_resumes(spawn, probe, tmp_path):
+def test_a_stalled_fish_shows_as_a_gap_and_the_stream_resumes(
+        start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    _start_fish(spawn, link, '--stall-every', '2.5', '--stall-for', '1.0')
-    bridge = _start_bridge(spawn, link)
+    start_fish(link, '--stall-every', '2.5', '--stall-for', '1.0')
+    bridge = start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     probe.spin_for(4.0)
     stamps = [_stamp(m) for m in probe.imu]
@@ -250,35 +182,20 @@ def test_a_stalled_fish_shows_as_a_gap_and_the_stream_resumes(spawn, probe, tmp_
     assert probe.last_diagnostics()['link_state'] == 'connected'
 
 
-def test_bridge_commands_neutral_as_it_shuts_down(spawn, probe, tmp_path):
+def test_bridge_commands_neutral_as_it_shuts_down(start_bridge, probe, fake_device):
     # This test plays the fish: it holds the pty's master side and decodes what arrives.
-    from wirefish_bridge.codec import StreamDecoder
-    from wirefish_bridge.protocol import ServoCommand
-    master, slave = os.openpty()
-    link = tmp_path / 'tty'
-    os.symlink(os.ttyname(slave), link)
-    bridge = _start_bridge(spawn, link)
+    bridge = start_bridge(fake_device.link)
     commands = []
-    decoder = StreamDecoder()
-
-    def read_available() -> None:
-        while True:
-            ready, _, _ = select.select([master], [], [], 0.0)
-            if not ready:
-                return
-            for frame in decoder.feed(os.read(master, 4096)):
-                if isinstance(frame.message, ServoCommand):
-                    commands.append((frame.message.servo_1, frame.message.servo_2))
-
     deadline = time.monotonic() + 20.0
     while not any(c == pytest.approx((0.4, 0.3), abs=1e-6) for c in commands):
         assert time.monotonic() < deadline, 'no servo command reached the fish'
+        fake_device.send_fish_heartbeat()
         probe.spin_for(0.05, command=[0.4, 0.3])
-        read_available()
+        commands += [(m.servo_1, m.servo_2) for m in fake_device.messages()
+                     if isinstance(m, ServoCommand)]
     assert stop_process(bridge) == 0
-    read_available()
-    os.close(master)
-    os.close(slave)
+    commands += [(m.servo_1, m.servo_2) for m in fake_device.messages()
+                 if isinstance(m, ServoCommand)]
     assert commands[-1] == (0.0, 0.0)
 
 
@@ -288,8 +205,9 @@ def test_bridge_commands_neutral_as_it_shuts_down(spawn, probe, tmp_path):
     ('--corrupt-fraction', '1.5', '--corrupt-fraction must be in [0, 1]'),
     ('--servo-rate-limit', '-2', 'rate_limit_rad_s must be finite and > 0'),
 ])
-def test_fish_sim_refuses_bad_flags_with_one_line(tmp_path, ros_env, flag, value, reason):
-    result = subprocess.run([str(SIM_BIN / 'fish_sim'), '--link', str(tmp_path / 'tty'), flag,
+def test_fish_sim_refuses_bad_flags_with_one_line(fish_sim_exe, tmp_path, ros_env, flag, value,
+                                                  reason):
+    result = subprocess.run([str(fish_sim_exe), '--link', str(tmp_path / 'tty'), flag,
                              value], env=ros_env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 2
     assert reason in result.stderr and 'Traceback' not in result.stderr, result.stderr

@@ -41,6 +41,11 @@ class CommandGate:
             self.clamped += 1
         return clamped
 
+    def counters(self) -> dict[str, object]:
+        """Return the gate's state and counters under their /diagnostics names."""
+        return {'failsafe': self.failsafe, 'failsafe_entries': self.failsafe_entries,
+                'commands_clamped': self.clamped}
+
     def on_command(self, angles: tuple[float, float], now: float
                    ) -> tuple[float, float] | None:
         """Take a new command (rad); return it (clamped) if it may go out now, else None."""

@@ -16,8 +16,7 @@ from sensor_msgs.msg import BatteryState, Imu, JointState
 
 from wirefish_bridge.conversions import diagonal_covariance, NOT_PROVIDED, quaternion_from_rpy
 from wirefish_bridge.protocol import Status, Telemetry
-
-SERVO_NAMES = ('servo_1', 'servo_2')
+from wirefish_common.servo_joints import servo_joint_state
 
 
 def imu_message(telemetry: Telemetry, stamp: Time, frame_id: str,
@@ -59,11 +58,7 @@ def attitude_message(telemetry: Telemetry, stamp: Time, frame_id: str) -> Vector
 
 def servo_state_message(telemetry: Telemetry, stamp: Time) -> JointState:
     """Return the measured servo angles (rad) as a sensor_msgs/JointState (no velocity)."""
-    msg = JointState()
-    msg.header.stamp = stamp
-    msg.name = list(SERVO_NAMES)
-    msg.position = [telemetry.servo_1, telemetry.servo_2]
-    return msg
+    return servo_joint_state((telemetry.servo_1, telemetry.servo_2), stamp=stamp)
 
 
 def battery_message(telemetry: Telemetry, stamp: Time, low_battery: bool) -> BatteryState:
@@ -84,10 +79,11 @@ def battery_message(telemetry: Telemetry, stamp: Time, low_battery: bool) -> Bat
     return msg
 
 
-def diagnostic_status(name: str, hardware_id: str, level: bytes, message: str,
+def diagnostic_status(name: str, hardware_id: str, level: int, message: str,
                       values: dict[str, object]) -> DiagnosticStatus:
-    """Return a diagnostic_msgs/DiagnosticStatus with ``values`` as strings."""
-    status = DiagnosticStatus(name=name, hardware_id=hardware_id, level=level, message=message)
+    """Return a diagnostic_msgs/DiagnosticStatus (level 0 OK, 1 WARN, 2 ERROR), values as text."""
+    status = DiagnosticStatus(name=name, hardware_id=hardware_id, level=bytes([int(level)]),
+                              message=message)
     status.values = [KeyValue(key=k, value=f'{v:.3f}' if isinstance(v, float) else str(v))
                      for k, v in values.items()]
     return status

@@ -6,6 +6,19 @@ bytes out (``write``, non-blocking). When the device disappears (unplugged, or t
 fish closed its pseudo-terminal) the reader thread reports it through ``on_state``, closes the
 port, and retries opening the same path with exponential backoff until it is back; nobody has
 to restart anything. Errors are typed (``LinkError`` and subclasses); nothing calls sys.exit.
+
+The port is opened exclusively: an advisory ``flock`` (pyserial's ``exclusive=True``), so a
+second link on the same device (another bridge, even as root) fails to open, says who holds it
+and keeps retrying, instead of splitting the byte stream. (TIOCEXCL is not used: root ignores
+it, and a process killed while holding it leaves the flag on a pty whose other end stays open,
+locking out everyone else; a flock dies with its holder.)
+
+With ``identify_timeout_s`` the link writes nothing until the peer has identified itself: the
+consumer, which understands the bytes, calls ``identify_peer()`` from ``on_data`` (the reader
+thread, so the identification belongs to the same open of the device). Until then the state
+is IDENTIFYING and ``write`` raises ``PeerNotIdentified``; a peer that does not identify
+itself within the timeout is closed and the path is reopened with backoff (it may point at
+another device by then, e.g. a virtual fish's symlink re-pointed).
 """
 
 from __future__ import annotations
@@ -13,8 +26,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 import enum
+import errno
 import os
 import threading
+import time
 
 import serial
 
@@ -31,10 +46,15 @@ class LinkWriteError(LinkError):
     """A write failed or was cut short (device gone, or its buffer full)."""
 
 
+class PeerNotIdentified(LinkError):
+    """The port is open but the device has not identified itself yet: nothing is written."""
+
+
 class LinkState(enum.Enum):
     """State of the link, as reported to ``on_state``."""
 
     CONNECTING = 'connecting'
+    IDENTIFYING = 'identifying'   # open, waiting for the peer to identify itself
     CONNECTED = 'connected'
     DISCONNECTED = 'disconnected'
     STOPPED = 'stopped'
@@ -51,6 +71,9 @@ class LinkStats:
     bytes_in: int = 0
     bytes_out: int = 0
     write_failures: int = 0
+    writes_withheld: int = 0   # writes refused because the peer had not identified itself
+    identify_timeouts: int = 0  # opens closed again: the peer never identified itself
+    last_open_unidentified: bool = False  # the last open ended so (reset when one identifies)
     last_error: str = ''
     callback_errors: int = 0  # exceptions raised by on_data (the reader goes on)
 
@@ -72,9 +95,9 @@ class SerialLink:
     def __init__(self, port: str, baudrate: int, on_data: Callable[[bytes], None],
                  on_state: Callable[[LinkState, str], None] | None = None, *,
                  backoff_min_s: float = 0.1, backoff_max_s: float = 1.0,
-                 read_timeout_s: float = 0.05,
+                 read_timeout_s: float = 0.05, identify_timeout_s: float | None = None,
                  serial_factory: Callable[..., serial.Serial] = serial.Serial) -> None:
-        """Configure the link; nothing is opened before ``start``."""
+        """Configure the link (``identify_timeout_s`` None: no identification); no I/O yet."""
         self.port = port
         self.baudrate = baudrate
         self.stats = LinkStats()
@@ -83,8 +106,11 @@ class SerialLink:
         self._backoff_min_s = backoff_min_s
         self._backoff_max_s = backoff_max_s
         self._read_timeout_s = read_timeout_s
+        self._identify_timeout_s = identify_timeout_s
         self._factory = serial_factory
         self._serial: serial.Serial | None = None
+        self._identified = False   # the peer of the current open identified itself
+        self._opened_at = 0.0
         self._lock = threading.Lock()   # guards _serial between the reader and writers
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -92,8 +118,17 @@ class SerialLink:
 
     @property
     def connected(self) -> bool:
-        """Return True while the port is open."""
+        """Return True while the port is open (and its peer identified, if that is required)."""
         return self.state is LinkState.CONNECTED
+
+    def identify_peer(self) -> None:
+        """Accept the peer of the current open: writes go out from now (call from on_data)."""
+        with self._lock:
+            if self._serial is None or self._identified:
+                return
+            self._identified = True
+        self.stats.last_open_unidentified = False
+        self._set_state(LinkState.CONNECTED, f'{self.port}: peer identified')
 
     def start(self) -> None:
         """Start the reader thread (which opens the port); idempotent."""
@@ -117,13 +152,17 @@ class SerialLink:
         """
         Write ``data`` without blocking.
 
-        Raises ``LinkDown`` when the port is not open, ``LinkWriteError`` when the device
-        failed or took only part of ``data`` (the receiver discards the cut frame).
+        Raises ``LinkDown`` when the port is not open, ``PeerNotIdentified`` before its peer
+        identified itself, ``LinkWriteError`` when the device failed or took only part of
+        ``data`` (the receiver discards the cut frame).
         """
         with self._lock:
             port = self._serial
             if port is None:
                 raise LinkDown(f'{self.port} is not open')
+            if not self._identified:
+                self.stats.writes_withheld += 1
+                raise PeerNotIdentified(f'{self.port} has not identified itself')
             try:
                 written = _write_without_blocking(port, data)
             except (serial.SerialException, OSError) as error:
@@ -142,6 +181,7 @@ class SerialLink:
     def _close(self) -> None:
         with self._lock:
             port, self._serial = self._serial, None
+            self._identified = False
         if port is not None:
             try:
                 port.close()
@@ -151,17 +191,21 @@ class SerialLink:
     def _open(self) -> bool:
         try:
             # write_timeout=0: non-blocking writes, so no caller ever waits on the device.
+            # exclusive=True: flock(LOCK_EX | LOCK_NB) before any termios change.
             port = self._factory(self.port, self.baudrate, timeout=self._read_timeout_s,
-                                 write_timeout=0)
+                                 write_timeout=0, exclusive=True)
             port.reset_input_buffer()  # stale bytes from before we were listening
         except (serial.SerialException, OSError, ValueError) as error:
             self.stats.open_failures += 1
-            if str(error) != self.stats.last_error:  # say it once, not at every retry
-                self._on_state(self.state, f'cannot open {self.port}: {error}; retrying')
-            self.stats.last_error = str(error)
+            reason = _open_failure(self.port, error)
+            if reason != self.stats.last_error:  # say it once, not at every retry
+                self._on_state(self.state, f'cannot open {self.port}: {reason}; retrying')
+            self.stats.last_error = reason
             return False
         with self._lock:
             self._serial = port
+            self._identified = self._identify_timeout_s is None
+        self._opened_at = time.monotonic()
         self.stats.opens += 1
         if self.stats.opens > 1:
             self.stats.reconnects += 1
@@ -175,10 +219,25 @@ class SerialLink:
             if port is None:
                 if self._open():
                     backoff = self._backoff_min_s
-                    self._set_state(LinkState.CONNECTED, f'{self.port} open')
+                    if self._identified:
+                        self._set_state(LinkState.CONNECTED, f'{self.port} open')
+                    else:
+                        self._set_state(LinkState.IDENTIFYING,
+                                        f'{self.port} open, waiting for it to identify itself')
                 else:
                     self._stop.wait(backoff)
                     backoff = next_backoff(backoff, self._backoff_min_s, self._backoff_max_s)
+                continue
+            if self._identify_overdue():
+                self.stats.identify_timeouts += 1
+                self.stats.last_open_unidentified = True
+                self.stats.last_error = (f'{self.port} did not identify itself within '
+                                         f'{self._identify_timeout_s:g} s')
+                self._close()
+                self._set_state(LinkState.CONNECTING,
+                                f'{self.stats.last_error}; closed, retrying')
+                self._stop.wait(backoff)
+                backoff = next_backoff(backoff, self._backoff_min_s, self._backoff_max_s)
                 continue
             try:
                 chunk = port.read(port.in_waiting or 1)
@@ -198,6 +257,35 @@ class SerialLink:
                     self.stats.callback_errors += 1
                     self.stats.last_error = f'on_data failed: {error!r}'
         self._close()
+
+    def _identify_overdue(self) -> bool:
+        return (not self._identified and self._identify_timeout_s is not None
+                and time.monotonic() - self._opened_at > self._identify_timeout_s)
+
+
+def _open_failure(path: str, error: Exception) -> str:
+    """Return why opening ``path`` failed; a lock held by another process is named as such."""
+    if getattr(error, 'errno', None) in (errno.EAGAIN, errno.EWOULDBLOCK):
+        holder = lock_holder(path)
+        return (f'in use by another process{f" (pid {holder})" if holder else ""}: it holds '
+                'the exclusive lock')
+    return str(error)
+
+
+def lock_holder(path: str, locks: str = '/proc/locks') -> int | None:
+    """Return the pid holding a flock on the device behind ``path`` (Linux), or None."""
+    try:
+        info = os.stat(path)
+        with open(locks, encoding='ascii') as table:
+            lines = table.read().splitlines()
+    except OSError:
+        return None
+    inode = f'{os.major(info.st_dev):02x}:{os.minor(info.st_dev):02x}:{info.st_ino}'
+    for line in lines:
+        fields = line.split()   # '1: FLOCK ADVISORY WRITE <pid> <maj:min:inode> 0 EOF'
+        if len(fields) >= 6 and fields[1] == 'FLOCK' and fields[5] == inode:
+            return int(fields[4]) if fields[4].isdigit() else None
+    return None
 
 
 def _write_without_blocking(port: serial.Serial, data: bytes) -> int:
