@@ -139,3 +139,57 @@ def estimate_speed(servo_angles: ArrayLike, servo_rates: ArrayLike, dt: float,
                          swimming_number=speed / (frequency * geometry.body_length),
                          tail_beat_hz=frequency,
                          tail_tip_amplitude=0.5 * float(np.ptp(y_tip)))
+
+
+# --- Lighthill's time-resolved reactive force (the virtual fish's thrust) ------------------
+#
+# Eq 16 is the period mean of Lighthill's (1960) instantaneous reactive thrust
+#     T(t) = [m w dy/dt - m w^2 / 2]_(q = L_T) - d/dt int_0^L_T m w dy/dq dq,
+# with w = dy/dt + U dy/dq the water's lateral velocity relative to the body and m(q) the
+# lateral added mass per unit length. The tip term equals the eq 16 integrand
+# (``instantaneous_thrust``); the last term is the rate of change of the lateral momentum
+# shed along the tail, whose period mean is zero. With G = K1 + U K2,
+#     K1 = int m dy/dt dy/dq dq,    K2 = int m (dy/dq)^2 dq,
+# dG/dt = K1' + U K2' + U' K2: the U' K2 part is inertia (it joins the mass in the surge
+# equation). Model assumption: m(q) = rho A(L_T) along the whole tail (the paper gives the
+# cross-section only at the tip; the fish is about as deep, 150 mm, as the fin's 140 mm span);
+# the rigid head (q < 0) does not move laterally in C0 and sheds nothing.
+TAIL_GAUSS_POINTS = 4  # Gauss-Legendre points per link (the integrands are smooth on each)
+_GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(TAIL_GAUSS_POINTS)
+
+
+def tail_quadrature(geometry: FishGeometry) -> tuple[np.ndarray, np.ndarray]:
+    """Return stations q (S,) m and weights (S,) m integrating over [0, L_T] link by link."""
+    edges = np.cumsum([0.0, geometry.l1, geometry.l2, geometry.l3])
+    half = 0.5 * np.diff(edges)
+    stations = (edges[:-1, None] + half[:, None] * (_GAUSS_NODES + 1.0)).ravel()
+    return stations, (half[:, None] * _GAUSS_WEIGHTS).ravel()
+
+
+def lateral_added_mass_per_length(geometry: FishGeometry) -> float:
+    """Return m = rho A(L_T) (kg/m), the lateral added mass per unit length (assumption)."""
+    return geometry.water_density * geometry.tip_cross_section_area
+
+
+def reactive_state(servo_angles: ArrayLike, servo_rates: ArrayLike, geometry: FishGeometry
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Return (dy/dt, dy/dq at the tip, K1 (kg m/s), K2 (kg)) of servo samples (..., 2), each (...,).
+
+    The tip's lateral velocity and slope as ``tail_tip_velocity_and_slope`` (eqs 19-22);
+    K1 = int m dy/dt dy/dq dq and K2 = int m (dy/dq)^2 dq over the tail (see above): the
+    lateral momentum of the water along the tail is K1 + U K2. One kinematics evaluation
+    serves all four (the virtual fish calls this every physics block).
+    """
+    angles = np.asarray(servo_angles, dtype=float)
+    rates = np.asarray(servo_rates, dtype=float)
+    stations, weights = tail_quadrature(geometry)
+    stations = np.append(stations, geometry.tail_length)
+    beta1, beta2 = bend_angles(angles[..., 0], angles[..., 1], geometry)
+    rate1, rate2 = bend_rates(rates[..., 0], rates[..., 1], geometry)
+    velocity = lateral_velocity(stations, beta1, beta2, rate1, rate2, geometry)
+    slope = lateral_slope(stations, beta1, beta2, geometry)
+    m = lateral_added_mass_per_length(geometry)
+    k1 = m * (velocity[..., :-1] * slope[..., :-1]) @ weights
+    k2 = m * (slope[..., :-1] * slope[..., :-1]) @ weights
+    return velocity[..., -1], slope[..., -1], k1, k2

@@ -43,8 +43,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help='firmware: neutral after this long without SERVO_CMD (s)')
     p.add_argument('--heartbeat-timeout', type=float, default=1.5,
                    help='firmware: neutral after this long without a host heartbeat (s)')
-    p.add_argument('--speed-time-constant', type=float, default=0.75,
-                   help='surge time constant set by the force scale (s)')
     p.add_argument('--servo-rate-limit', type=float,
                    default=ServoParameters.rate_limit_rad_s, help='slew limit (rad/s)')
     p.add_argument('--servo-lag', type=float, default=ServoParameters.time_constant_s,
@@ -77,7 +75,6 @@ def config_from(args: argparse.Namespace) -> SimConfig:
     return SimConfig(
         telemetry_hz=args.telemetry_hz, heartbeat_hz=args.heartbeat_hz,
         command_timeout_s=args.command_timeout, heartbeat_timeout_s=args.heartbeat_timeout,
-        speed_time_constant_s=args.speed_time_constant,
         servo=ServoParameters(args.servo_rate_limit, args.servo_lag, args.servo_update_hz,
                               args.servo_limit),
         imu_noise=ImuNoise().scaled(args.imu_noise_scale))
@@ -216,7 +213,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def flags_problem(args: argparse.Namespace) -> str | None:
     """Return why the flags cannot make a virtual fish, or None."""
-    for name in ('ground_truth_hz', 'telemetry_hz', 'heartbeat_hz', 'speed_time_constant',
+    for name in ('ground_truth_hz', 'telemetry_hz', 'heartbeat_hz',
                  'command_timeout', 'heartbeat_timeout'):
         value = getattr(args, name)
         if not (math.isfinite(value) and value > 0.0):

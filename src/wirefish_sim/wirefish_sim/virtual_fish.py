@@ -1,6 +1,9 @@
 """
 The virtual fish: firmware, servos, tail kinematics, Lighthill surge and a yaw model.
 
+Surge: Lighthill's time-resolved reactive thrust with the body's mass and added mass as
+inertia (``fish_dynamics``): the speed ripple and the time constant follow from the physics.
+
 No ROS and no real time: ``step(dt)`` advances simulated time, so tests run the physics faster
 than real time; ``fish_sim`` drives it from the wall clock over a pseudo-terminal. The firmware
 part decodes frames (``receive``), commands neutral when servo commands or host heartbeats stop,
@@ -17,11 +20,10 @@ from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, PROTOCOL_VERSION, Role,
                                       ServoCommand, Status, Telemetry)
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust,
-                                           tail_tip_lateral_positions,
-                                           tail_tip_velocity_and_slope)
-from wirefish_sim.fish_dynamics import (force_scale_for_time_constant, GRAVITY,
-                                        surge_acceleration, wrap_angle, yaw_acceleration)
+from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust, reactive_state,
+                                           tail_tip_lateral_positions)
+from wirefish_sim.fish_dynamics import (GRAVITY, surge_acceleration, wrap_angle,
+                                        yaw_acceleration)
 from wirefish_sim.servo_model import Servo, ServoParameters
 
 
@@ -45,16 +47,14 @@ class SimConfig:
     """
     Constants of the virtual fish; SI units, radians.
 
-    ``mass_kg`` (3.3 kg, section 2.1) and ``added_mass_kg`` (~0.27 kg) make the surge inertia;
-    ``speed_time_constant_s`` sets the force scale above ``speed_floor_m_s`` (see
-    ``fish_dynamics``). ``command_timeout_s``/``heartbeat_timeout_s`` are the firmware's
+    ``mass_kg`` (3.3 kg, section 2.1) and ``added_mass_kg`` (~0.27 kg, longitudinal) make the
+    surge inertia with the tail's lateral momentum share (see ``fish_dynamics``).
+    ``command_timeout_s``/``heartbeat_timeout_s`` are the firmware's
     failsafe timeouts (None: not checked, for physics runs without a host).
     """
 
     mass_kg: float = 3.3
     added_mass_kg: float = 0.27
-    speed_time_constant_s: float = 0.75
-    speed_floor_m_s: float = 0.05
     yaw_gain: float = 20.0  # 3 cm tail offset at 0.3 m/s turns ~20 deg/s (assumption)
     yaw_time_constant_s: float = 0.3
     physics_dt_s: float = 0.001
@@ -111,6 +111,7 @@ class VirtualFish:
         self._next_heartbeat = 0.0
         self._remainder = 0.0
         self._crc_errors_reported = 0
+        self._last_momentum: tuple[float, float] | None = None  # K1, K2 of the last step
         noise = c.imu_noise
         self._gyro_bias = self.rng.normal(0.0, noise.gyro_bias_rad_s, 3)
         self._accel_bias = self.rng.normal(0.0, noise.accel_bias_m_s2, 3)
@@ -190,18 +191,27 @@ class VirtualFish:
                 angles[i, j], rates[i, j] = servo.angle, servo.rate
             self.state.time_s += h
             self._emit_due(angles[i])
-        velocity, slope = tail_tip_velocity_and_slope(angles, rates, self.geometry)
+        velocity, slope, k1, k2 = reactive_state(angles, rates, self.geometry)
         tip = tail_tip_lateral_positions(angles, self.geometry)
-        self._integrate(velocity, slope, tip, h)
+        # Rates of the tail's lateral momentum terms by differences between physics steps
+        # (their sum over a period telescopes to zero, as the exact mean does).
+        first = self._last_momentum or (float(k1[0]), float(k2[0]))
+        k1_rate = np.diff(k1, prepend=first[0]) / h
+        k2_rate = np.diff(k2, prepend=first[1]) / h
+        self._last_momentum = (float(k1[-1]), float(k2[-1]))
+        self._integrate(velocity, slope, tip, k1_rate, k2, k2_rate, h)
 
     def _integrate(self, velocity: np.ndarray, slope: np.ndarray, tip: np.ndarray,
+                   k1_rate: np.ndarray, k2: np.ndarray, k2_rate: np.ndarray,
                    h: float) -> None:
         s, c, g = self.state, self.config, self.geometry
-        for v, dydq, y_tip in zip(velocity.tolist(), slope.tolist(), tip.tolist()):
+        for v, dydq, y_tip, dk1, mass_k2, dk2 in zip(
+                velocity.tolist(), slope.tolist(), tip.tolist(), k1_rate.tolist(),
+                k2.tolist(), k2_rate.tolist()):
             thrust = float(instantaneous_thrust(v, dydq, s.speed, g))
             drag = float(drag_force(s.speed, g))
-            scale = self.force_scale(s.speed)
-            s.acceleration = surge_acceleration(thrust, drag, self.total_mass, scale)
+            s.acceleration = surge_acceleration(thrust, dk1, mass_k2, dk2, s.speed, drag,
+                                                self.total_mass)
             s.speed += s.acceleration * h
             s.yaw_rate += h * yaw_acceleration(s.yaw_rate, y_tip, s.speed, c.yaw_gain,
                                                c.yaw_time_constant_s, g.body_length)
@@ -209,13 +219,6 @@ class VirtualFish:
             s.x += s.speed * math.cos(s.yaw) * h
             s.y += s.speed * math.sin(s.yaw) * h
             s.tail_tip_offset = y_tip
-
-    def force_scale(self, speed: float) -> float:
-        """Return the factor s on thrust and drag at ``speed`` (see ``fish_dynamics``)."""
-        c, g = self.config, self.geometry
-        return force_scale_for_time_constant(self.total_mass, c.speed_time_constant_s, speed,
-                                             c.speed_floor_m_s, g.drag_coefficient,
-                                             g.water_density, g.wetted_area)
 
     def battery_voltage(self) -> float:
         """Return the battery voltage (V): a slow linear discharge (model assumption)."""
