@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from wirefish_bringup import mcap_records as rec
+from wirefish_bringup import cli, mcap_records as rec
 from wirefish_bringup.bag_storage import IncompleteFile, read_file_info
 from wirefish_bringup.recorder import open_bag_file
 from wirefish_bringup.reindex import reindex
@@ -163,3 +163,16 @@ def test_records_decode_to_what_was_encoded(encoded, decode, expected):
 def test_a_record_running_past_the_end_is_an_error():
     with pytest.raises(rec.RecordError, match='past the end'):
         list(rec.iter_records(rec.message(1, 0, 0, b'abc')[:-1]))
+
+
+def test_bag_info_names_the_repair_for_a_killed_bag(killed_bag, capsys):
+    assert cli.main(['bag', 'info', str(killed_bag.bag_dir)]) == 1
+    assert 'wirefish bag reindex' in capsys.readouterr().err
+
+
+def test_bag_reindex_then_info_shows_every_recovered_message(killed_bag, capsys):
+    assert cli.main(['bag', 'reindex', str(killed_bag.bag_dir)]) == 0
+    assert cli.main(['bag', 'info', str(killed_bag.bag_dir)]) == 0
+    out = capsys.readouterr().out
+    assert 'rebuilt from 12 intact chunks (120 messages)' in out
+    assert 'Topic: /a | Type: std_msgs/msg/String | Count: 60' in out
