@@ -176,3 +176,13 @@ def test_bag_reindex_then_info_shows_every_recovered_message(killed_bag, capsys)
     out = capsys.readouterr().out
     assert 'rebuilt from 12 intact chunks (120 messages)' in out
     assert 'Topic: /a | Type: std_msgs/msg/String | Count: 60' in out
+
+
+def test_messages_whose_channel_was_in_a_damaged_chunk_are_counted_not_guessed(killed_bag,
+                                                                               typestore):
+    data = bytearray(killed_bag.path.read_bytes())
+    data[killed_bag.flush_ends[0] // 2] ^= 0xFF  # the first chunk holds the schema and channels
+    killed_bag.path.write_bytes(bytes(data))
+    (recovery,) = reindex(killed_bag.bag_dir)
+    assert (recovery.damaged_chunks, recovery.orphan_messages) == (1, 110)
+    assert read_texts(killed_bag.bag_dir, typestore) == []

@@ -28,8 +28,10 @@ class Recovery:
     name: str
     chunks: int
     messages: int
-    damaged_chunks: int  # whole records whose content failed its CRC or could not be decoded
-    orphan_messages: int  # messages of a channel whose definition was in a damaged chunk
+    # Chunks framed whole whose content failed its CRC or could not be decoded (or compressed:
+    # the recorder never compresses).
+    damaged_chunks: int
+    orphan_messages: int  # messages whose channel or type was defined in a damaged chunk
     dropped_tail_bytes: int  # from the end of the last whole record to the end of the file
 
 
@@ -88,9 +90,10 @@ def _copy(chunks: Iterator[list[Decoded]], writer: McapWriter) -> tuple[int, int
                 schema_ids[record.schema_id] = writer.add_schema(
                     record.name, record.encoding, record.data)
             elif isinstance(record, rec.ChannelRecord):
-                channel_ids[record.channel_id] = writer.add_channel(
-                    record.topic, schema_ids.get(record.schema_id, 0), record.metadata,
-                    record.encoding)
+                if record.schema_id in schema_ids:  # else its type is lost: orphans follow
+                    channel_ids[record.channel_id] = writer.add_channel(
+                        record.topic, schema_ids[record.schema_id], record.metadata,
+                        record.encoding)
             elif record.channel_id in channel_ids:
                 writer.write(channel_ids[record.channel_id], record.log_time_ns, record.data,
                              record.sequence)
@@ -113,11 +116,14 @@ def rebuild(source: Path, target: Path) -> Recovery:
                 chunks = messages = orphans = 0
                 scan.end = 0
             else:
+                # Mapped, not read: a long recording need not fit in memory.
                 with mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ) as data:
                     view = memoryview(data)
+                    intact = _intact_chunks(view, scan)
                     try:
-                        chunks, messages, orphans = _copy(_intact_chunks(view, scan), writer)
+                        chunks, messages, orphans = _copy(intact, writer)
                     finally:
+                        intact.close()  # drops its views of the map, so the map can close
                         view.release()
     finally:
         writer.close()
