@@ -11,7 +11,7 @@ No rclpy import: the cpg node, the tuner and pure tests share it.
 from __future__ import annotations
 
 import math
-from typing import Mapping
+from typing import Any, Mapping
 
 from wirefish_common.parameter_table import ParameterSpec
 from wirefish_cpg.oscillator import CpgParameters
@@ -42,21 +42,22 @@ def flat_values(params: CpgParameters) -> dict[str, float]:
     return values
 
 
-def parameters_from(values: Mapping[str, object]) -> CpgParameters:
+def parameters_from(values: Mapping[str, Any]) -> CpgParameters:
     """
     Return the CpgParameters of a flat name -> value mapping (e.g. the node's parameters).
 
     Raises ``KeyError`` if a name of ``CPG_PARAMETER_NAMES`` is missing and ``ValueError`` if
     the values are not a valid network (``CpgParameters`` says why).
     """
-    fields: dict[str, object] = {}
-    pairs: dict[str, list[object]] = {}
+    fields: dict[str, Any] = {}
+    pairs: dict[str, list[Any]] = {}
     for name, (field, index) in _FIELD_OF.items():
         if index is None:
             fields[field] = values[name]
         else:
             pairs.setdefault(field, [None, None])[index] = values[name]
-    return CpgParameters(**fields, **{field: tuple(pair) for field, pair in pairs.items()})
+    fields.update((field, tuple(pair)) for field, pair in pairs.items())
+    return CpgParameters(**fields)
 
 
 _DEFAULT = flat_values(CpgParameters())

@@ -11,7 +11,6 @@ from __future__ import annotations
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point
 import numpy as np
-from numpy.typing import ArrayLike
 from visualization_msgs.msg import Marker, MarkerArray
 from wirefish_kinematics.lighthill import SpeedEstimate
 from wirefish_kinematics.tail_shape import TailShape
@@ -47,7 +46,7 @@ def speed_estimate_message(estimate: SpeedEstimate, stamp: Time) -> SpeedEstimat
     return msg
 
 
-def _marker(stamp: Time, marker_id: int, kind: int, points_x: ArrayLike, points_y: ArrayLike,
+def _marker(stamp: Time, marker_id: int, kind: int, points_x: np.ndarray, points_y: np.ndarray,
             scale: float, rgb: tuple[float, float, float]) -> Marker:
     m = Marker(ns=MARKER_NAMESPACE, id=marker_id, type=kind, action=Marker.ADD)
     m.header.stamp, m.header.frame_id = stamp, FRAME

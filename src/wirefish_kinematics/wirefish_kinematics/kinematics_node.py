@@ -30,6 +30,7 @@ import numpy as np
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.subscription import Subscription
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 from wirefish_common.node_main import run_node
@@ -71,7 +72,7 @@ class KinematicsNode(Node):
         self._marker_pub = self.create_publisher(MarkerArray, 'body_wave_markers', MARKERS)
         self._speed_pub = self.create_publisher(SpeedEstimateMsg, 'speed_estimate', RELIABLE)
         self.create_subscription(BodyWaveSpec, 'target_wave', self._on_target, LATCHED)
-        self._servo_sub = None
+        self._servo_sub: Subscription | None = None
         self._subscribe_servo()
         self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'], self._on_tick)
         self.add_on_set_parameters_callback(self._validate)
@@ -135,7 +136,7 @@ class KinematicsNode(Node):
 
     # --- outputs --------------------------------------------------------------------------
     def _on_tick(self) -> None:
-        if not self._fresh:
+        if not self._fresh or self._latest is None:
             return
         self._fresh = False
         sec, nanosec, angles = self._latest

@@ -10,7 +10,7 @@ names, ranges and descriptions cannot drift apart. Defaults are ``FishGeometry()
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Any, Mapping
 
 from wirefish_common.parameter_table import (check_value, declare as declare_specs,
                                              merged_update, ParameterSpec, validate_update)
@@ -80,7 +80,7 @@ def geometry_parameters(names: tuple[str, ...] = GEOMETRY_FIELDS) -> tuple[Param
     return tuple(by_name[name] for name in names)
 
 
-def geometry_from(values: Mapping[str, object], names: tuple[str, ...] = GEOMETRY_FIELDS
+def geometry_from(values: Mapping[str, Any], names: tuple[str, ...] = GEOMETRY_FIELDS
                   ) -> FishGeometry:
     """
     Return the FishGeometry of the fields ``names`` in a name -> value mapping.
@@ -92,7 +92,7 @@ def geometry_from(values: Mapping[str, object], names: tuple[str, ...] = GEOMETR
     return FishGeometry(**{name: values[name] for name in names})
 
 
-def wave_from(values: Mapping[str, object]) -> WaveSpec:
+def wave_from(values: Mapping[str, Any]) -> WaveSpec:
     """Return the WaveSpec of the ``wave_*`` parameters in a name -> value mapping."""
     return WaveSpec(**{field: values[name] for name, field in WAVE_PARAMETER_NAMES.items()})
 
