@@ -29,8 +29,3 @@ def test_a_wave_survives_the_message_round_trip():
 def test_a_bad_message_is_refused_with_the_reason_of_the_type():
     with pytest.raises(ValueError, match='k must be > 0'):
         wave_from_message(BodyWaveSpec(c1=0.1, c2=1.0, k=0.0, frequency_hz=1.0))
-
-
-def test_the_fit_uses_the_same_wave_type():
-    from wirefish_cpg.wave_loss import WaveSpec as FitWaveSpec
-    assert FitWaveSpec is WaveSpec
