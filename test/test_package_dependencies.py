@@ -27,6 +27,7 @@ import xml.etree.ElementTree as ElementTree
 from ament_index_python.packages import get_packages_with_prefixes
 import pytest
 
+pytestmark = pytest.mark.linter
 WORKSPACE = Path(__file__).resolve().parents[1]
 PACKAGES = sorted(p.parent for p in (WORKSPACE / 'src').glob('*/package.xml'))
 

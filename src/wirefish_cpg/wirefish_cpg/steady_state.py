@@ -23,17 +23,19 @@ import numpy as np
 
 from wirefish_cpg.oscillator import CpgParameters
 
+Real = float | np.ndarray  # a number or an array of them: every function here broadcasts
 
-def phase_difference_rate(delta: np.ndarray, r1: np.ndarray, r2: np.ndarray,
-                          w12: np.ndarray, w21: np.ndarray, phi12: np.ndarray,
-                          phi21: np.ndarray) -> np.ndarray:
+
+def phase_difference_rate(delta: Real, r1: Real, r2: Real,
+                          w12: Real, w21: Real, phi12: Real,
+                          phi21: Real) -> np.ndarray:
     """Return dDelta/dt (rad/s) of Delta = xi_2 - xi_1 at amplitudes r1, r2 (from eq 1)."""
     return r1 * w21 * np.sin(-delta - phi21) - r2 * w12 * np.sin(delta - phi12)
 
 
-def stable_phase_difference(r1: np.ndarray, r2: np.ndarray, w12: np.ndarray,
-                            w21: np.ndarray, phi12: np.ndarray,
-                            phi21: np.ndarray) -> np.ndarray:
+def stable_phase_difference(r1: Real, r2: Real, w12: Real,
+                            w21: Real, phi12: Real,
+                            phi21: Real) -> np.ndarray:
     """
     Return the stable root Delta* in (-pi, pi] of the phase-difference equation (from eq 1).
 
@@ -50,14 +52,14 @@ def stable_phase_difference(r1: np.ndarray, r2: np.ndarray, w12: np.ndarray,
     return np.where(coupled, delta, 0.0)
 
 
-def locked_angular_frequency(frequency_hz: np.ndarray, r2: np.ndarray, w12: np.ndarray,
-                             phi12: np.ndarray, delta: np.ndarray) -> np.ndarray:
+def locked_angular_frequency(frequency_hz: Real, r2: Real, w12: Real,
+                             phi12: Real, delta: Real) -> np.ndarray:
     """Return the common angular frequency Omega (rad/s) at phase difference ``delta`` (eq 1)."""
     return 2.0 * np.pi * frequency_hz + r2 * w12 * np.sin(delta - phi12)
 
 
-def intrinsic_frequency_for(target_hz: np.ndarray, r2: np.ndarray, w12: np.ndarray,
-                            phi12: np.ndarray, delta: np.ndarray) -> np.ndarray:
+def intrinsic_frequency_for(target_hz: Real, r2: Real, w12: Real,
+                            phi12: Real, delta: Real) -> np.ndarray:
     """
     Return the intrinsic frequency v (Hz) that makes the locked network turn at ``target_hz``.
 

@@ -62,7 +62,7 @@ def upward_crossings(times: ArrayLike, signal: ArrayLike) -> np.ndarray:
         if k < below.size and below[k] < i:
             fraction = (middle - s[i - 1]) / (s[i] - s[i - 1])
             crossings.append(t[i - 1] + fraction * (t[i] - t[i - 1]))
-            armed_after = i
+            armed_after = int(i)
     return np.array(crossings)
 
 
