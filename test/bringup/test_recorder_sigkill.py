@@ -15,11 +15,14 @@ import sys
 import time
 
 from bag_utils import assert_bag_readable, counters, reindex_bag
+from e2e_utils import descendants
 import numpy as np
 import pytest
 from ros_utils import spin_until, stop_process
 from wirefish_bringup import mcap_records as rec
 from wirefish_bringup.bag_storage import read_file_info, storage_files
+from wirefish_bringup.bagfile import read_bag
+from wirefish_bringup.graph import expected_rates
 import yaml
 
 pytestmark = pytest.mark.ros
@@ -34,6 +37,15 @@ def _record(namespace: str, bag: Path, *options: str) -> list[str]:
 def _flushed(bag: Path) -> bool:
     """Return True once a chunk is on disk (the header alone is 45 bytes)."""
     return any(p.stat().st_size > 200 for p in bag.glob('*.mcap'))
+
+
+def _wait_flushed(bag: Path, timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if bag.is_dir() and _flushed(bag):
+            return True
+        time.sleep(0.1)
+    return False
 
 
 def _record_then_kill(spawn, listener, namespace: str, bag: Path, seed: int) -> float:
@@ -123,3 +135,43 @@ def test_a_clean_stop_writes_a_finished_bag(tmp_path, spawn, talker_namespace, l
                              str(bag)], env=ros_env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert f'Count: {info.message_count}' in result.stdout
+
+
+def _read_until(proc: subprocess.Popen, prefix: str, timeout_s: float) -> list[str]:
+    lines: list[str] = []
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        lines.append(line)
+        if line.startswith(prefix):
+            break
+    return lines
+
+
+def test_a_recorder_killed_under_wirefish_up_leaves_a_bag_that_reindex_repairs(
+        tmp_path, spawn, python, kill_seed):
+    namespace = '/wf_up_kill'
+    launcher = spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+                      '--namespace', namespace, '--out', str(tmp_path), '--duration', '12'])
+    lines = _read_until(launcher, 'recording to', 120.0)
+    assert lines and lines[-1].startswith('recording to'), ''.join(lines)
+    bag = Path(lines[-1].split()[2].rstrip(';'))
+    (recorder,) = [p for p in descendants(launcher.pid) if 'record' in p.cmdline()]
+    assert _wait_flushed(bag, 60.0), 'recorder never flushed'
+    time.sleep(float(np.random.default_rng(kill_seed).uniform(1.0, 5.0)))
+    killed_at = time.time()  # the recorder stamps messages with the system clock
+    recorder.kill()
+    output = launcher.communicate(timeout=120)[0]
+    assert 'wirefish_recorder exited with code -9' in output, output
+    reindex_bag(bag)
+    counts = assert_bag_readable(bag)
+    streams = {f'{namespace}/{topic}' for topic, hz in expected_rates(sim=True)[0].items()
+               if hz >= 20.0}
+    assert streams <= set(counts), (streams, counts)
+    # The file the killed recorder wrote (a recorder restarted with --resume adds bag_1.mcap).
+    in_bag = read_bag(bag / 'bag_0.mcap', sorted(streams))
+    early = {topic: killed_at - max(t for t, _ in in_bag.messages[topic]) for topic in streams}
+    print(f'the streams end {min(early.values()):.2f}-{max(early.values()):.2f} s before the kill')
+    assert max(early.values()) <= KILL_MARGIN_S, early
