@@ -80,8 +80,11 @@ def test_a_stale_link_to_a_reused_terminal_gets_no_byte_and_a_new_fish_is_found(
     bridge = start_bridge(link, 'reconnect_backoff_max_s:=0.2')
     assert spin_until(probe.executor, lambda: len(probe.statuses()) >= 3, 20.0)
     fake_device.read_available()
+    status = probe.statuses()[-1]
+    print(f'stale link: {status.message!r}')
     assert fake_device.received == b''
-    assert 'no fish heartbeat' in probe.statuses()[-1].message
+    assert f'stale virtual-fish link: its owner (pid {killed.pid}) is gone' in status.message
+    assert probe.last_diagnostics()['opens'] == '0'   # the terminal was not even opened
     start_fish(link)   # a new virtual fish re-points the link
     assert spin_until(probe.executor, lambda: _connected(probe) and len(probe.imu) > 10, 20.0)
     probe.spin_for(1.5, command=[0.3, -0.2])

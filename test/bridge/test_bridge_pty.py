@@ -107,7 +107,7 @@ def test_bridge_and_fish_exit_cleanly_on_sigint(start_fish, start_bridge, probe,
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     assert stop_process(bridge) == 0
     assert stop_process(fish) == 0
-    assert not os.path.lexists(link)
+    assert not os.path.lexists(link) and not os.path.lexists(f'{link}.owner')
     assert math.isfinite(_stamp(probe.imu[-1]))
 
 

@@ -139,3 +139,18 @@ def test_identification_belongs_to_one_open_of_the_device():
         link.write(b'b')
     link.stop()
     assert written == [b'a']
+
+
+def test_a_port_refused_before_opening_is_never_opened_and_is_retried():
+    opened, reports = [], []
+    link = SerialLink('/dev/fake', 115200, lambda chunk: None,
+                      lambda state, detail: reports.append(detail),
+                      backoff_min_s=0.001, backoff_max_s=0.002,
+                      open_check=lambda port: f'{port} is stale',
+                      serial_factory=lambda *args, **kwargs: opened.append(args))
+    link.start()
+    assert _wait(lambda: link.stats.open_failures >= 3)
+    link.stop()
+    assert opened == [] and link.stats.last_error == '/dev/fake is stale'
+    assert [r for r in reports if 'stale' in r] == ['cannot open /dev/fake: /dev/fake is stale; '
+                                                    'retrying']

@@ -11,10 +11,11 @@ Publishes (sensor-data QoS, stamped on receipt with the node clock)
     measured angles), ``battery`` (sensor_msgs/BatteryState); and ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, reliable) at ``diagnostics_rate_hz``: one status named
     ``<namespace>/bridge_node: serial link <port>``, hardware_id ``<node> on <port> (<device>)``.
-Only the fish it was started for: the port is locked (a second bridge on it cannot open it and
-keeps retrying) and nothing is written to it until the device has sent a fish HEARTBEAT (a
-device silent for ``fish_identify_timeout_s`` is closed and reopened: a stale link may point at
-an unrelated terminal). Telemetry outside the physical limits of ``telemetry_limits`` is
+Only the fish it was started for: a virtual fish's link whose owner record says it is stale is
+not opened (``link_owner``); the port is locked (a second bridge on it cannot open it and keeps
+retrying); nothing is written to it until the device has sent a fish HEARTBEAT (a device
+silent for ``fish_identify_timeout_s`` is closed and reopened: a stale link may point at an
+unrelated terminal). Telemetry outside the physical limits of ``telemetry_limits`` is
 counted (``telemetry_rejected``) and dropped, never published.
 The port is read by the transport's thread. Telemetry is published straight from that thread
 (publishing is thread-safe): the 100 Hz path then costs no executor wake-up, which was the larger
@@ -42,6 +43,7 @@ from wirefish_bridge.bridge_parameters import (check_combination, LINK_PARAMETER
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
+from wirefish_bridge.link_owner import stale_link_problem
 from wirefish_bridge.protocol import (ErrorReport, Heartbeat,
                                       PROTOCOL_VERSION, ProtocolMessage, Role, ServoCommand,
                                       Status, Telemetry)
@@ -130,7 +132,8 @@ class BridgeNode(Node):
                           self._on_link_state,
                           backoff_min_s=self._values['reconnect_backoff_min_s'],
                           backoff_max_s=self._values['reconnect_backoff_max_s'],
-                          identify_timeout_s=self._values['fish_identify_timeout_s'])
+                          identify_timeout_s=self._values['fish_identify_timeout_s'],
+                          open_check=stale_link_problem)
 
     # --- reader thread side: decode, publish telemetry, hand the rest over ------------------
     def _on_bytes(self, chunk: bytes) -> None:

@@ -46,6 +46,10 @@ class LinkWriteError(LinkError):
     """A write failed or was cut short (device gone, or its buffer full)."""
 
 
+class LinkRefused(LinkError):
+    """The port was not opened: the check before opening (``open_check``) refused it."""
+
+
 class PeerNotIdentified(LinkError):
     """The port is open but the device has not identified itself yet: nothing is written."""
 
@@ -96,8 +100,15 @@ class SerialLink:
                  on_state: Callable[[LinkState, str], None] | None = None, *,
                  backoff_min_s: float = 0.1, backoff_max_s: float = 1.0,
                  read_timeout_s: float = 0.05, identify_timeout_s: float | None = None,
+                 open_check: Callable[[str], str | None] = lambda port: None,
                  serial_factory: Callable[..., serial.Serial] = serial.Serial) -> None:
-        """Configure the link (``identify_timeout_s`` None: no identification); no I/O yet."""
+        """
+        Configure the link; nothing is opened before ``start``.
+
+        ``identify_timeout_s`` None: writes go out as soon as the port is open (no
+        identification). ``open_check(port)`` runs before every open and returns why the port
+        must not be opened now (the link retries later), or None.
+        """
         self.port = port
         self.baudrate = baudrate
         self.stats = LinkStats()
@@ -107,6 +118,7 @@ class SerialLink:
         self._backoff_max_s = backoff_max_s
         self._read_timeout_s = read_timeout_s
         self._identify_timeout_s = identify_timeout_s
+        self._open_check = open_check
         self._factory = serial_factory
         self._serial: serial.Serial | None = None
         self._identified = False   # the peer of the current open identified itself
@@ -190,12 +202,15 @@ class SerialLink:
 
     def _open(self) -> bool:
         try:
+            refusal = self._open_check(self.port)
+            if refusal is not None:
+                raise LinkRefused(refusal)
             # write_timeout=0: non-blocking writes, so no caller ever waits on the device.
             # exclusive=True: flock(LOCK_EX | LOCK_NB) before any termios change.
             port = self._factory(self.port, self.baudrate, timeout=self._read_timeout_s,
                                  write_timeout=0, exclusive=True)
             port.reset_input_buffer()  # stale bytes from before we were listening
-        except (serial.SerialException, OSError, ValueError) as error:
+        except (LinkRefused, serial.SerialException, OSError, ValueError) as error:
             self.stats.open_failures += 1
             reason = _open_failure(self.port, error)
             if reason != self.stats.last_error:  # say it once, not at every retry
@@ -265,6 +280,8 @@ class SerialLink:
 
 def _open_failure(path: str, error: Exception) -> str:
     """Return why opening ``path`` failed; a lock held by another process is named as such."""
+    if isinstance(error, LinkRefused):
+        return str(error)
     if getattr(error, 'errno', None) in (errno.EAGAIN, errno.EWOULDBLOCK):
         holder = lock_holder(path)
         return (f'in use by another process{f" (pid {holder})" if holder else ""}: it holds '

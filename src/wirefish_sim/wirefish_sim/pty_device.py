@@ -5,6 +5,10 @@ The virtual fish's end of a pseudo-terminal pair, with a stable symlink to the d
 to its slave device, so a bridge that opens the link path always finds the current device, as with
 /dev/serial/by-id/ for a real board. ``close`` closes both ends, which the bridge sees as EIO
 on its old descriptor (the device was "unplugged").
+
+Beside the link, an owner record (``wirefish_bridge.link_owner``) names this process and the
+device, written before the link is re-pointed: if this process is killed and its pts number is
+reused by another terminal, a bridge sees that the link is stale and does not open it.
 """
 
 from __future__ import annotations
@@ -13,6 +17,8 @@ import errno
 import os
 from pathlib import Path
 import tty
+
+from wirefish_bridge.link_owner import remove_owner_record, write_owner_record
 
 
 class PtyDevice:
@@ -45,6 +51,7 @@ class PtyDevice:
         self._master, self._slave = master, slave
         self.path = os.ttyname(slave)
         if self.link is not None:
+            write_owner_record(self.link, self.path)
             temporary = self.link.with_name(f'.{self.link.name}.{os.getpid()}')
             if temporary.is_symlink():
                 temporary.unlink()
@@ -60,10 +67,11 @@ class PtyDevice:
         self._master = self._slave = None
 
     def remove_link(self) -> None:
-        """Remove the symlink if it still points at our device."""
+        """Remove the symlink and its owner record if the link still points at our device."""
         if self.link is not None and self.link.is_symlink() and self.path is not None:
             if os.readlink(self.link) == self.path:
                 self.link.unlink()
+                remove_owner_record(self.link)
 
     def read(self, size: int = 4096) -> bytes:
         """Return the bytes the peer wrote (b'' if none or if closed)."""
