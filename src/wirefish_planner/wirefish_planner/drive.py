@@ -1,0 +1,190 @@
+"""
+`wirefish drive`: a terminal teleop; the planner's state live on one line.
+
+Keys: w / arrow up faster, s / arrow down slower, a / arrow left turn left (+ yaw rate,
+REP-103), d / arrow right turn right, space stop (speed and turn 0), q quit (the fish rests:
+cmd_vel stops and the planner's timeout brings it to rest). cmd_vel goes out at 10 Hz,
+faster than the planner's 0.5 s timeout. On a full install,
+`ros2 run teleop_twist_keyboard teleop_twist_keyboard --ros-args -r __ns:=/wirefish` does the
+same job.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+import math
+import sys
+
+PUBLISH_HZ = 10.0
+ARROWS = {'\x1b[A': 'w', '\x1b[B': 's', '\x1b[D': 'a', '\x1b[C': 'd'}
+
+
+@dataclass(frozen=True)
+class DriveLimits:
+    """Step and limit of each axis (m/s, rad/s)."""
+
+    speed_step: float = 0.05
+    max_speed: float = 0.4
+    turn_step: float = 0.1
+    max_turn: float = 0.6
+
+
+def key_action(key: str, speed: float, turn: float, limits: DriveLimits
+               ) -> tuple[float, float] | None:
+    """Return the new (speed, yaw rate) after ``key``, or None to quit; unknown keys: no change."""
+    key = ARROWS.get(key, key).lower()
+    if key == 'q' or key == '\x03':  # q or Ctrl-C
+        return None
+    if key == 'w':
+        speed = min(limits.max_speed, speed + limits.speed_step)
+    elif key == 's':
+        speed = max(0.0, speed - limits.speed_step)
+    elif key == 'a':
+        turn = min(limits.max_turn, turn + limits.turn_step)
+    elif key == 'd':
+        turn = max(-limits.max_turn, turn - limits.turn_step)
+    elif key == ' ':
+        speed, turn = 0.0, 0.0
+    return round(speed, 6), round(turn, 6)
+
+
+def split_keys(data: str) -> list[str]:
+    """Return the keys in ``data``: an arrow's escape sequence counts as one key."""
+    keys, i = [], 0
+    while i < len(data):
+        if data.startswith('\x1b[', i) and i + 2 < len(data):
+            keys.append(data[i:i + 3])
+            i += 3
+        else:
+            keys.append(data[i])
+            i += 1
+    return keys
+
+
+def state_line(speed: float, turn: float, state) -> str:
+    """Return the status line: what is sent, and the planner's state (or that none came)."""
+    sent = f'cmd_vel {speed:.2f} m/s {turn:+.2f} rad/s'
+    if state is None:
+        return f'{sent} | no planner_state yet'
+    heading = '' if math.isnan(state.heading_target) else \
+        f' hold {math.degrees(state.heading_target):+.0f} deg'
+    line = (f'{sent} | {state.mode:<9} {state.predicted_speed:.2f} m/s '
+            f'{state.tail_beat_hz:.2f} Hz x{state.amplitude_scale:.2f} | yaw rate '
+            f'{state.yaw_rate_target:+.2f}/{state.yaw_rate_measured:+.2f} b {state.offset:+.3f}'
+            f'{heading}')
+    reason = state.clamp_reason or state.note
+    return f'{line} | {reason}' if reason else line
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish drive`."""
+    from wirefish_bringup.graph import DEFAULT_NAMESPACE
+
+    defaults = DriveLimits()
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('--speed-step', type=float, default=defaults.speed_step,
+                        help='m/s per key press')
+    parser.add_argument('--max-speed', type=float, default=defaults.max_speed, help='m/s')
+    parser.add_argument('--turn-step', type=float, default=defaults.turn_step,
+                        help='rad/s per key press')
+    parser.add_argument('--max-turn', type=float, default=defaults.max_turn, help='rad/s')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish drive` on this terminal; return the exit code."""
+    import select
+    import termios
+    import tty
+
+    from wirefish_bringup.graph import validate_namespace
+
+    try:
+        namespace = validate_namespace(args.namespace)
+    except ValueError as error:
+        print(f'wirefish drive: {error}', file=sys.stderr)
+        return 2
+    values = (args.speed_step, args.max_speed, args.turn_step, args.max_turn)
+    if not all(math.isfinite(v) and v > 0.0 for v in values):
+        print('wirefish drive: steps and limits must be finite and > 0', file=sys.stderr)
+        return 2
+    if not sys.stdin.isatty():
+        print('wirefish drive: needs a terminal (keys are read from stdin)', file=sys.stderr)
+        return 2
+    limits = DriveLimits(*values)
+    link = _Link(namespace)
+    saved = termios.tcgetattr(sys.stdin)
+    speed, turn = 0.0, 0.0
+    print(__doc__.strip().split('\n\n')[1].replace('\n', ' '))
+    try:
+        tty.setcbreak(sys.stdin.fileno())
+        while link.ok():
+            ready, _, _ = select.select([sys.stdin], [], [], 1.0 / PUBLISH_HZ)
+            if ready:
+                for key in split_keys(sys.stdin.read(1) + _pending(sys.stdin)):
+                    result = key_action(key, speed, turn, limits)
+                    if result is None:
+                        return 0
+                    speed, turn = result
+            link.send(speed, turn)
+            sys.stdout.write('\r\x1b[K' + state_line(speed, turn, link.state)[:160])
+            sys.stdout.flush()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        termios.tcsetattr(sys.stdin, termios.TCSADRAIN, saved)
+        link.close()
+        print()
+    return 0
+
+
+def _pending(stream) -> str:
+    """Return what else is waiting on ``stream`` (the rest of an arrow's escape sequence)."""
+    import select
+
+    data = ''
+    while select.select([stream], [], [], 0.0)[0]:
+        data += stream.read(1)
+    return data
+
+
+class _Link:
+    """The teleop's node: cmd_vel out, planner_state in (spun between key reads)."""
+
+    def __init__(self, namespace: str) -> None:
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from rclpy.signals import SignalHandlerOptions
+
+        from geometry_msgs.msg import Twist
+        from wirefish_msgs.msg import PlannerState
+
+        self._rclpy = rclpy
+        self._twist = Twist
+        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+        self.node = rclpy.create_node('wirefish_drive', namespace=namespace)
+        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        self._pub = self.node.create_publisher(Twist, 'cmd_vel', reliable)
+        self.state = None
+        self.node.create_subscription(PlannerState, 'planner_state', self._on_state, reliable)
+        self._executor = SingleThreadedExecutor()
+        self._executor.add_node(self.node)
+
+    def _on_state(self, msg) -> None:
+        self.state = msg
+
+    def ok(self) -> bool:
+        return self._rclpy.ok()
+
+    def send(self, speed: float, turn: float) -> None:
+        msg = self._twist()
+        msg.linear.x, msg.angular.z = speed, turn
+        self._pub.publish(msg)
+        for _ in range(5):  # planner_state comes at 20 Hz, the keys are read at 10 Hz
+            self._executor.spin_once(timeout_sec=0.0)
+
+    def close(self) -> None:
+        self._executor.shutdown()
+        self.node.destroy_node()
+        self._rclpy.try_shutdown()

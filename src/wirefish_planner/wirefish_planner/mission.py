@@ -1,0 +1,160 @@
+"""
+`wirefish mission FILE`: drive the planner through timed cmd_vel legs, record, plot the path.
+
+FILE is a mission YAML (``wirefish_planner.mission_plan``) or the name of a shipped one
+(``square``). The legs go to ``<namespace>/cmd_vel`` at 20 Hz once the planner answers; the
+whole namespace is recorded into a rosbag2 (MCAP) bag (``wirefish_bringup.recorder``, as
+`wirefish record`); afterwards the report PNG (x-y path from sim/ground_truth with heading
+arrows, speed and yaw rate against the setpoints) and the closure error are written and printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+from datetime import datetime
+from pathlib import Path
+import sys
+
+CMD_RATE_HZ = 20.0
+DISCOVERY_TIMEOUT_S = 30.0
+SHIPPED = ('square',)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish mission`."""
+    from wirefish_bringup.graph import DEFAULT_NAMESPACE
+
+    parser.add_argument('mission', help=f'mission YAML file, or a shipped one: {SHIPPED}')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('-o', '--output', type=Path, default=None,
+                        help='directory for the bag and the PNG '
+                        '(default: out/missions/<name>_<time>); must not exist')
+
+
+def mission_path(text: str) -> Path:
+    """Return the YAML of ``text``: a file, or a shipped mission's name."""
+    path = Path(text)
+    if path.exists() or text not in SHIPPED:
+        return path
+    from ament_index_python.packages import get_package_share_directory
+    return Path(get_package_share_directory('wirefish_planner'), 'missions', f'{text}.yaml')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish mission`; return the exit code."""
+    from wirefish_bringup.graph import validate_namespace
+    from wirefish_planner.mission_plan import load_mission
+
+    try:
+        mission = load_mission(mission_path(args.mission))
+        namespace = validate_namespace(args.namespace)
+    except ValueError as error:
+        print(f'wirefish mission: {error}', file=sys.stderr)
+        return 2
+    out = args.output or Path('out', 'missions',
+                              datetime.now().strftime(f'{mission.name}_%Y%m%d_%H%M%S'))
+    if out.exists():
+        print(f'wirefish mission: {out} exists; choose a new -o', file=sys.stderr)
+        return 2
+    out.mkdir(parents=True)
+    bag_path = out / 'bag'
+    t0, problem = _drive(mission, namespace, bag_path)
+    if problem is not None:
+        print(f'wirefish mission: {problem}', file=sys.stderr)
+        return 1
+    return _report(mission, namespace, bag_path, out, t0)
+
+
+def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
+    """Send the legs and record; return (first leg's start on the node clock s, problem)."""
+    from geometry_msgs.msg import Twist
+    import rclpy
+    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from rclpy.signals import SignalHandlerOptions
+    from wirefish_bringup.recorder import BagRecorder
+    from wirefish_common.shutdown import SignalShutdown
+    from wirefish_msgs.msg import PlannerState
+
+    signals = SignalShutdown()  # Ctrl-C stops the legs, the fish rests, the bag is closed
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node('wirefish_mission', namespace=namespace)
+    recorder = BagRecorder(bag_path, namespace)
+    signals.attach(node)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    executor.add_node(recorder)
+    reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+    publisher = node.create_publisher(Twist, 'cmd_vel', reliable)
+    heard = []
+    node.create_subscription(PlannerState, 'planner_state', heard.append, reliable)
+    truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
+    state = {'t0': None, 'problem': None, 'done': False}
+    started = node.get_clock().now().nanoseconds * 1e-9
+
+    def now() -> float:
+        return node.get_clock().now().nanoseconds * 1e-9
+
+    def tick() -> None:
+        t = now()
+        if state['t0'] is None:
+            if heard and recorder.counts.get(truth_topic, 0) > 0:
+                state['t0'] = t + mission.rest_s
+                print(f'mission {mission.name}: {len(mission.legs)} legs, '
+                      f'{mission.duration_s:.1f} s, recording to {bag_path}', flush=True)
+            elif t - started > DISCOVERY_TIMEOUT_S:
+                state['problem'] = (f'no planner_state and sim/ground_truth under {namespace} '
+                                    f'within {DISCOVERY_TIMEOUT_S:g} s: are the graph and '
+                                    'the planner running?')
+                rclpy.try_shutdown()
+            return
+        command = mission.command_at(t - state['t0'])
+        if command is not None:
+            msg = Twist()
+            msg.linear.x, msg.angular.z = command
+            publisher.publish(msg)
+        elif t - state['t0'] > mission.duration_s + mission.coast_s:
+            state['done'] = True
+            rclpy.try_shutdown()
+
+    node.create_timer(1.0 / CMD_RATE_HZ, tick)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        recorder.close()
+        executor.shutdown()
+        recorder.destroy_node()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    if state['problem'] is None and not state['done']:
+        state['problem'] = f'interrupted; the bag so far is in {bag_path}'
+    return state['t0'] or 0.0, state['problem']
+
+
+def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> int:
+    import math
+
+    import numpy as np
+    from wirefish_bringup.bagfile import read_bag
+    from wirefish_planner.mission_report import (plot_mission, summarise, summary_text,
+                                                 Track)
+
+    topic = f'{namespace.rstrip("/")}/sim/ground_truth'
+    bag = read_bag(bag_path, [topic])
+    rows = [(t - t0, m.pose.pose.position.x, m.pose.pose.position.y,
+             2.0 * math.atan2(m.pose.pose.orientation.z, m.pose.pose.orientation.w),
+             m.twist.twist.linear.x, m.twist.twist.angular.z)
+            for t, m in bag.messages.get(topic, [])]
+    if len(rows) < 2:
+        print(f'wirefish mission: the bag {bag_path} has no {topic}: the report needs the '
+              "virtual fish's ground truth", file=sys.stderr)
+        return 1
+    data = np.array(rows)
+    track = Track(*(data[:, i] for i in range(6)))
+    summary = summarise(track, mission)
+    png = plot_mission(track, mission, summary, out / f'{mission.name}.png')
+    print(summary_text(mission, summary))
+    print(f'bag: {bag_path}\nreport: {png}')
+    return 0
