@@ -25,18 +25,14 @@ from __future__ import annotations
 import threading
 
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import (DurabilityPolicy, qos_profile_sensor_data, QoSProfile,
-                       ReliabilityPolicy)
-from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
-from wirefish_common.parameter_table import create_node_or_exit, declare, validate_update
+from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.qos import LATCHED, SENSOR_DATA
 from wirefish_common.servo_joints import servo_joint_state
-from wirefish_common.shutdown import SignalShutdown
 from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.cpg_node_parameters import NODE_PARAMETERS, SPECS
 from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES, parameters_from
@@ -45,8 +41,6 @@ from wirefish_cpg.oscillator import at_rest, CpgIntegrator
 from wirefish_cpg.servo_limit import clamp_to_limit
 from wirefish_msgs.msg import CpgParams
 
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
 # Longest clock gap integrated step by step (s); a longer jump re-bases the clock instead.
 MAX_CATCH_UP_S = 0.5
 
@@ -68,7 +62,7 @@ class CpgNode(Node):
                                   step_s=self._values['integration_step_s'],
                                   time_s=self._now_s())
         self._servo_pub = self.create_publisher(JointState, 'servo_cmd',
-                                                qos_profile_sensor_data)
+                                                SENSOR_DATA)
         self._params_pub = self.create_publisher(CpgParams, 'cpg_params', LATCHED)
         self.create_service(Trigger, 'start', self._on_start)
         self.create_service(Trigger, 'stop', self._on_stop)
@@ -157,14 +151,4 @@ class CpgNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the CPG node until shutdown."""
-    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    node = create_node_or_exit(CpgNode)
-    signals.attach(node)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(CpgNode, args)

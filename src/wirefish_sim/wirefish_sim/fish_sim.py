@@ -17,12 +17,12 @@ import argparse
 import math
 from pathlib import Path
 import select
-import signal
 import sys
 import time
 
 import numpy as np
 
+from wirefish_common.shutdown import SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.servo_model import ServoParameters
@@ -134,9 +134,8 @@ class Schedule:
 
 def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     """Run the virtual fish until SIGINT/SIGTERM; return the exit code."""
-    stop = []
-    signal.signal(signal.SIGINT, lambda *_: stop.append(1))
-    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+    # However many SIGINT/SIGTERM arrive: one stop, exit 0 (see wirefish_common.shutdown).
+    signals = SignalShutdown()
     rng = np.random.default_rng(args.seed)
     fish = VirtualFish(config_from(args), rng=rng)
     faults = FaultInjector(np.random.default_rng(args.seed + 1), args.corrupt_fraction,
@@ -151,7 +150,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
         start = last = time.monotonic()
         next_truth = start
         reopened = 0
-        while not stop:
+        while not signals.requested:
             now = time.monotonic()
             elapsed = now - start
             closing = reopens.index(elapsed)
