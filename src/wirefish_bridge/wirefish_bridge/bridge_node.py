@@ -36,6 +36,7 @@ from geometry_msgs.msg import Vector3Stamped
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.timer import Timer
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
 from wirefish_bridge.bridge_parameters import (check_combination, LINK_PARAMETERS,
@@ -86,7 +87,7 @@ class BridgeNode(Node):
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA)
         self._wake = self.create_guard_condition(self._drain_inbox)
-        self._bridge_timers = {}
+        self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)

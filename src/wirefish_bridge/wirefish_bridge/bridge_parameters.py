@@ -7,7 +7,9 @@ ROS.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 import math
+from typing import Any
 
 from wirefish_bridge.protocol import DEFAULT_BAUDRATE
 from wirefish_common.parameter_table import ParameterSpec
@@ -51,7 +53,7 @@ LINK_PARAMETERS = {'port', 'baudrate', 'reconnect_backoff_min_s', 'reconnect_bac
                    'fish_identify_timeout_s'}
 
 
-def check_combination(values: dict[str, object]) -> str | None:
+def check_combination(values: Mapping[str, Any]) -> str | None:
     """Return why a full set of parameter values is inconsistent, or None."""
     if values['reconnect_backoff_max_s'] < values['reconnect_backoff_min_s']:
         return 'reconnect_backoff_max_s must be >= reconnect_backoff_min_s'

@@ -36,7 +36,7 @@ class CommandGate:
 
     def _clamp(self, angles: tuple[float, float]) -> tuple[float, float]:
         limit = self.limit_rad
-        clamped = tuple(min(limit, max(-limit, a)) for a in angles)
+        clamped = (min(limit, max(-limit, angles[0])), min(limit, max(-limit, angles[1])))
         if clamped != tuple(angles):
             self.clamped += 1
         return clamped

@@ -11,6 +11,7 @@ counter there shows up in /diagnostics without being named here.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 import enum
 import math
@@ -22,9 +23,10 @@ from wirefish_bridge.telemetry_limits import telemetry_problem
 from wirefish_bridge.transport import LinkState, LinkStats
 
 # Public /diagnostics names of counters whose dataclass field says it differently.
-DECODER_KEYS = {'frames_ok': 'frames_in', 'seq_gaps': 'drops'}
-LINK_KEYS = {'last_error': 'last_link_error', 'callback_errors': 'reader_errors',
-             'writes_withheld': 'frames_withheld', 'bytes_in': None}   # None: the decoder's
+DECODER_KEYS: dict[str, str | None] = {'frames_ok': 'frames_in', 'seq_gaps': 'drops'}
+LINK_KEYS: dict[str, str | None] = {
+    'last_error': 'last_link_error', 'callback_errors': 'reader_errors',
+    'writes_withheld': 'frames_withheld', 'bytes_in': None}   # None: the decoder's is listed
 
 
 class Level(enum.IntEnum):
@@ -50,7 +52,7 @@ def error_name(code: int) -> str:
 
 def status_names(status: int) -> str:
     """Return the names of the set status flags, or 'ok'."""
-    names = [flag.name for flag in Status if flag and status & flag]
+    names = [str(flag.name) for flag in Status if flag and status & flag]
     return ', '.join(names) or 'ok'
 
 
@@ -177,6 +179,11 @@ class LinkHealth:
         return values
 
 
-def _renamed(counters: dict[str, object], names: dict[str, str | None]) -> dict[str, object]:
-    return {names.get(key, key): value for key, value in counters.items()
-            if names.get(key, key) is not None}
+def _renamed(counters: Mapping[str, object],
+             names: Mapping[str, str | None]) -> dict[str, object]:
+    renamed: dict[str, object] = {}
+    for key, value in counters.items():
+        name = names.get(key, key)
+        if name is not None:
+            renamed[name] = value
+    return renamed

@@ -221,12 +221,12 @@ def message_class(kind: int) -> type[ProtocolMessage] | None:
 
 
 def _registered(message: object) -> type[ProtocolMessage]:
-    cls = type(message)
-    if not isinstance(message, ProtocolMessage) or _BY_KIND.get(cls.KIND) is not cls:
+    if (not isinstance(message, ProtocolMessage)
+            or _BY_KIND.get(message.KIND) is not type(message)):
         known = ', '.join(c.__name__ for c in _BY_KIND.values())
         raise UnknownMessageError(f'not a protocol message: {message!r} (the messages are '
                                   f'{known})')
-    return cls
+    return type(message)
 
 
 def message_type(message: ProtocolMessage) -> MsgType:
