@@ -39,6 +39,8 @@ def command(name: str, tmp_path: Path) -> list[str]:
     if name == 'bridge_node':  # no device: the bridge keeps retrying, which is enough here
         return [executable('wirefish_bridge', name), '--ros-args',
                 '-p', f'port:={tmp_path / "no-such-device"}']
+    if name == 'planner_node':
+        return [executable('wirefish_planner', name)]
     if name == 'fish_sim':
         return [executable('wirefish_sim', name), '--ros', '--link', str(tmp_path / 'tty')]
     if name == 'wirefish_recorder':
@@ -57,7 +59,7 @@ def burst(rng: np.random.Generator) -> list[tuple[float, int]]:
 
 @pytest.mark.parametrize('run', range(RUNS))
 @pytest.mark.parametrize('name', ['cpg_node', 'tuner_node', 'kinematics_node', 'bridge_node',
-                                  'fish_sim', 'wirefish_recorder'])
+                                  'planner_node', 'fish_sim', 'wirefish_recorder'])
 def test_a_burst_of_signals_stops_the_process_cleanly(spawn, ros_context, tmp_path, name, run):
     rng = np.random.default_rng([61, run, *name.encode()])
     proc = spawn(command(name, tmp_path))

@@ -38,6 +38,7 @@ def test_a_node_refuses_to_start_on_invalid_values(ros_env, package, node, overr
     ('wirefish_cpg', 'cpg_node', 'frequency_hz:=2', 'a double', "an integer '2'"),
     ('wirefish_cpg', 'tuner_node', 'swarm_size:=true', 'an integer', "a bool 'True'"),
     ('wirefish_kinematics', 'kinematics_node', 'l1:=long', 'a double', "a string 'long'"),
+    ('wirefish_planner', 'planner_node', 'cmd_vel_timeout_s:=1', 'a double', "an integer '1'"),
 ])
 def test_a_value_of_the_wrong_type_gives_one_fatal_line(
         ros_env, package, node, override, expected, given):
@@ -49,3 +50,16 @@ def test_a_value_of_the_wrong_type_gives_one_fatal_line(
     assert len(lines) == 1 and '[FATAL]' in lines[0], lines
     assert f'{node}: parameter {name} must be {expected}' in lines[0], lines
     assert f'given {given}' in lines[0], lines
+
+
+def test_a_parameter_file_value_of_the_wrong_type_gives_the_same_line(ros_env, tmp_path):
+    params = tmp_path / 'params.yaml'
+    params.write_text('cpg_node:\n  ros__parameters:\n    frequency_hz: 2\n')
+    result = subprocess.run([executable('wirefish_cpg', 'cpg_node'), '--ros-args',
+                             '--params-file', str(params)],
+                            env=ros_env, capture_output=True, text=True, timeout=60)
+    lines = (result.stdout + result.stderr).strip().splitlines()
+    assert result.returncode == 1, lines
+    assert len(lines) == 1 and '[FATAL]' in lines[0], lines
+    assert "cpg_node: parameter frequency_hz must be a double (default" in lines[0], lines
+    assert "given an integer '2' (write 2.0)" in lines[0], lines
