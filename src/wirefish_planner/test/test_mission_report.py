@@ -47,3 +47,28 @@ def test_the_png_is_written_and_the_summary_names_the_closure(tmp_path):
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     assert 'closure error 0.250 m' in summary_text(MISSION, summary)
     assert not math.isnan(summary.path_length_m)
+
+
+def _states(offsets):
+    """Return (t, planner_state) pairs at 20 Hz with r = -9 U b + 0.02 for these offsets."""
+    from types import SimpleNamespace
+
+    states = []
+    for i, b in enumerate(offsets):
+        states.append((i * 0.05, SimpleNamespace(mode='turn', predicted_speed=0.2, offset=b,
+                                                 yaw_rate_measured=-9.0 * 0.2 * b + 0.02)))
+    return states
+
+
+def test_the_mission_prints_the_turn_gain_it_identifies():
+    from wirefish_planner.mission import turn_gain_text
+
+    offsets = [0.0] * 60 + [-0.1] * 100 + [0.1] * 100
+    assert 'k = -9.00' in turn_gain_text(_states(offsets))
+    assert 'd = +0.0200' in turn_gain_text(_states(offsets))
+
+
+def test_a_straight_mission_says_why_no_turn_gain():
+    from wirefish_planner.mission import turn_gain_text
+
+    assert 'not identified' in turn_gain_text(_states([0.0] * 100))

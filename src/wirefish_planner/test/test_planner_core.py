@@ -120,3 +120,13 @@ def test_in_process_heading_hold_rejects_the_current(turn_and_hold, closed_loop)
 def test_in_process_servo_commands_never_step(turn_and_hold):
     rates = np.abs(np.diff(turn_and_hold.servo, axis=0)) / 0.005
     assert rates.max() < 9.1  # the virtual fish's slew limit: never a jump
+
+
+def test_the_default_turn_gain_is_what_the_in_process_fish_identifies(turn_and_hold):
+    from wirefish_planner.planner_config import default_values
+    from wirefish_planner.yaw_control import identify_turn_gain, steady_means
+
+    tr = turn_and_hold
+    gain, bias = identify_turn_gain(*steady_means(tr.t, tr.speed, tr.offset, tr.yaw_rate))
+    assert gain == pytest.approx(default_values()['turn_gain'], rel=0.15)
+    assert bias == pytest.approx(0.05, abs=0.02)  # the current

@@ -2,10 +2,11 @@
 
 import math
 
+import numpy as np
 import pytest
 from wirefish_planner.yaw_control import (feedforward_offset, heading_rate_reference,
-                                          PeriodMean, wrap_angle, yaw_from_quaternion, YawGains,
-                                          YawRatePi)
+                                          identify_turn_gain, PeriodMean, wrap_angle,
+                                          yaw_from_quaternion, YawGains, YawRatePi)
 
 
 @pytest.mark.parametrize('yaw', [-3.0, -1.0, 0.0, 0.5, 2.9])
@@ -79,3 +80,17 @@ def test_negative_gains_are_refused(field):
 def test_zero_turn_gain_is_refused():
     with pytest.raises(ValueError):
         YawGains(turn_gain=0.0)
+
+
+def test_turn_gain_identification_recovers_gain_and_disturbance():
+    rng = np.random.default_rng(1)
+    speed = np.full(400, 0.2)
+    offset = rng.uniform(-0.1, 0.1, 400)
+    rate = -9.0 * speed * offset + 0.05 + rng.normal(0.0, 0.01, 400)
+    gain, bias = identify_turn_gain(speed, offset, rate)
+    assert gain == pytest.approx(-9.0, rel=0.05) and bias == pytest.approx(0.05, abs=0.005)
+
+
+def test_a_straight_run_cannot_identify_the_turn_gain():
+    with pytest.raises(ValueError, match='turn'):
+        identify_turn_gain(np.full(50, 0.2), np.zeros(50), np.zeros(50))

@@ -142,7 +142,8 @@ def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> in
                                                  Track)
 
     topic = f'{namespace.rstrip("/")}/sim/ground_truth'
-    bag = read_bag(bag_path, [topic])
+    state_topic = f'{namespace.rstrip("/")}/planner_state'
+    bag = read_bag(bag_path, [topic, state_topic])
     rows = [(t - t0, m.pose.pose.position.x, m.pose.pose.position.y,
              2.0 * math.atan2(m.pose.pose.orientation.z, m.pose.pose.orientation.w),
              m.twist.twist.linear.x, m.twist.twist.angular.z)
@@ -156,5 +157,25 @@ def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> in
     summary = summarise(track, mission)
     png = plot_mission(track, mission, summary, out / f'{mission.name}.png')
     print(summary_text(mission, summary))
+    print(turn_gain_text(bag.messages.get(state_topic, [])))
     print(f'bag: {bag_path}\nreport: {png}')
     return 0
+
+
+def turn_gain_text(states: list) -> str:
+    """Return the turn gain identified from recorded planner_state (or why it cannot be)."""
+    import numpy as np
+    from wirefish_planner.yaw_control import identify_turn_gain, steady_means
+
+    rows = [(t, m.predicted_speed, m.offset, m.yaw_rate_measured) for t, m in states
+            if m.mode in ('turn', 'hold', 'straight')]
+    if len(rows) < 3:
+        return 'turn gain: not identified (no planner_state of a closed-loop run recorded)'
+    data = np.array(rows)
+    try:
+        gain, bias = identify_turn_gain(*steady_means(*data.T))
+    except ValueError as error:
+        return f'turn gain: not identified: {error}'
+    return (f'turn gain identified from this run (r = k U b + d, steady 1 s means): '
+            f'k = {gain:.2f} rad/s per rad per m/s (planner parameter turn_gain), '
+            f'd = {bias:+.4f} rad/s (a current, or the gyro bias)')

@@ -63,6 +63,9 @@ PLANNER_PARAMETERS = (
                   'angular.z = 0 holds the heading the turn ended on (else yaw rate 0)'),
     ParameterSpec('yaw_control', True,
                   'Close the yaw loops on imu/data (false: feed-forward offsets only)'),
+    ParameterSpec('rest_at_start', True,
+                  'Rest the CPG at start-up (no cmd_vel yet: the fish rests); false: leave '
+                  'cpg_node as it is until the first cmd_vel'),
 ) + geometry_parameters()  # eq 18 needs the fish's geometry: the graph's one /** block
 GAIT_NAMES = ('frequency_hz', 'amplitude_1', 'amplitude_2', 'w12', 'w21', 'phi12', 'phi21',
               'alpha')

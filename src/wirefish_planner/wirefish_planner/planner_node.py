@@ -15,7 +15,8 @@ Drives
     tuner_node applies a fit: the gait (eq 18 inverted, ``gait_family``) and the offsets
     b_1 = b_2 (``yaw_control``). Every change goes through the CPG's smooth convergence, never a
     servo step. At rest (no cmd_vel yet, or none for ``cmd_vel_timeout_s``) the amplitudes and
-    offsets are 0. One request is in flight at a time; newer wishes replace older unsent ones.
+    offsets are 0 (``rest_at_start`` false: cpg_node is left alone until the first cmd_vel).
+    One request is in flight at a time; newer wishes replace older unsent ones.
 Parameters: ``PLANNER_PARAMETERS`` (each with a range; an invalid set changes nothing).
 """
 
@@ -27,15 +28,12 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
 from rcl_interfaces.msg import SetParametersResult
 from rcl_interfaces.srv import SetParametersAtomically
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import Imu
-from wirefish_common.parameter_table import create_node_or_exit, declare, validate_update
-from wirefish_common.shutdown import SignalShutdown
+from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.qos import RELIABLE, SENSOR_DATA
 from wirefish_msgs.msg import PlannerState
 from wirefish_planner.planner_config import (cpg_values, planner_from, PLANNER_PARAMETERS,
                                              values_changed)
@@ -43,7 +41,6 @@ from wirefish_planner.planner_core import ignored_fields, PlannerOutput
 from wirefish_planner.yaw_control import yaw_from_quaternion
 
 SPECS = {spec.name: spec for spec in PLANNER_PARAMETERS}
-RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 DIAGNOSTICS_PERIOD_S = 1.0
 WARN_THROTTLE_S = 2.0
 
@@ -67,7 +64,7 @@ class PlannerNode(Node):
             SetParametersAtomically,
             f'{self._values["cpg_node_name"]}/set_parameters_atomically')
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
-        self.create_subscription(Imu, 'imu/data', self._on_imu, qos_profile_sensor_data)
+        self.create_subscription(Imu, 'imu/data', self._on_imu, SENSOR_DATA)
         self._state_pub = self.create_publisher(PlannerState, 'planner_state', RELIABLE)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self.add_on_set_parameters_callback(self._validate)
@@ -135,6 +132,8 @@ class PlannerNode(Node):
     def _send(self, wanted: dict[str, float]) -> None:
         if self._in_flight is not None or not values_changed(self._sent, wanted):
             return
+        if self._last_cmd_s is None and not self._values['rest_at_start']:
+            return  # cpg_node keeps its own parameters until the first cmd_vel
         if not self._client.service_is_ready():
             return
         self._in_flight = wanted
@@ -209,14 +208,4 @@ class PlannerNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the planner node until shutdown."""
-    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    node = create_node_or_exit(PlannerNode)
-    signals.attach(node)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(PlannerNode, args)

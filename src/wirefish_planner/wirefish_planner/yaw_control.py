@@ -16,6 +16,11 @@ Controller, on each IMU sample with the real dt between message stamps::
 Heading hold (angular.z = 0): r_ref = clip(k_h wrap(psi_target - psi_mean), +-r_hold_max), with
 psi from the IMU orientation. The period means remove the head's yaw oscillation at the
 tail-beat frequency, which would otherwise drive the offsets at that frequency.
+
+The turn gain k is a parameter; ``identify_turn_gain`` estimates it (and a constant yaw
+disturbance d) from a run's steady stretches (``steady_means``: 1 s means where b held still;
+the transients after a change of b would bias k towards 0), r = k U b + d by least squares:
+`wirefish mission` prints it from the planner_state it recorded.
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 import math
+
+import numpy as np
 
 MIN_TURNING_SPEED_M_S = 0.01  # below this the tail cannot turn the fish (r = k U b)
 
@@ -135,3 +142,56 @@ class YawRatePi:
         self.offset = min(limit, max(-limit, raw))
         self.saturated = abs(raw) > limit
         return self.offset
+
+
+MIN_TURN_SPREAD = 0.005  # m/s x rad: U b must vary this much (turns both ways or more)
+
+
+def identify_turn_gain(speed: np.ndarray, offset: np.ndarray, yaw_rate: np.ndarray
+                       ) -> tuple[float, float]:
+    """
+    Return (k, d) of r = k U b + d fitted by least squares to samples of U, b and r.
+
+    ``speed`` U (m/s), ``offset`` b (rad) and ``yaw_rate`` r (rad/s) are arrays of one length.
+    Raises ValueError when U b hardly varies (a straight run cannot tell k from d).
+    """
+    x = np.asarray(speed, dtype=float) * np.asarray(offset, dtype=float)
+    r = np.asarray(yaw_rate, dtype=float)
+    keep = np.isfinite(x) & np.isfinite(r)
+    x, r = x[keep], r[keep]
+    if len(x) < 3 or float(np.std(x)) < MIN_TURN_SPREAD:
+        raise ValueError(f'U b varies by {float(np.std(x)) if len(x) else 0.0:.4g} m/s rad over '
+                         f'{len(x)} samples: turn (both ways) to identify the turn gain')
+    design = np.column_stack([x, np.ones_like(x)])
+    (gain, bias), *_ = np.linalg.lstsq(design, r, rcond=None)
+    return float(gain), float(bias)
+
+
+def steady_means(t: np.ndarray, speed: np.ndarray, offset: np.ndarray, yaw_rate: np.ndarray,
+                 window_s: float = 1.0, max_offset_change: float = 0.01
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Return the means of U, b and r over consecutive ``window_s`` windows where b held still.
+
+    A window counts when b moved less than ``max_offset_change`` rad in it and in the window
+    before it (the yaw rate lags b by the CPG's and the body's time constants).
+    """
+    t = np.asarray(t, dtype=float)
+    edges = np.arange(t[0], t[-1], window_s) if len(t) else np.array([])
+    means, ranges = [], []
+    for start in edges:
+        inside = (t >= start) & (t < start + window_s)
+        if not inside.any():
+            means.append(None)
+            ranges.append(math.inf)
+            continue
+        b = offset[inside]
+        means.append((speed[inside].mean(), b.mean(), yaw_rate[inside].mean()))
+        ranges.append(float(b.max() - b.min()))
+    keep = [means[i] for i in range(1, len(means))
+            if means[i] is not None and max(ranges[i], ranges[i - 1]) < max_offset_change
+            and abs(means[i][1] - (means[i - 1] or (0, math.inf))[1]) < max_offset_change]
+    if not keep:
+        return np.array([]), np.array([]), np.array([])
+    u, b, r = (np.array(column) for column in zip(*keep))
+    return u, b, r
