@@ -61,5 +61,5 @@ def test_a_parameter_file_value_of_the_wrong_type_gives_the_same_line(ros_env, t
     lines = (result.stdout + result.stderr).strip().splitlines()
     assert result.returncode == 1, lines
     assert len(lines) == 1 and '[FATAL]' in lines[0], lines
-    assert "cpg_node: parameter frequency_hz must be a double (default" in lines[0], lines
+    assert 'cpg_node: parameter frequency_hz must be a double (default' in lines[0], lines
     assert "given an integer '2' (write 2.0)" in lines[0], lines
