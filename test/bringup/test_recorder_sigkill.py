@@ -35,8 +35,17 @@ def _record(namespace: str, bag: Path, *options: str) -> list[str]:
 
 
 def _flushed(bag: Path) -> bool:
-    """Return True once a chunk is on disk (the header alone is 45 bytes)."""
-    return any(p.stat().st_size > 200 for p in bag.glob('*.mcap'))
+    """Return True once a chunk holding a message is on disk."""
+    for path in bag.glob('*.mcap'):
+        try:
+            for opcode, _, content in rec.iter_records(path.read_bytes(), len(rec.MAGIC)):
+                if opcode == rec.CHUNK and any(
+                        op == rec.MESSAGE for op, _, _ in rec.iter_records(
+                            rec.decode_chunk(content))):
+                    return True
+        except rec.RecordError:
+            pass  # the tail is still being written
+    return False
 
 
 def _wait_flushed(bag: Path, timeout_s: float) -> bool:
@@ -52,7 +61,7 @@ def _record_then_kill(spawn, listener, namespace: str, bag: Path, seed: int) -> 
     """Record, SIGKILL the recorder at a seeded moment after its first flush; return when."""
     recorder = spawn(_record(namespace, bag))
     assert spin_until(listener.executor, lambda: _flushed(bag), 60.0), 'recorder never flushed'
-    delay = float(np.random.default_rng(seed).uniform(0.3, 3.5))
+    delay = float(np.random.default_rng(seed).uniform(1.2, 4.0))  # > KILL_MARGIN_S of data
     kill_at = time.monotonic() + delay
     spin_until(listener.executor, lambda: time.monotonic() >= kill_at, delay + 1.0)
     killed_at = time.monotonic()
@@ -160,7 +169,7 @@ def test_a_recorder_killed_under_wirefish_up_leaves_a_bag_that_reindex_repairs(
     bag = Path(lines[-1].split()[2].rstrip(';'))
     (recorder,) = [p for p in descendants(launcher.pid) if 'record' in p.cmdline()]
     assert _wait_flushed(bag, 60.0), 'recorder never flushed'
-    time.sleep(float(np.random.default_rng(kill_seed).uniform(1.0, 5.0)))
+    time.sleep(float(np.random.default_rng(kill_seed).uniform(1.2, 5.0)))
     killed_at = time.time()  # the recorder stamps messages with the system clock
     recorder.kill()
     output = launcher.communicate(timeout=120)[0]
