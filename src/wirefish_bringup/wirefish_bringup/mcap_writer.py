@@ -9,6 +9,12 @@ made whole again by `wirefish bag reindex` (wirefish_bringup.reindex) from its i
 
 Schemas and channels go into the chunk they first appear in, so every chunk that survives
 carries what is needed to read its messages.
+
+Why not rosbags' writer: it keeps a chunk in memory until it holds 1 MiB (seconds to minutes of
+the graph) and writes nothing else before close(). Why chunks rather than ~1 s split files: on
+the graph's traffic a 0.5 s flush costs no measurable CPU and 0.3 % more bytes, where 1 s splits
+repeat every schema and summary per file (+6 % bytes, 3,600 files an hour, and rosbags opens
+every file of a bag at once).
 """
 
 from collections import defaultdict

@@ -103,6 +103,7 @@ class BagRecorder(Node):
             if self.first_message_ns is None:
                 self.first_message_ns = now
             number = info.get('publication_sequence_number')
+            # The publisher's DDS sequence number is the MCAP message's: a bag shows its gaps.
             self._writer.write(connection, now, data, number or 0)
             self.counts[topic] += 1
             sequence.add(number)
