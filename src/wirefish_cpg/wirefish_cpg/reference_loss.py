@@ -61,18 +61,18 @@ def simulated_cycle(position: np.ndarray, problem: WaveFitProblem, alpha: float 
             outputs.append((state[2] * math.cos(state[0]), state[3] * math.cos(state[1])))
             if abs(state[0] - phases[0]) > 2.0 * math.pi + 2.0 * abs(k1[0]) * h:
                 break
-    phases = np.array(phases)
-    outputs = np.array(outputs)
-    omega_measured = (phases[-1] - phases[0]) / (h * (len(phases) - 1))
+    phase_track, output_track = np.array(phases), np.array(outputs)
+    omega_measured = (phase_track[-1] - phase_track[0]) / (h * (len(phase_track) - 1))
     omega = 2.0 * np.pi * v
-    if abs(phases[-1] - phases[0]) < 2.0 * np.pi:
+    if abs(phase_track[-1] - phase_track[0]) < 2.0 * np.pi:
         return np.zeros((problem.samples_per_period, 2)), math.nan
-    if phases[-1] < phases[0]:  # turning backwards: same waveform as a function of phase
-        phases, outputs = phases[::-1], outputs[::-1]
+    if phase_track[-1] < phase_track[0]:  # turning backwards: same waveform as a function of phase
+        phase_track, output_track = phase_track[::-1], output_track[::-1]
     # Oscillator 1's phase on the loss grid; the outputs follow by interpolation in phase.
     grid = oscillator1_phase(problem) + (np.pi if r1 < 0.0 else 0.0) + omega * problem.times()
-    grid = phases[0] + np.mod(grid - phases[0], 2.0 * np.pi)
-    angles = np.stack([np.interp(grid, phases, outputs[:, i]) for i in range(2)], axis=-1)
+    grid = phase_track[0] + np.mod(grid - phase_track[0], 2.0 * np.pi)
+    angles = np.stack([np.interp(grid, phase_track, output_track[:, i]) for i in range(2)],
+                      axis=-1)
     intrinsic = v - (omega_measured - omega) / (2.0 * np.pi)
     return angles, float(intrinsic)
 
