@@ -27,6 +27,6 @@ def test_mypy_finds_no_type_error_in_src():
 def test_mypy_with_this_configuration_refuses_a_wrong_type(tmp_path):
     module = tmp_path / 'wrong_type.py'
     module.write_text('def rate_hz() -> float:\n    return "fast"\n')
-    result = mypy(str(module))
+    result = mypy('--cache-dir', str(tmp_path / 'cache'), str(module))
     assert result.returncode == 1, result.stdout + result.stderr
     assert 'Incompatible return value type (got "str", expected "float")' in result.stdout
