@@ -14,7 +14,8 @@ setup(
     zip_safe=True,
     maintainer='wirefish maintainers',
     maintainer_email='maintainers@wirefish.dev',
-    description='Declaring and validating ROS parameters from one table.',
+    description='What every wirefish node shares: parameter table, main() idiom and signal '
+                'handling, QoS profiles, servo joint names.',
     license='Apache-2.0',
     tests_require=['pytest'],
 )

@@ -1,1 +1,1 @@
-"""Pieces the wirefish nodes share: the ROS parameter table."""
+"""Pieces every wirefish node shares: parameter table, main() idiom, signals, QoS, servo joints."""
