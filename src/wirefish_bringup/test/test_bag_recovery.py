@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from wirefish_bringup import cli, mcap_records as rec
-from wirefish_bringup.bag_storage import IncompleteFile, read_file_info
+from wirefish_bringup.bag_storage import (IncompleteFile, next_file_path, read_file_info,
+                                          storage_files)
 from wirefish_bringup.recorder import open_bag_file
 from wirefish_bringup.reindex import reindex
 import yaml
@@ -186,3 +187,19 @@ def test_messages_whose_channel_was_in_a_damaged_chunk_are_counted_not_guessed(k
     (recovery,) = reindex(killed_bag.bag_dir)
     assert (recovery.damaged_chunks, recovery.orphan_messages) == (1, 110)
     assert read_texts(killed_bag.bag_dir, typestore) == []
+
+
+@pytest.mark.parametrize('names, ordered, following', [
+    ([], [], 'bag_0.mcap'),
+    (['bag_2.mcap', 'bag_10.mcap', 'bag_0.mcap'], ['bag_0.mcap', 'bag_2.mcap', 'bag_10.mcap'],
+     'bag_11.mcap'),
+    (['bag.mcap'], ['bag.mcap'], 'bag_0.mcap'),  # rosbags' name for a one-file bag
+])
+def test_split_files_are_ordered_by_index_and_the_next_one_is_new(tmp_path, names, ordered,
+                                                                  following):
+    bag_dir = tmp_path / 'bag'
+    bag_dir.mkdir()
+    for name in names:
+        (bag_dir / name).write_bytes(b'')
+    assert [p.name for p in storage_files(bag_dir)] == ordered
+    assert next_file_path(bag_dir).name == following

@@ -49,18 +49,21 @@ class FileInfo:
     topics: tuple[TopicInfo, ...]
 
 
+def _split_index(path: Path) -> int:
+    match = re.search(r'_(\d+)\.mcap$', path.name)
+    return int(match.group(1)) if match else -1  # a file named otherwise comes first
+
+
 def storage_files(bag_dir: Path) -> list[Path]:
     """Return the bag's MCAP files in recording order (by their split index)."""
-    def order(path: Path) -> tuple[int, str]:
-        match = re.search(r'_(\d+)\.mcap$', path.name)
-        return (int(match.group(1)) if match else -1, path.name)
-    return sorted(Path(bag_dir).glob('*.mcap'), key=order)
+    return sorted(Path(bag_dir).glob('*.mcap'), key=lambda p: (_split_index(p), p.name))
 
 
 def next_file_path(bag_dir: Path) -> Path:
     """Return the path of the bag's next split file (``<dir>_<n>.mcap``)."""
     bag_dir = Path(bag_dir)
-    return bag_dir / f'{bag_dir.name}_{len(storage_files(bag_dir))}.mcap'
+    index = max((_split_index(p) for p in storage_files(bag_dir)), default=-1) + 1
+    return bag_dir / f'{bag_dir.name}_{index}.mcap'
 
 
 def add_topic(writer: McapWriter, typestore: Typestore, topic: str, type_name: str,
