@@ -2,20 +2,25 @@
 tuner_node: fits the CPG to a desired body wave on request (paper section 4, eqs 23-27).
 
 Service
-    ``retune_gait`` (wirefish_msgs/srv/RetuneGait). The request is validated (finite values,
-    frequency in (0, 10] Hz, k > 0, swarm_size 0 or in [2, 2000], max_iterations 0 or in
-    [1, 5000]; 0 = this node's default) and answered with ``success: false`` and the reason
-    otherwise. One fit runs at a time: a request arriving while one runs is refused at once
-    with ``success: false`` ("busy"), not queued. With ``apply: true`` the fitted parameters
-    are set on the CPG node through its standard ``<cpg_node_name>/set_parameters_atomically``
-    service (the same change as ``ros2 param set``), and success is reported only after the
-    CPG node accepted them. Offsets are not touched (the fit assumes b = 0).
+    ``retune_gait`` (wirefish_msgs/srv/RetuneGait). Every request is answered, however many
+    arrive at once: the service keeps up to 1000 requests (``SERVICE_QOS``), refusals are
+    immediate, answers are paced 20 ms apart so that no client's answer is pushed out of its
+    queue by the others' (``answered_service``), and one fit runs at a time: a request arriving
+    while one runs is refused with ``success: false`` ("busy"), not queued. The request is
+    judged by ``wirefish_cpg.retune_core`` (values, then whether the tail can follow the wave
+    at all: ``wirefish_cpg.feasibility``), fitted, and the fit judged
+    (finite loss, swing-angle RMSE <= ``max_rmse_deg``); a refused wave or fit answers
+    ``success: false`` with the reason and the figures, and is never applied. With
+    ``apply: true`` the fitted parameters are set on the CPG node through its standard
+    ``<cpg_node_name>/set_parameters_atomically`` service (the same change as ``ros2 param
+    set``), and success is reported only after the CPG node accepted them. Offsets are not
+    touched (the fit assumes b = 0).
 Publishes
     ``retune_progress`` (std_msgs/Float64MultiArray, reliable, depth 10) while a fit runs, once
     per PSO iteration: ``data = [iteration, best_loss (m*s), max_iterations]``; iteration 0 is
     the initial swarm, and the run can end before max_iterations when the loss stalls.
     ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local, depth 1): the wave
-    of each accepted request.
+    the CPG runs, published only once a fit was applied.
 The fit runs in the service callback on a multi-threaded executor; the service and the
 parameter client sit in separate callback groups, so the node keeps serving (parameters,
 refusals, the parameter-service response) while a fit runs.
@@ -26,25 +31,23 @@ from __future__ import annotations
 import math
 import threading
 
-import numpy as np
 from rcl_interfaces.msg import Parameter as ParameterMsg, SetParametersResult
 from rcl_interfaces.srv import SetParametersAtomically
-import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Float64MultiArray
-from wirefish_common.parameter_table import (create_node_or_exit, declare, ParameterSpec,
-                                             validate_update)
-from wirefish_common.shutdown import SignalShutdown
+from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.qos import LATCHED, RELIABLE, reliable
+from wirefish_cpg.answered_service import pace_answers
 from wirefish_cpg.cpg_messages import to_message
+from wirefish_cpg.feasibility import FitLimits
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
-from wirefish_cpg.tuning import fit_gait
-from wirefish_cpg.wave_loss import WaveFitProblem, WaveSpec
+from wirefish_cpg.retune_core import (MAX_ITERATIONS, MAX_SWARM_SIZE, retune, RetuneOrder,
+                                      RetuneOutcome, RetuneSettings)
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS, geometry_parameters
 from wirefish_msgs.msg import BodyWaveSpec
@@ -52,11 +55,12 @@ from wirefish_msgs.srv import RetuneGait
 
 # The fit needs the body wave's geometry only; its specs are the one geometry block's.
 GEOMETRY_FIELDS = BODY_WAVE_GEOMETRY_FIELDS
+_LIMITS = FitLimits()
 TUNER_PARAMETERS = (
     ParameterSpec('cpg_node_name', 'cpg_node',
                   'Name (relative or absolute) of the CPG node whose parameters apply sets'),
-    ParameterSpec('swarm_size', 40, 'Default PSO particles per run', 2, 2000),
-    ParameterSpec('max_iterations', 100, 'Default PSO iteration limit', 1, 5000),
+    ParameterSpec('swarm_size', 40, 'Default PSO particles per run', 2, MAX_SWARM_SIZE),
+    ParameterSpec('max_iterations', 100, 'Default PSO iteration limit', 1, MAX_ITERATIONS),
     ParameterSpec('stall_iterations', 20, 'Stop after this many iterations without gain', 1,
                   5000),
     ParameterSpec('stall_tolerance', 1e-6, 'Relative gain below which an iteration stalls',
@@ -68,8 +72,17 @@ TUNER_PARAMETERS = (
                   low_exclusive=True),
     ParameterSpec('phase_bound', math.pi, 'Search bound |phi_ij| (rad); paper: pi', 0.0,
                   math.pi, low_exclusive=True),
-    ParameterSpec('amplitude_bound', math.pi / 2, 'Search bound |R_i| (rad); paper: pi/2',
-                  0.0, math.pi / 2, low_exclusive=True),
+    ParameterSpec('amplitude_bound', math.pi / 2,
+                  'Search bound |R_i| (rad), also the servo range a wave may ask for; '
+                  'paper: pi/2', 0.0, math.pi / 2, low_exclusive=True),
+    ParameterSpec('servo_rate_limit_rad_s', _LIMITS.servo_rate_limit_rad_s,
+                  'Fastest servo rate a wave may ask for (rad/s); the virtual fish slews 9.1',
+                  0.0, 1000.0, low_exclusive=True),
+    ParameterSpec('min_frequency_hz', _LIMITS.min_frequency_hz,
+                  'Slowest tail beat a wave may ask for (Hz)', 0.0, 10.0, low_exclusive=True),
+    ParameterSpec('max_rmse_deg', _LIMITS.max_rmse_deg,
+                  'Largest swing-angle RMSE of a fit that may be used (deg); paper fit: 1.7',
+                  0.0, 90.0, low_exclusive=True),
     ParameterSpec('alpha', 20.0, 'Convergence gain alpha given to fitted gaits (1/s)', 0.0,
                   200.0, low_exclusive=True),
     ParameterSpec('samples_per_period', 48, 'Quadrature points of the loss per period', 8,
@@ -77,28 +90,17 @@ TUNER_PARAMETERS = (
     ParameterSpec('apply_timeout_s', 5.0, 'Wait for the CPG node to accept (s)', 0.1, 60.0),
 ) + geometry_parameters(GEOMETRY_FIELDS)
 SPECS = {spec.name: spec for spec in TUNER_PARAMETERS}
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
-RELIABLE = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# A burst of requests must fit the service's own DDS queues while a fit holds the executor;
+# its clients' queues are protected by pacing the answers (answered_service).
+SERVICE_QOS = reliable(depth=1000)
 
 
-def request_problem(request: RetuneGait.Request) -> str | None:
-    """Return why a RetuneGait request is invalid, or None if it is acceptable."""
+def order_of(request: RetuneGait.Request) -> RetuneOrder:
+    """Return the retune order of a service request (the library is not used by the service)."""
     wave = request.wave
-    values = {'c1': wave.c1, 'c2': wave.c2, 'k': wave.k, 'frequency_hz': wave.frequency_hz}
-    for name, value in values.items():
-        if not math.isfinite(value):
-            return f'wave.{name} must be finite, got {value}'
-    if not 0.0 < wave.frequency_hz <= 10.0:
-        return f'wave.frequency_hz must be in (0, 10] Hz, got {wave.frequency_hz:g}'
-    if wave.k <= 0.0:
-        return f'wave.k must be > 0, got {wave.k:g}'
-    if request.swarm_size != 0 and not 2 <= request.swarm_size <= 2000:
-        return f'swarm_size must be 0 (default) or in [2, 2000], got {request.swarm_size}'
-    if request.max_iterations != 0 and not 1 <= request.max_iterations <= 5000:
-        return (f'max_iterations must be 0 (default) or in [1, 5000], '
-                f'got {request.max_iterations}')
-    return None
+    return RetuneOrder(c1=wave.c1, c2=wave.c2, k=wave.k, frequency_hz=wave.frequency_hz,
+                       seed=request.seed, max_iterations=request.max_iterations,
+                       swarm_size=request.swarm_size, use_library=False)
 
 
 def parameter_messages(params: CpgParameters) -> list[ParameterMsg]:
@@ -124,14 +126,33 @@ class TunerNode(Node):
         self._wave_pub = self.create_publisher(BodyWaveSpec, 'target_wave', LATCHED)
         self._client_group = MutuallyExclusiveCallbackGroup()
         self._param_clients: dict[str, object] = {}
-        self.create_service(RetuneGait, 'retune_gait', self._on_retune,
-                            callback_group=ReentrantCallbackGroup())
+        pace_answers(self.create_service(
+            RetuneGait, 'retune_gait', self._on_retune, qos_profile=SERVICE_QOS,
+            callback_group=ReentrantCallbackGroup()))
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
         return validate_update(SPECS, {}, parameters)
 
     def _value(self, name: str):
         return self.get_parameter(name).value
+
+    def _settings(self) -> RetuneSettings:
+        """Return the fit settings of the current parameters (raises ValueError if invalid)."""
+        value = self._value
+        return RetuneSettings(
+            geometry=FishGeometry(**{name: value(name) for name in GEOMETRY_FIELDS}),
+            limits=FitLimits(servo_range_rad=value('amplitude_bound'),
+                             servo_rate_limit_rad_s=value('servo_rate_limit_rad_s'),
+                             min_frequency_hz=value('min_frequency_hz'),
+                             max_rmse_deg=value('max_rmse_deg')),
+            pso=PsoOptions(swarm_size=value('swarm_size'),
+                           max_iterations=value('max_iterations'), inertia=value('inertia'),
+                           cognitive=value('cognitive'), social=value('social'),
+                           stall_iterations=value('stall_iterations'),
+                           stall_tolerance=value('stall_tolerance')),
+            upper=(value('weight_bound'),) * 2 + (value('phase_bound'),) * 2
+            + (value('amplitude_bound'),) * 2,
+            alpha=value('alpha'), samples_per_period=value('samples_per_period'))
 
     def _parameter_client(self):
         service = f'{self._value("cpg_node_name")}/set_parameters_atomically'
@@ -142,64 +163,39 @@ class TunerNode(Node):
 
     def _on_retune(self, request: RetuneGait.Request, response: RetuneGait.Response
                    ) -> RetuneGait.Response:
-        reason = request_problem(request)
-        if reason is not None:
-            response.success, response.message = False, f'rejected: {reason}'
-            return response
         if not self._busy.acquire(blocking=False):
             response.success = False
             response.message = 'busy: a retune is already running; retry when it finishes'
             return response
         try:
-            self._wave_pub.publish(request.wave)
-            return self._retune(request, response)
-        except ValueError as error:  # e.g. a geometry FishGeometry refuses
-            response.success, response.message = False, f'rejected: {error}'
-            return response
+            max_iterations = float(request.max_iterations or self._value('max_iterations'))
+
+            def progress(iteration: int, best_loss: float, _rmse) -> None:
+                self._progress_pub.publish(Float64MultiArray(
+                    data=[float(iteration), best_loss, max_iterations]))
+
+            outcome = retune(order_of(request), self._settings(), progress)
+            success, message = self._conclude(outcome, request.apply, request.wave)
         except Exception as error:  # noqa: B902 (answer, and keep serving, whatever failed)
             self.get_logger().error(f'retune failed: {error!r}')
             response.success, response.message = False, f'failed: {error!r}'
             return response
         finally:
             self._busy.release()
-
-    def _retune(self, request: RetuneGait.Request, response: RetuneGait.Response
-                ) -> RetuneGait.Response:
-        wave = request.wave
-        geometry = FishGeometry(**{name: self._value(name) for name in GEOMETRY_FIELDS})
-        problem = WaveFitProblem(
-            wave=WaveSpec(wave.c1, wave.c2, wave.k, wave.frequency_hz), geometry=geometry,
-            samples_per_period=self._value('samples_per_period'))
-        options = PsoOptions(
-            swarm_size=request.swarm_size or self._value('swarm_size'),
-            max_iterations=request.max_iterations or self._value('max_iterations'),
-            inertia=self._value('inertia'), cognitive=self._value('cognitive'),
-            social=self._value('social'), stall_iterations=self._value('stall_iterations'),
-            stall_tolerance=self._value('stall_tolerance'))
-        upper = np.array([self._value('weight_bound')] * 2 + [self._value('phase_bound')] * 2
-                         + [self._value('amplitude_bound')] * 2)
-
-        def progress(iteration: int, best_loss: float, _position: np.ndarray) -> None:
-            self._progress_pub.publish(Float64MultiArray(
-                data=[float(iteration), best_loss, float(options.max_iterations)]))
-
-        fit = fit_gait(problem, np.random.default_rng(request.seed), options, -upper, upper,
-                       alpha=self._value('alpha'), callback=progress)
-        response.params = to_message(fit.params)
-        response.loss = fit.loss
-        response.rmse_theta_deg = [float(v) for v in fit.rmse_theta_deg]
-        response.iterations = fit.iterations
-        response.elapsed_s = fit.elapsed_s
-        summary = (f'loss {fit.loss:.6g} m*s after {fit.iterations} iterations, RMSE theta '
-                   f'{fit.rmse_theta_deg[0]:.3f}/{fit.rmse_theta_deg[1]:.3f} deg')
-        if not request.apply:
-            response.success, response.message = True, f'fitted: {summary}'
-            return response
-        reason = self._apply(fit.params)
-        response.success = reason is None
-        response.message = (f'fitted and applied: {summary}' if reason is None
-                            else f'fitted ({summary}) but not applied: {reason}')
+        fill_response(response, outcome)
+        response.success, response.message = success, message
         return response
+
+    def _conclude(self, outcome: RetuneOutcome, apply: bool, wave: BodyWaveSpec
+                  ) -> tuple[bool, str]:
+        """Apply a successful outcome if asked; return (success, message) of the answer."""
+        if not outcome.success or not apply:
+            return outcome.success, outcome.message
+        reason = self._apply(outcome.params)
+        if reason is not None:
+            return False, f'fitted ({outcome.summary()}) but not applied: {reason}'
+        self._wave_pub.publish(wave)  # the wave the CPG now runs (kinematics overlay)
+        return True, f'fitted and applied: {outcome.summary()}'
 
     def _apply(self, params: CpgParameters) -> str | None:
         """Set the fit on the CPG node atomically; return why it failed, or None."""
@@ -220,19 +216,16 @@ class TunerNode(Node):
         return None
 
 
+def fill_response(response: RetuneGait.Response, outcome: RetuneOutcome) -> None:
+    """Copy an outcome's figures into a service response (success/message set by the caller)."""
+    if outcome.params is not None:
+        response.params = to_message(outcome.params)
+    response.loss = float(outcome.loss)
+    response.rmse_theta_deg = [float(v) for v in outcome.rmse_theta_deg]
+    response.iterations = outcome.iterations
+    response.elapsed_s = outcome.elapsed_s
+
+
 def main(args: list[str] | None = None) -> None:
     """Run the tuner node on a multi-threaded executor until shutdown."""
-    signals = SignalShutdown()  # Ctrl-C between callbacks: see wirefish_common.shutdown
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    node = create_node_or_exit(TunerNode)
-    signals.attach(node)
-    executor = MultiThreadedExecutor(num_threads=4)
-    executor.add_node(node)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run_node(TunerNode, args, executor_factory=lambda: MultiThreadedExecutor(num_threads=4))
