@@ -8,23 +8,30 @@ from hypothesis import given, settings, strategies as st
 import pytest
 from wirefish_bridge.codec import (crc16, DecoderStats, encode_body, encode_frame, FrameEncoder,
                                    MAX_ENCODED_FRAME, StreamDecoder)
-from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, MsgType, Role,
-                                      ServoCommand, Status, Telemetry)
+from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, message_class,
+                                      MsgType, Role, ServoCommand, Status, Telemetry)
 
 f32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
 u16 = st.integers(0, 0xFFFF)
 u32 = st.integers(0, 0xFFFFFFFF)
-messages = st.one_of(
-    st.builds(Heartbeat, version=st.integers(0, 255), role=st.sampled_from(Role), uptime_ms=u32),
-    st.builds(ServoCommand, f32, f32),
-    st.builds(Telemetry, board_time_ms=u32, roll=f32, pitch=f32, yaw=f32,
-              gyro=st.tuples(f32, f32, f32), accel=st.tuples(f32, f32, f32), servo_1=f32,
-              servo_2=f32, battery_v=f32, status=u16),
-    st.builds(ErrorReport, code=st.integers(0, 255), ref_seq=u16),
-)
+# One strategy per registered message class (a test below keeps it complete).
+STRATEGIES = {
+    Heartbeat: st.builds(Heartbeat, version=st.integers(0, 255), role=st.sampled_from(Role),
+                         uptime_ms=u32),
+    ServoCommand: st.builds(ServoCommand, f32, f32),
+    Telemetry: st.builds(Telemetry, board_time_ms=u32, roll=f32, pitch=f32, yaw=f32,
+                         gyro=st.tuples(f32, f32, f32), accel=st.tuples(f32, f32, f32),
+                         servo_1=f32, servo_2=f32, battery_v=f32, status=u16),
+    ErrorReport: st.builds(ErrorReport, code=st.integers(0, 255), ref_seq=u16),
+}
+messages = st.one_of(*STRATEGIES.values())
 TELEMETRY = Telemetry(board_time_ms=1234, roll=0.1, pitch=-0.2, yaw=3.0, gyro=(0.0, 0.5, -1.0),
                       accel=(0.25, 0.0, 9.75), servo_1=0.375, servo_2=-0.5, battery_v=8.125,
                       status=int(Status.LOW_BATTERY))
+
+
+def test_the_round_trips_cover_every_registered_message():
+    assert set(STRATEGIES) == {message_class(kind) for kind in MsgType}
 
 
 def test_crc16_is_ccitt_false():
