@@ -144,7 +144,7 @@ class YawRatePi:
         return self.offset
 
 
-MIN_TURN_SPREAD = 0.005  # m/s x rad: U b must vary this much (turns both ways or more)
+MIN_TURN_SPREAD = 0.005  # m/s x rad: U b must vary this much (a run with turns)
 
 
 def identify_turn_gain(speed: np.ndarray, offset: np.ndarray, yaw_rate: np.ndarray
@@ -161,14 +161,14 @@ def identify_turn_gain(speed: np.ndarray, offset: np.ndarray, yaw_rate: np.ndarr
     x, r = x[keep], r[keep]
     if len(x) < 3 or float(np.std(x)) < MIN_TURN_SPREAD:
         raise ValueError(f'U b varies by {float(np.std(x)) if len(x) else 0.0:.4g} m/s rad over '
-                         f'{len(x)} samples: turn (both ways) to identify the turn gain')
+                         f'{len(x)} samples: the run must turn to identify the turn gain')
     design = np.column_stack([x, np.ones_like(x)])
     (gain, bias), *_ = np.linalg.lstsq(design, r, rcond=None)
     return float(gain), float(bias)
 
 
 def steady_means(t: np.ndarray, speed: np.ndarray, offset: np.ndarray, yaw_rate: np.ndarray,
-                 window_s: float = 1.0, max_offset_change: float = 0.01
+                 window_s: float = 1.0, max_offset_change: float = 0.02
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     Return the means of U, b and r over consecutive ``window_s`` windows where b held still.
