@@ -24,8 +24,11 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 	src/wirefish_analysis/test/test_flake8.py src/wirefish_analysis/test/test_pep257.py \
 	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py
 
+# pytest-xdist workers: one per core of the 2-core reference machine.
+FAST_JOBS ?= 2
+
 test-fast: setup  ## cores and lint, no node processes (under a minute)
-	@$(WFENV) python -m pytest -m "not ros" $(FAST_TESTS) $(PYTEST_ARGS)
+	@$(WFENV) python -m pytest -n $(FAST_JOBS) -m "not ros" $(FAST_TESTS) $(PYTEST_ARGS)
 
 lint: setup  ## flake8, pep257, mypy (mypy.ini) and the package.xml dependency check
 	@$(WFENV) python -m pytest -m linter $(PYTEST_ARGS)
