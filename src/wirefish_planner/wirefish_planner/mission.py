@@ -11,6 +11,7 @@ arrows, speed and yaw rate against the setpoints) and the closure error are writ
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 import sys
@@ -65,6 +66,15 @@ def run(args: argparse.Namespace) -> int:
     return _report(mission, namespace, bag_path, out, t0)
 
 
+@dataclass
+class _Run:
+    """Where a mission run is: the first leg's start (node clock s), a problem, done."""
+
+    t0: float | None = None
+    problem: str | None = None
+    done: bool = False
+
+
 def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
     """Send the legs and record; return (first leg's start on the node clock s, problem)."""
     from geometry_msgs.msg import Twist
@@ -86,10 +96,10 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
     executor.add_node(recorder)
     reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     publisher = node.create_publisher(Twist, 'cmd_vel', reliable)
-    heard = []
+    heard: list[PlannerState] = []
     node.create_subscription(PlannerState, 'planner_state', heard.append, reliable)
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
-    state = {'t0': None, 'problem': None, 'done': False}
+    run = _Run()
     started = node.get_clock().now().nanoseconds * 1e-9
 
     def now() -> float:
@@ -97,24 +107,24 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
 
     def tick() -> None:
         t = now()
-        if state['t0'] is None:
+        if run.t0 is None:
             if heard and recorder.counts.get(truth_topic, 0) > 0:
-                state['t0'] = t + mission.rest_s
+                run.t0 = t + mission.rest_s
                 print(f'mission {mission.name}: {len(mission.legs)} legs, '
                       f'{mission.duration_s:.1f} s, recording to {bag_path}', flush=True)
             elif t - started > DISCOVERY_TIMEOUT_S:
-                state['problem'] = (f'no planner_state and sim/ground_truth under {namespace} '
-                                    f'within {DISCOVERY_TIMEOUT_S:g} s: are the graph and '
-                                    'the planner running?')
+                run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
+                               f'within {DISCOVERY_TIMEOUT_S:g} s: are the graph and '
+                               'the planner running?')
                 rclpy.try_shutdown()
             return
-        command = mission.command_at(t - state['t0'])
+        command = mission.command_at(t - run.t0)
         if command is not None:
             msg = Twist()
             msg.linear.x, msg.angular.z = command
             publisher.publish(msg)
-        elif t - state['t0'] > mission.duration_s + mission.coast_s:
-            state['done'] = True
+        elif t - run.t0 > mission.duration_s + mission.coast_s:
+            run.done = True
             rclpy.try_shutdown()
 
     node.create_timer(1.0 / CMD_RATE_HZ, tick)
@@ -128,9 +138,9 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
         recorder.destroy_node()
         node.destroy_node()
         rclpy.try_shutdown()
-    if state['problem'] is None and not state['done']:
-        state['problem'] = f'interrupted; the bag so far is in {bag_path}'
-    return state['t0'] or 0.0, state['problem']
+    if run.problem is None and not run.done:
+        run.problem = f'interrupted; the bag so far is in {bag_path}'
+    return run.t0 or 0.0, run.problem
 
 
 def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> int:

@@ -41,7 +41,7 @@ class MissionSummary:
 
 
 def _at(track: Track, t: float) -> int:
-    return int(min(len(track.t) - 1, np.searchsorted(track.t, t)))
+    return min(len(track.t) - 1, int(np.searchsorted(track.t, t)))
 
 
 def summarise(track: Track, mission: Mission, settle_s: float = 2.0) -> MissionSummary:

@@ -9,6 +9,7 @@ planner output into the cpg_node parameters to set.
 from __future__ import annotations
 
 import math
+from typing import Any, Mapping
 
 from wirefish_common.parameter_table import ParameterSpec
 from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
@@ -73,8 +74,13 @@ OFFSET_NAMES = ('offset_1', 'offset_2')
 OFFSET_DEADBAND_RAD = 0.002  # smaller offset changes are not sent (the CPG would barely move)
 
 
-def planner_from(values: dict[str, object], family: GaitFamily | None = None) -> Planner:
-    """Return the Planner of a parameter set; raise ValueError naming what is inconsistent."""
+def planner_from(values: Mapping[str, Any], family: GaitFamily | None = None) -> Planner:
+    """
+    Return the Planner of a parameter set; raise ValueError naming what is inconsistent.
+
+    Values are typed Any: the parameter table has judged their types, the dataclasses judge
+    their values.
+    """
     limits = GaitLimits(
         min_frequency_hz=values['min_frequency_hz'], max_frequency_hz=values['max_frequency_hz'],
         max_amplitude_scale=values['max_amplitude_scale'],
@@ -93,7 +99,7 @@ def planner_from(values: dict[str, object], family: GaitFamily | None = None) ->
                    settings)
 
 
-def default_values() -> dict[str, object]:
+def default_values() -> dict[str, Any]:
     """Return the parameters' defaults by name."""
     return {spec.name: spec.default for spec in PLANNER_PARAMETERS}
 

@@ -178,19 +178,24 @@ def steady_means(t: np.ndarray, speed: np.ndarray, offset: np.ndarray, yaw_rate:
     """
     t = np.asarray(t, dtype=float)
     edges = np.arange(t[0], t[-1], window_s) if len(t) else np.array([])
-    means, ranges = [], []
+    # (means of U, b, r; how far b moved) per window, None for an empty window
+    windows: list[tuple[tuple[float, float, float], float] | None] = []
     for start in edges:
         inside = (t >= start) & (t < start + window_s)
         if not inside.any():
-            means.append(None)
-            ranges.append(math.inf)
+            windows.append(None)
             continue
         b = offset[inside]
-        means.append((speed[inside].mean(), b.mean(), yaw_rate[inside].mean()))
-        ranges.append(float(b.max() - b.min()))
-    keep = [means[i] for i in range(1, len(means))
-            if means[i] is not None and max(ranges[i], ranges[i - 1]) < max_offset_change
-            and abs(means[i][1] - (means[i - 1] or (0, math.inf))[1]) < max_offset_change]
+        windows.append(((float(speed[inside].mean()), float(b.mean()),
+                         float(yaw_rate[inside].mean())), float(b.max() - b.min())))
+    keep = []
+    for before, now in zip(windows, windows[1:]):
+        if before is None or now is None:
+            continue
+        steady = max(before[1], now[1]) < max_offset_change and \
+            abs(now[0][1] - before[0][1]) < max_offset_change
+        if steady:
+            keep.append(now[0])
     if not keep:
         return np.array([]), np.array([]), np.array([])
     u, b, r = (np.array(column) for column in zip(*keep))
