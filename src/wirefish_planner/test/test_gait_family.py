@@ -74,3 +74,16 @@ def test_a_slower_servo_lowers_the_fastest_gait():
 def test_inconsistent_limits_are_refused(field, value):
     with pytest.raises(ValueError):
         GaitLimits(**{field: value})
+
+
+class _Table1NotDeclaredLinear(Table1Family):
+    """Table 1 seen as a family of unknown shape: the feasible scale by bisection."""
+
+    linear_in_scale = False
+
+
+@pytest.mark.parametrize('frequency', [1.0, 2.5, 3.5])
+def test_bisection_finds_the_feasible_scale_the_linear_rule_gives(gait_planner, frequency):
+    general = GaitPlanner(_Table1NotDeclaredLinear(), GaitLimits())
+    assert general.feasible_scale(frequency)[0] == pytest.approx(
+        gait_planner.feasible_scale(frequency)[0], rel=1e-6)

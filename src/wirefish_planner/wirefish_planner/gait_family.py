@@ -8,9 +8,10 @@ follow exactly), the peak servo rate and the peak servo angle.
 
 Feasible: peak rate <= ``slew_margin`` x the servo's slew limit (the virtual fish's 9.1 rad/s,
 ``wirefish_analysis.servo_calibration``: a faster command is not followed, so eq 18 would
-over-predict) and peak angle + the largest turning offset <= the servo range. Both are linear
-in s (the locked phase difference does not depend on s), so the largest feasible scale at a
-frequency is one division.
+over-predict) and peak angle + the largest turning offset <= the servo range. In Table 1's
+family both are linear in s (the locked phase difference does not depend on s), so the largest
+feasible scale at a frequency is one division; a family that is not (``linear_in_scale``
+False, e.g. fitted gaits) gets it by bisection.
 
 Policy: the lowest frequency that reaches the target. Below the speed of the lowest frequency at
 the largest feasible scale, the frequency stays at its minimum and the scale is solved; above,
@@ -21,6 +22,7 @@ reason names the binding limit.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 import functools
 import math
@@ -41,6 +43,7 @@ class GaitFamily(Protocol):
     """A family of gaits: CPG parameters for (tail-beat frequency Hz, amplitude scale)."""
 
     name: str
+    linear_in_scale: bool  # servo angles and rates proportional to the amplitude scale
 
     def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
         """Return the CPG parameters of this gait."""
@@ -50,6 +53,7 @@ class Table1Family:
     """Table 1 locked at f with R_i scaled by s (the analytic family, no fit needed)."""
 
     name = 'table1'
+    linear_in_scale = True
 
     def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
         """Return Table 1 locked at ``frequency_hz`` with R_i scaled by ``amplitude_scale``."""
@@ -141,9 +145,15 @@ class GaitPlanner:
     def feasible_scale(self, frequency_hz: float) -> tuple[float, str]:
         """Return the largest feasible amplitude scale at ``frequency_hz`` and what binds it."""
         lim = self.limits
-        unit = self._point(frequency_hz, 1.0)  # rates and angles are linear in the scale
-        by_rate = lim.slew_margin * lim.servo_rate_limit_rad_s / unit.peak_rate
-        by_range = (lim.servo_limit_rad - lim.max_offset_rad) / unit.peak_angle
+        rate_limit = lim.slew_margin * lim.servo_rate_limit_rad_s
+        angle_limit = lim.servo_limit_rad - lim.max_offset_rad
+        if self.family.linear_in_scale:
+            unit = self._point(frequency_hz, 1.0)
+            by_rate = rate_limit / unit.peak_rate
+            by_range = angle_limit / unit.peak_angle
+        else:
+            by_rate = self._largest_scale(frequency_hz, lambda p: p.peak_rate <= rate_limit)
+            by_range = self._largest_scale(frequency_hz, lambda p: p.peak_angle <= angle_limit)
         candidates = ((lim.max_amplitude_scale, 'the largest amplitude scale '
                        f'{lim.max_amplitude_scale:g}'),
                       (by_rate, f'the servo slew limit {lim.servo_rate_limit_rad_s:g} rad/s x '
@@ -151,6 +161,21 @@ class GaitPlanner:
                       (by_range, f'the servo range {lim.servo_limit_rad:.3g} rad less the '
                        f'turning offset {lim.max_offset_rad:g} rad'))
         return min(candidates, key=lambda c: c[0])
+
+    def _largest_scale(self, frequency_hz: float, ok: Callable[[GaitPoint], bool],
+                       iterations: int = 30) -> float:
+        """Return the largest s in (0, max scale] with ``ok(gait)``, by bisection (monotone)."""
+        high = self.limits.max_amplitude_scale
+        if ok(self._point(frequency_hz, high)):
+            return high
+        low = 0.0
+        for _ in range(iterations):
+            middle = 0.5 * (low + high)
+            if ok(self._point(frequency_hz, middle)):
+                low = middle
+            else:
+                high = middle
+        return low
 
     def frontier_point(self, frequency_hz: float) -> GaitPoint:
         """Return the gait at ``frequency_hz`` with its largest feasible amplitude scale."""
