@@ -20,8 +20,11 @@ counted (``telemetry_rejected``) and dropped, never published.
 The port is read by the transport's thread. Telemetry is published straight from that thread
 (publishing is thread-safe): the 100 Hz path then costs no executor wake-up, which was the larger
 part of the bridge's CPU and of the bytes -> imu/data latency. Every other frame and link event
-reaches the executor through a guard condition, so the executor never waits on the device. An
-unplugged device is reopened by the transport with backoff; the node keeps running.
+goes into an inbox that the executor drains: the reader hands it over with ``create_task`` on
+the node's executor (one task pending at most; the events executor has no guard conditions,
+and this works on both), and each diagnostics tick drains it too (events from before the node
+was spun), so the executor never waits on the device. An unplugged device is reopened by the
+transport with backoff; the node keeps running.
 """
 
 from __future__ import annotations
@@ -74,6 +77,7 @@ class BridgeNode(Node):
                                  self._values['servo_limit_rad'])
         self._inbox: deque = deque(maxlen=1000)  # reader thread -> executor; bounded
         self._inbox_lock = threading.Lock()
+        self._drain_scheduled = False  # a drain task is pending on the executor (inbox lock)
         self._health = LinkHealth(self._values['heartbeat_timeout_s'], time.monotonic())
 
         self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
@@ -86,7 +90,6 @@ class BridgeNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA)
-        self._wake = self.create_guard_condition(self._drain_inbox)
         self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
         self.add_on_set_parameters_callback(self._validate)
@@ -150,7 +153,7 @@ class BridgeNode(Node):
         if others:
             with self._inbox_lock:
                 self._inbox.extend(others)
-            self._wake.trigger()
+            self._hand_over()
 
     def _publish_from_reader(self, telemetry: Telemetry) -> None:
         problem = self._health.on_telemetry(telemetry, time.monotonic())
@@ -171,13 +174,23 @@ class BridgeNode(Node):
             self._health.on_new_device()
         with self._inbox_lock:
             self._inbox.append((state, detail))
-        self._wake.trigger()
+        self._hand_over()
+
+    def _hand_over(self) -> None:
+        """Have the executor drain the inbox soon: one pending drain task at most."""
+        with self._inbox_lock:
+            executor = self.executor
+            if self._drain_scheduled or executor is None:  # None: not spun yet (see module doc)
+                return
+            self._drain_scheduled = True
+        executor.create_task(self._drain_inbox)
 
     # --- executor side ----------------------------------------------------------------------
     def _drain_inbox(self) -> None:
         with self._inbox_lock:
             items = list(self._inbox)
             self._inbox.clear()
+            self._drain_scheduled = False
         for item in items:
             if isinstance(item, tuple):
                 state, detail = item
@@ -247,6 +260,7 @@ class BridgeNode(Node):
         self._health.out.sent += 1
 
     def _publish_diagnostics(self) -> None:
+        self._drain_inbox()  # heartbeats first, so the status is up to date
         now = time.monotonic()
         port, state, stats = self._values['port'], self._link.state, self._link.stats
         level, message = self._health.level(now, state, port, stats, self._gate.failsafe)

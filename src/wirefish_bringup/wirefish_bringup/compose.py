@@ -25,10 +25,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--port', required=True,
                         help="the fish's serial device (the nodes' {device} parameters)")
     parser.add_argument('--params-file', default=None, help='parameter YAML')
-    parser.add_argument('--executor', choices=('single', 'multi'), default='single',
-                        help='executor of the bridge, CPG and kinematics nodes: '
-                        'SingleThreadedExecutor (default: least overhead per callback) or '
-                        'MultiThreadedExecutor; the tuner always has its own')
+    parser.add_argument('--executor', choices=('events', 'classic', 'multi'), default=None,
+                        help='executor of the bridge, CPG and kinematics nodes: events '
+                        '(rclpy.experimental.EventsExecutor), classic '
+                        '(SingleThreadedExecutor) or multi (MultiThreadedExecutor); default: '
+                        'the one WIREFISH_EXECUTOR names, events if unset, as in one process '
+                        'per node; the tuner always has its own')
 
 
 def node_class(path: str | None) -> type:
@@ -41,28 +43,29 @@ def node_class(path: str | None) -> type:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish compose` until SIGINT/SIGTERM; return the exit code."""
-    import signal
-
     import rclpy
-    from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+    from rclpy.executors import MultiThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
+    from wirefish_common.executors import executor_kind, make_executor, spin_until_stopped
     from wirefish_common.parameter_table import InvalidParameters
+    from wirefish_common.shutdown import SignalShutdown
 
     try:
         namespace = validate_namespace(args.namespace)
+        kind = args.executor or executor_kind()
     except ValueError as error:
         print(f'wirefish compose: {error}', file=sys.stderr)
         return 2
     params = str(args.params_file or default_params_file())
-    # SIGINT/SIGTERM end the spin loop between callbacks, so no callback ever publishes on a
-    # context that is being shut down; then the nodes are destroyed and the context shut down.
-    stop_requested = []
-    signal.signal(signal.SIGINT, lambda *_: stop_requested.append(True))
-    signal.signal(signal.SIGTERM, lambda *_: stop_requested.append(True))
+    # SIGINT/SIGTERM end the spin loop between callbacks (as run_node does for one node), so
+    # no callback ever publishes on a context that is being shut down; then the nodes are
+    # destroyed and the context shut down.
+    signals = SignalShutdown()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     nodes = []
-    executor = (SingleThreadedExecutor() if args.executor == 'single'
-                else MultiThreadedExecutor(num_threads=4))
+    executor = (MultiThreadedExecutor(num_threads=4) if kind == 'multi'
+                else make_executor(kind))
+    signals.attach_executor(executor)
     # As in its own process (tuner_node.main): a multi-threaded executor, so the service that
     # runs a fit can wait for the answer of cpg_node's parameter service.
     own_executor = MultiThreadedExecutor(num_threads=4)
@@ -76,17 +79,20 @@ def run(args: argparse.Namespace) -> int:
             nodes.append(node)
             (own_executor if entry.own_executor else executor).add_node(node)
         own_thread.start()
-        while not stop_requested:
-            executor.spin_once(timeout_sec=0.1)
+        spin_until_stopped(executor, lambda: signals.requested)
     except InvalidParameters as error:
         print(f'wirefish compose: {error}', file=sys.stderr)
         return 1
     finally:
-        executor.shutdown()
+        signals.attach_executor(None)
         own_executor.shutdown()
         if own_thread.is_alive():
             own_thread.join(5.0)
+        # Nodes go before the executor: their threads are joined while it can take a task.
         for node in reversed(nodes):
+            if node.executor is executor:
+                executor.remove_node(node)
             node.destroy_node()
+        executor.shutdown()
         rclpy.try_shutdown()
     return 0

@@ -7,8 +7,12 @@ The one ``main()`` of every wirefish node: signals, rclpy, the node, its executo
    handlers are off), so a signal stops the node between two callbacks, however many arrive;
 2. the node is built; start-up values it refuses (``InvalidParameters``, including a value of
    the wrong type) end the process with one FATAL line and exit code 1, no traceback;
-3. the executor (``executor_factory()``, single-threaded by default) spins until a signal;
-4. the executor, the node and the context are torn down in that order; exit code 0.
+3. the executor (``executor_factory()``; by default the one ``WIREFISH_EXECUTOR`` names, the
+   events executor unless it says ``classic``: ``wirefish_common.executors``) spins one
+   callback at a time until a signal; a ``WIREFISH_EXECUTOR`` that names no executor ends the
+   process with one FATAL line and exit code 1;
+4. the node leaves the executor and is destroyed (its threads joined), then the executor and
+   the context are shut down; exit code 0.
 """
 
 from __future__ import annotations
@@ -17,9 +21,10 @@ from collections.abc import Callable
 from typing import TypeVar
 
 import rclpy
-from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from wirefish_common.executors import executor_kind, make_executor, spin_until_stopped
 from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import SignalShutdown
 
@@ -41,20 +46,36 @@ def create_node_or_exit(node_class: Callable[[], NodeT]) -> NodeT:
         raise SystemExit(1) from None
 
 
+def chosen_executor_factory() -> Callable[[], Executor]:
+    """Return a factory of the executor ``WIREFISH_EXECUTOR`` names; FATAL line, exit 1 if none."""
+    try:
+        kind = executor_kind()
+    except ValueError as error:
+        rclpy.logging.get_logger('wirefish').fatal(str(error))
+        rclpy.try_shutdown()
+        raise SystemExit(1) from None
+    return lambda: make_executor(kind)
+
+
 def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
-             executor_factory: Callable[[], Executor] = SingleThreadedExecutor) -> None:
+             executor_factory: Callable[[], Executor] | None = None) -> None:
     """Run ``node_class()`` on ``executor_factory()`` until SIGINT/SIGTERM, then stop cleanly."""
     signals = SignalShutdown()  # before rclpy.init: no window with rclpy's handlers
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    factory = executor_factory or chosen_executor_factory()
     node = create_node_or_exit(node_class)
-    signals.attach(node)
-    executor = executor_factory()
+    executor = factory()
     executor.add_node(node)
+    signals.attach_executor(executor)
     try:
-        executor.spin()
-    except ExternalShutdownException:  # the signal's guard shut the context down
+        spin_until_stopped(executor, lambda: signals.requested)
+    except ExternalShutdownException:  # the context was shut down under the loop
         pass
     finally:
-        executor.shutdown()
+        signals.attach_executor(None)
+        # The node's own threads (serial reader, publish loop) are joined by destroy_node
+        # before the executor goes: a task they hand over meets a live executor.
+        executor.remove_node(node)
         node.destroy_node()
+        executor.shutdown()
         rclpy.try_shutdown()

@@ -18,9 +18,14 @@ However many signals arrive, the process stops once and exits 0:
   every signal that has a Python handler, so a late Ctrl-C used to kill a process that had
   already stopped cleanly; from ``atexit`` on, SIGINT and SIGTERM are ignored instead.
 
-Nodes use it through ``wirefish_common.node_main.run_node``. Processes without a node to attach
-(a loop of their own) poll ``requested``. A signal that arrives before ``attach`` is kept and
-acted on as soon as a node is attached.
+Nodes use it through ``wirefish_common.node_main.run_node``, which spins with
+``wirefish_common.executors.spin_until_stopped`` and hands its executor to ``attach_executor``:
+the events executor supports no guard condition, so there a signal sets ``requested`` and wakes
+the executor with a no-op task, and the loop ends between two callbacks (the same on the classic
+executor). ``attach(node)`` (a guard condition that shuts rclpy down) is for processes that
+call ``spin()`` on a classic executor. Processes without a node to attach (a loop of their own)
+poll ``requested``. A signal that arrives before ``attach``/``attach_executor`` is kept and
+acted on as soon as one is called.
 """
 
 from __future__ import annotations
@@ -47,6 +52,8 @@ class SignalShutdown:
         """Route both signals to a watcher thread (call from the main thread)."""
         self.requested = False
         self._guard: Any = None
+        self._executor: Any = None
+        self._executor_lock = threading.Lock()  # a wake never meets an executor shut down
         self._receiver, sender = socket.socketpair()
         sender.setblocking(False)
         self._sender = sender  # kept open for the life of the process
@@ -66,6 +73,18 @@ class SignalShutdown:
         if self.requested:
             self._trigger()
 
+    def attach_executor(self, executor: Any) -> None:
+        """
+        Wake ``executor`` once a signal came (its spin loop stops on ``requested``).
+
+        ``attach_executor(None)`` before shutting the executor down: a later signal then wakes
+        nothing (a classic executor refuses tasks once shut down).
+        """
+        with self._executor_lock:
+            self._executor = executor
+        if self.requested:
+            self._trigger()
+
     def _watch(self) -> None:
         while self._receiver.recv(64):
             self.requested = True
@@ -74,6 +93,10 @@ class SignalShutdown:
     def _trigger(self) -> None:
         from rclpy.exceptions import InvalidHandle
 
+        with self._executor_lock:
+            if self._executor is not None:
+                from wirefish_common.executors import wake
+                wake(self._executor)
         guard = self._guard
         if guard is None:
             return
