@@ -147,7 +147,7 @@ NODES: tuple[NodeEntry, ...] = (
               node_class='wirefish_cpg.cpg_node:CpgNode', rates_hz={'servo_cmd': 200.0}),
     NodeEntry('wirefish_kinematics', 'kinematics_node', 'kinematics_node', start_order=30,
               node_class='wirefish_kinematics.kinematics_node:KinematicsNode',
-              rates_hz={'body_wave': 50.0, 'body_wave_markers': 50.0},
+              rates_hz={'body_wave': 50.0, 'body_wave_markers': 10.0},
               min_rates_hz={'speed_estimate': 0.5}, fed_by=('cpg_node',)),
     NodeEntry('wirefish_cpg', 'tuner_node', 'tuner_node', start_order=40,
               node_class='wirefish_cpg.tuner_node:TunerNode', own_executor=True),

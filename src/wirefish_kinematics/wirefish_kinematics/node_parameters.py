@@ -60,8 +60,10 @@ WAVE_PARAMETERS = (
 )
 NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
     ParameterSpec('station_count', 50, 'Stations along the tail in body_wave', 2, 1000),
-    ParameterSpec('publish_rate_hz', 50.0, 'Rate of body_wave and body_wave_markers (Hz)',
-                  0.1, 500.0),
+    ParameterSpec('publish_rate_hz', 50.0, 'Rate of body_wave (Hz)', 0.1, 500.0),
+    ParameterSpec('markers_rate_hz', 10.0,
+                  'Rate of body_wave_markers (Hz): every n-th body_wave, n = '
+                  'round(publish_rate_hz / markers_rate_hz), at least 1', 0.1, 500.0),
     ParameterSpec('use_servo_state', False,
                   'Read the measured servo_state (bridge) instead of the commanded servo_cmd'),
     ParameterSpec('max_tail_beat_period_s', 2.5,
@@ -69,6 +71,17 @@ NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
                   0.1, 20.0),
 )
 SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
+
+
+def markers_every(publish_rate_hz: float, markers_rate_hz: float) -> int:
+    """
+    Return n: body_wave_markers go out with every n-th body_wave (n >= 1).
+
+    Markers cost more than the body wave itself (about 100 Points built in Python and
+    converted), and a display needs far fewer than 50 a second; on a body_wave tick they show
+    exactly that tick's shape.
+    """
+    return max(1, round(publish_rate_hz / markers_rate_hz))
 
 
 def geometry_parameters(names: tuple[str, ...] = GEOMETRY_FIELDS) -> tuple[ParameterSpec, ...]:
