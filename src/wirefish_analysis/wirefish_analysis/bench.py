@@ -22,6 +22,8 @@ import numpy as np
 WORKSPACE = Path(__file__).resolve().parents[3] if (
     Path(__file__).resolve().parents[3] / 'Makefile').is_file() else Path.cwd()
 DOMAIN = int(os.environ.get('WIREFISH_BENCH_DOMAIN', '101'))
+# Issue 15: every node benchmark runs on the old executor and the new one, side by side.
+EXECUTORS = ('classic', 'events')
 
 
 def machine() -> dict:
@@ -78,25 +80,32 @@ def run_all(quick: bool = False) -> dict:
 
     scale = 0.2 if quick else 1.0
     results: dict = {'machine': machine()}
-    results['cpg_rate'] = [_run(f'cpg at {r} Hz', bench_graph.cpg_rate, r, 10.0 * scale, DOMAIN)
-                           for r in (200.0, 500.0, 1000.0)]
+    results['cpg_rate'] = [_run(f'cpg at {r} Hz ({e})', bench_graph.cpg_rate, r, 10.0 * scale,
+                                DOMAIN, e)
+                           for r in (200.0, 500.0, 1000.0) for e in EXECUTORS]
     try:
         from wirefish_analysis import bench_links
-        results['links'] = _run('command/telemetry latency', bench_links.run)
+        results['links_by_executor'] = {
+            e: _run(f'command/telemetry latency ({e})', bench_links.run, domain_id=DOMAIN,
+                    executor=e)
+            for e in EXECUTORS}
     except ImportError as error:
-        results['links'] = {'error': f'not available: {error}'}
+        results['links_by_executor'] = {e: {'error': f'not available: {error}'}
+                                        for e in EXECUTORS}
     try:
         from wirefish_analysis import bench_retune
         results['retune'] = _run('retune', bench_retune.run)
     except ImportError as error:
         results['retune'] = {'error': f'not available: {error}'}
     results['kinematics_cpu'] = [
-        _run(f'kinematics {s} x {r}', bench_graph.kinematics_cpu, s, r, 10.0 * scale, DOMAIN)
-        for s, r in ((50, 50.0), (500, 200.0))]
+        _run(f'kinematics {s} x {r} ({e})', bench_graph.kinematics_cpu, s, r, 10.0 * scale,
+             DOMAIN, e)
+        for s, r in ((50, 50.0), (500, 200.0)) for e in EXECUTORS]
     results['recording'] = _run('recording', recording, 60.0 * scale, DOMAIN)
     results['fleet'] = [
-        _run(f'{n} fish ({mode})', bench_graph.fleet, n, 10.0 * scale, DOMAIN, mode == 'single')
-        for mode in ('per-node', 'single') for n in (1, 2, 4, 8)]
+        _run(f'{n} fish ({mode}, {e})', bench_graph.fleet, n, 10.0 * scale, DOMAIN,
+             mode == 'single', e)
+        for mode in ('per-node', 'single') for n in (1, 2, 4, 8) for e in EXECUTORS]
     return results
 
 

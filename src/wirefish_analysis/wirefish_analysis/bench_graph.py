@@ -3,6 +3,8 @@ Benchmarks of the running graph: publish-rate jitter, node CPU, recording loss, 
 
 Each function starts real node processes (own ROS domain), measures from the receiving side
 and returns plain figures; `wirefish_analysis.bench` runs them all and writes BENCHMARKS.md.
+``executor`` ('events' or 'classic', None: the nodes' default) is passed to the node
+processes as WIREFISH_EXECUTOR, so one run measures both side by side (issue 15).
 Nothing here asserts: these are measurements, not tests.
 """
 
@@ -17,6 +19,7 @@ import psutil
 
 from wirefish_bringup.graph import fish_graph, NodeSpec
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
+from wirefish_common.executors import EXECUTOR_VARIABLE
 
 READY_TIMEOUT_S = 60.0
 
@@ -51,9 +54,12 @@ def ros_session(domain_id: int):
 
 
 @contextmanager
-def processes(specs: list[NodeSpec], domain_id: int, log_dir: Path | None = None):
+def processes(specs: list[NodeSpec], domain_id: int, log_dir: Path | None = None,
+              executor: str | None = None):
     """Start ``specs`` on ``domain_id``; yield the Supervisor; stop them all afterwards."""
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    if executor is not None:
+        env[EXECUTOR_VARIABLE] = executor
     log_dir = log_dir or Path(tempfile.mkdtemp(prefix='wirefish_bench_'))
     supervisor = Supervisor(log_dir, env=env)
     try:
@@ -86,53 +92,65 @@ def spin_for(executor, seconds: float) -> None:
         executor.spin_once(timeout_sec=0.01)
 
 
-def cpg_rate(rate_hz: float, duration_s: float, domain_id: int) -> dict:
-    """CPG node at ``rate_hz``: achieved rate, receive-period error, the node's CPU."""
+def cpg_rate(rate_hz: float, duration_s: float, domain_id: int,
+             executor: str | None = None) -> dict:
+    """CPG node at ``rate_hz``: achieved rate, period error at the source and receiver, CPU."""
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
 
     spec = NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node',
                     ('--ros-args', '-p', f'publish_rate_hz:={rate_hz}'))
     arrivals: list[int] = []
-    with processes([spec], domain_id) as supervisor, ros_session(domain_id) as (node, executor):
-        node.create_subscription(JointState, 'servo_cmd',
-                                 lambda _msg: arrivals.append(time.perf_counter_ns()),
-                                 qos_profile_sensor_data)
-        spin_for(executor, 2.0)  # discovery and warm-up
+    stamps: list[int] = []  # header stamps: when the CPG published (the source side)
+
+    def on_servo(msg: JointState) -> None:
+        arrivals.append(time.perf_counter_ns())
+        stamps.append(msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec)
+
+    with processes([spec], domain_id, executor=executor) as supervisor, \
+            ros_session(domain_id) as (node, spinner):
+        node.create_subscription(JointState, 'servo_cmd', on_servo, qos_profile_sensor_data)
+        spin_for(spinner, 2.0)  # discovery and warm-up
         arrivals.clear()
+        stamps.clear()
         pid = supervisor.processes['cpg_node'].pid
         start_cpu = psutil.Process(pid).cpu_times()
         started = time.monotonic()
-        spin_for(executor, duration_s)
+        spin_for(spinner, duration_s)
         elapsed = time.monotonic() - started
         end_cpu = psutil.Process(pid).cpu_times()
-    periods = np.diff(np.array(arrivals)) * 1e-9
-    error = np.abs(periods - 1.0 / rate_hz)
+    error = np.abs(np.diff(np.array(arrivals)) * 1e-9 - 1.0 / rate_hz)
+    source_error = np.abs(np.diff(np.sort(np.array(stamps))) * 1e-9 - 1.0 / rate_hz)
     cpu = 100.0 * ((end_cpu.user + end_cpu.system) - (start_cpu.user + start_cpu.system)) / elapsed
-    return {'rate_hz': rate_hz, 'achieved_hz': len(arrivals) / elapsed,
+    return {'rate_hz': rate_hz, 'executor': executor, 'achieved_hz': len(arrivals) / elapsed,
             **{f'period_error_{k}': v for k, v in percentiles_ms(error).items()},
+            **{f'source_period_error_{k}': v for k, v in percentiles_ms(source_error).items()},
             'cpu_percent': cpu}
 
 
-def kinematics_cpu(stations: int, rate_hz: float, duration_s: float, domain_id: int) -> dict:
+def kinematics_cpu(stations: int, rate_hz: float, duration_s: float, domain_id: int,
+                   executor: str | None = None) -> dict:
     """Kinematics node CPU with ``stations`` stations published at ``rate_hz``."""
     specs = [NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node', ()),
              NodeSpec('wirefish_kinematics', 'kinematics_node', 'kinematics_node', (
                  '--ros-args', '-p', f'station_count:={stations}',
                  '-p', f'publish_rate_hz:={rate_hz}'))]
-    with processes(specs, domain_id) as supervisor:
+    with processes(specs, domain_id, executor=executor) as supervisor:
         time.sleep(3.0)
         pid = supervisor.processes['kinematics_node'].pid
         cpu = cpu_percent([pid], duration_s)[pid]
         alive = not supervisor.exited()
-    return {'stations': stations, 'rate_hz': rate_hz, 'cpu_percent': cpu, 'ran': alive}
+    return {'stations': stations, 'rate_hz': rate_hz, 'executor': executor, 'cpu_percent': cpu,
+            'ran': alive}
 
 
-def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = False) -> dict:
+def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = False,
+          executor: str | None = None) -> dict:
     """
-    ``fish`` whole graphs (namespaces /bench_fish_N) at default rates: rates and total CPU.
+    ``fish`` whole graphs (namespaces /bench_fish_N) at default rates: rates and CPU.
 
     ``single_process`` runs each fish's four ROS nodes in one process (`wirefish compose`).
+    CPU: the total, and the onboard part (every process but the virtual fish's), per fish.
     """
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import Imu, JointState
@@ -142,7 +160,8 @@ def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = F
         specs += fish_graph(f'/bench_fish_{i}', sim=True, single_process=single_process)
     counts = {('servo_cmd', i): 0 for i in range(1, fish + 1)}
     counts.update({('imu/data', i): 0 for i in range(1, fish + 1)})
-    with processes(specs, domain_id) as supervisor, ros_session(domain_id) as (node, executor):
+    with processes(specs, domain_id, executor=executor) as supervisor, \
+            ros_session(domain_id) as (node, spinner):
         for i in range(1, fish + 1):
             for topic, msg_type in (('servo_cmd', JointState), ('imu/data', Imu)):
                 def count(_m, key=(topic, i)) -> None:
@@ -153,23 +172,27 @@ def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = F
         # streams both topics (the time that takes is a figure too), then warm up 3 s more.
         launched = time.monotonic()
         while time.monotonic() - launched < READY_TIMEOUT_S and not all(counts.values()):
-            spin_for(executor, 0.5)
+            spin_for(spinner, 0.5)
         ready_s = time.monotonic() - launched if all(counts.values()) else float('nan')
-        spin_for(executor, 3.0)
+        spin_for(spinner, 3.0)
         for key in counts:
             counts[key] = 0
-        pids = [p.pid for p in supervisor.processes.values()]
-        procs = [psutil.Process(pid) for pid in pids]
-        cpu_start = sum(p.cpu_times().user + p.cpu_times().system for p in procs)
+        procs = {key: psutil.Process(p.pid) for key, p in supervisor.processes.items()}
+        cpu_start = {key: sum(p.cpu_times()[:2]) for key, p in procs.items()}
         started = time.monotonic()
-        spin_for(executor, duration_s)
+        spin_for(spinner, duration_s)
         elapsed = time.monotonic() - started
-        cpu_end = sum(p.cpu_times().user + p.cpu_times().system for p in procs)
+        cpu = {key: 100.0 * (sum(p.cpu_times()[:2]) - cpu_start[key]) / elapsed
+               for key, p in procs.items()}
         crashed = sorted(supervisor.exited())
+        onboard = [key for key in procs if supervisor.specs[key].package != 'wirefish_sim']
     servo = [counts[('servo_cmd', i)] / elapsed for i in range(1, fish + 1)]
     imu = [counts[('imu/data', i)] / elapsed for i in range(1, fish + 1)]
-    return {'fish': fish, 'single_process': single_process, 'processes': len(specs),
+    return {'fish': fish, 'single_process': single_process, 'executor': executor,
+            'processes': len(specs),
             'servo_cmd_hz_min': min(servo), 'servo_cmd_hz_median': float(np.median(servo)),
             'imu_hz_min': min(imu), 'imu_hz_median': float(np.median(imu)),
-            'cpu_percent_total': 100.0 * (cpu_end - cpu_start) / elapsed,
-            'ready_s': ready_s, 'crashed': crashed}
+            'cpu_percent_total': sum(cpu.values()),
+            'onboard_cpu_percent_per_fish': sum(cpu[key] for key in onboard) / fish,
+            'onboard_processes': onboard, 'cpu_percent_by_process': cpu, 'ready_s': ready_s,
+            'crashed': crashed}

@@ -30,8 +30,13 @@ def _percentiles(samples_s: list[float]) -> dict:
             'p99_ms': float(np.percentile(ms, 99)), 'max_ms': float(ms.max())}
 
 
-def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02) -> dict:
-    """Measure both paths ``samples`` times each; return p50/p99 (ms) per path."""
+def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02,
+        executor: str | None = None) -> dict:
+    """
+    Measure both paths ``samples`` times each; return p50/p99 (ms) per path.
+
+    ``executor`` ('events' or 'classic'; None: its default) is the bridge's WIREFISH_EXECUTOR.
+    """
     import rclpy
     from ament_index_python.packages import get_package_prefix
     from rclpy.executors import SingleThreadedExecutor
@@ -46,6 +51,8 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02) -> dict
     port = os.ttyname(slave)
     exe = Path(get_package_prefix('wirefish_bridge')) / 'lib' / 'wirefish_bridge' / 'bridge_node'
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    if executor is not None:
+        env['WIREFISH_EXECUTOR'] = executor
     bridge = subprocess.Popen([str(exe), '--ros-args', '-p', f'port:={port}',
                                '-p', 'max_command_rate_hz:=1000.0'],
                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
@@ -53,8 +60,8 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02) -> dict
     context = rclpy.context.Context()
     rclpy.init(context=context, domain_id=domain_id)
     node = rclpy.create_node('bench_links', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
+    spinner = SingleThreadedExecutor(context=context)
+    spinner.add_node(node)
     received: list[float] = []
     node.create_subscription(Imu, 'imu/data', lambda _m: received.append(time.perf_counter()),
                              qos_profile_sensor_data)
@@ -68,7 +75,7 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02) -> dict
             os.write(master, encoder.encode(Heartbeat(role=Role.FISH)))
             os.write(master, encoder.encode(Telemetry(0, 0.0, 0.0, 0.0, (0.0,) * 3,
                                                       (0.0, 0.0, 9.8), 0.0, 0.0, 8.0)))
-            executor.spin_once(timeout_sec=0.1)
+            spinner.spin_once(timeout_sec=0.1)
         for i in range(samples):
             # (a) command path
             angle = 0.001 * (i % 100 + 1)
@@ -91,12 +98,12 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02) -> dict
                                                       (0.0, 0.0, 9.8), 0.0, 0.0, 8.0)))
             stop = written + 0.5
             while len(received) == count and time.perf_counter() < stop:
-                executor.spin_once(timeout_sec=0.0005)
+                spinner.spin_once(timeout_sec=0.0005)
             if len(received) > count:
                 telemetry_latency.append(received[count] - written)
             time.sleep(period_s)
     finally:
-        executor.shutdown()
+        spinner.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
         if bridge.poll() is None:
@@ -108,7 +115,7 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02) -> dict
                 bridge.wait()
         os.close(master)
         os.close(slave)
-    return {'command': _percentiles(command_latency),
+    return {'executor': executor, 'command': _percentiles(command_latency),
             'telemetry': _percentiles(telemetry_latency),
             'how': f'{samples} samples each, {period_s * 1000:.0f} ms apart; bridge_node as a '
                    'separate process on a pty held by the benchmark (which plays the fish); '

@@ -1,7 +1,5 @@
 """Render benchmark results (the dict of `wirefish_analysis.bench`) as BENCHMARKS.md."""
 
-import json
-
 
 def _fmt(value, spec: str = '.3g') -> str:
     if isinstance(value, (int, float)):
@@ -23,36 +21,169 @@ def _verdict(measured, goal_ok) -> str:
     return 'met' if goal_ok else 'missed'
 
 
+# Issue 15: each node figure on the classic executor and the events executor, from one run.
+EXECUTORS = ('classic', 'events')
+FLEET_HOW = 'all streaming after {ready} s; then 3 s warm-up, 10 s window; psutil CPU'
+
+
+def _side_by_side(by_executor: dict, describe) -> str:
+    """Return 'classic: ...; events: ...' (``describe(result)`` per executor)."""
+    parts = []
+    for executor in EXECUTORS:
+        r = by_executor.get(executor)
+        text = ('not measured' if r is None else r['error'] if 'error' in r else describe(r))
+        parts.append(f'**{executor}**: {text}')
+    return '<br>'.join(parts)
+
+
+def _verdicts(by_executor: dict, ok) -> str:
+    """Return the verdict of the events executor, then the classic one's in brackets."""
+    def one(executor: str) -> str:
+        r = by_executor.get(executor)
+        if r is None or 'error' in r:
+            return 'not measured'
+        return 'met' if ok(r) else 'missed'
+    return f'{one("events")} (classic: {one("classic")})'
+
+
+def _by_executor(items, *keys) -> dict:
+    """Group result dicts by ``keys`` then executor: {key tuple: {executor: result}}."""
+    grouped: dict = {}
+    for r in items:
+        if 'error' in r:
+            continue
+        grouped.setdefault(tuple(r.get(k) for k in keys), {})[r.get('executor')] = r
+    return grouped
+
+
+def _cpg_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+    rows = [('CPG node rate', '', r['error'], 'failed', '')
+            for r in results.get('cpg_rate', []) if 'error' in r]
+    for (rate,), pair in _by_executor(results.get('cpg_rate', []), 'rate_hz').items():
+        def describe(r) -> str:
+            return (f'{r["achieved_hz"]:.1f} Hz; period error at the source p50/p99/max '
+                    f'{r["source_period_error_p50_ms"]:.3f} / '
+                    f'{r["source_period_error_p99_ms"]:.3f} / '
+                    f'{r["source_period_error_max_ms"]:.2f} ms, at the receiver '
+                    f'{r["period_error_p50_ms"]:.3f} / {r["period_error_p99_ms"]:.3f} / '
+                    f'{r["period_error_max_ms"]:.2f} ms; {r["cpu_percent"]:.1f} % of a core')
+
+        def ok(r) -> bool:
+            return (r['source_period_error_p99_ms'] <= 0.2 and r['period_error_p99_ms'] <= 0.2
+                    and r['cpu_percent'] <= 7.0)
+        kilohertz = rate == 1000.0
+        rows.append((f'CPG node at {rate:g} Hz: achieved rate, period error, CPU',
+                     'p99 ≤ 0.2 ms at the source and the receiver, CPU ≤ 7 %' if kilohertz
+                     else '—', _side_by_side(pair, describe),
+                     _verdicts(pair, ok) if kilohertz else '—',
+                     '10 s; source: header stamps of servo_cmd (the node clock when the loop '
+                     'published); receiver: arrival times in a separate process; psutil CPU'))
+    return rows
+
+
+def _link_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+    links = results.get('links_by_executor', {})
+    rows = []
+    for key, label in (('command', 'servo_cmd publish → frame bytes on the fish side'),
+                       ('telemetry', 'telemetry bytes written → imu/data received')):
+        pair = {e: (r if 'error' in r else r[key]) for e, r in links.items()}
+        how = next((r['how'] for r in links.values() if 'how' in r), 'see bench_links.py')
+        rows.append((f'{label}, p50 / p99', 'p99 ≤ 1 ms',
+                     _side_by_side(pair, lambda r: f'{_fmt(r.get("p50_ms"))} / '
+                                   f'{_fmt(r.get("p99_ms"))} ms ({r.get("count")} samples)'),
+                     _verdicts(pair, lambda r: r.get('p99_ms', float('inf')) <= 1.0),
+                     f'{how}; the benchmark side runs the classic executor in both'))
+    return rows
+
+
+def _kinematics_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+    rows = [('Kinematics node CPU', '—', r['error'], 'failed', '')
+            for r in results.get('kinematics_cpu', []) if 'error' in r]
+    for (stations, rate), pair in _by_executor(results.get('kinematics_cpu', []),
+                                               'stations', 'rate_hz').items():
+        rows.append((f'Kinematics node CPU, {stations} stations × {rate:g} Hz body_wave', '—',
+                     _side_by_side(pair, lambda r: f'{r["cpu_percent"]:.1f} % of a core'),
+                     '—', '10 s with the CPG feeding servo_cmd at 200 Hz; markers at their '
+                     'default 10 Hz; psutil'))
+    return rows
+
+
+def _fleet_ok(r: dict) -> bool:
+    return (not r['crashed'] and r['servo_cmd_hz_min'] >= 0.95 * 200
+            and r['imu_hz_min'] >= 0.95 * 100)
+
+
+def _onboard_names(one_fish: dict) -> list[str]:
+    for pair in one_fish.values():
+        for r in pair.values():
+            if r.get('onboard_processes'):
+                return list(r['onboard_processes'])
+    return ['?']
+
+
+def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+    fleet = results.get('fleet', [])
+    rows = [('Fish graphs on one machine', '8 at default rates', r['error'], 'failed', '')
+            for r in fleet if 'error' in r]
+    grouped = _by_executor(fleet, 'single_process', 'fish')
+    one_fish = {single: grouped.get((single, 1), {}) for single in (False, True)}
+    if any(one_fish.values()):
+        def onboard(single: bool, executor: str) -> float | None:
+            r = one_fish[single].get(executor)
+            return None if r is None else r['onboard_cpu_percent_per_fish']
+        old = onboard(False, 'classic')
+        new = [v for v in (onboard(False, 'events'), onboard(True, 'events')) if v is not None]
+        best = min(new) if new else None
+        measured = '<br>'.join(
+            f'**{e}**, {"one process per fish" if single else "one process per node"}: '
+            f'{_fmt(onboard(single, e), ".1f")} %' for single in (False, True) for e in EXECUTORS)
+        verdict = 'not measured'
+        if old is not None and best is not None:
+            measured += f'<br>best events / classic per node: {best / old:.2f}'
+            verdict = 'met' if best <= old / 3.0 and best <= 15.0 else 'missed'
+        rows.append(("One fish's onboard graph at default rates, CPU (% of a core)",
+                     "≤ ⅓ of the classic executor's (one process per node), ≤ 15 %",
+                     measured, verdict,
+                     'the 1-fish fleet runs below: every process but the virtual fish ('
+                     + ', '.join(_onboard_names(one_fish)) + '; the tuner idle, the planner '
+                     'without cmd_vel); psutil over the 10 s window'))
+    capacity: dict[tuple[bool, str], int] = {}
+    for (single, fish), pair in grouped.items():
+        for executor, r in pair.items():
+            if _fleet_ok(r):
+                key = (single, executor)
+                capacity[key] = max(capacity.get(key, 0), fish)
+    if grouped:
+        rows.append(('Fish at default rates on this machine (servo_cmd ≥ 190 Hz, imu ≥ 95 Hz '
+                     'each, nothing crashed)', '8',
+                     '<br>'.join(f'**{e}**, '
+                                 f'{"one process per fish" if single else "one per node"}: '
+                                 f'{capacity.get((single, e), 0)}'
+                                 for single in (False, True) for e in EXECUTORS),
+                     'met' if max(capacity.values(), default=0) >= 8 else 'missed',
+                     'largest fleet of the rows below that met the rates (sizes 1, 2, 4, 8)'))
+    for (single, fish), pair in sorted(grouped.items()):
+        mode = 'one process per fish' if single else 'one process per node'
+        processes = next(iter(pair.values()))['processes']
+
+        def describe(r) -> str:
+            return (f'servo_cmd min {r["servo_cmd_hz_min"]:.1f} Hz, imu min '
+                    f'{r["imu_hz_min"]:.1f} Hz, CPU {r["cpu_percent_total"]:.0f} % '
+                    f'(of {results["machine"]["cores"]} cores × 100), onboard '
+                    f'{r["onboard_cpu_percent_per_fish"]:.1f} % per fish'
+                    + (f', crashed: {r["crashed"]}' if r['crashed'] else ''))
+        ready = '/'.join(f'{pair[e].get("ready_s", float("nan")):.0f}'
+                         for e in EXECUTORS if e in pair)
+        rows.append((f'{fish} fish, {mode}, {processes} processes',
+                     '8 at default rates' if fish == 8 else '—', _side_by_side(pair, describe),
+                     _verdicts(pair, _fleet_ok), FLEET_HOW.format(ready=ready)
+                     + ' (ready: classic/events)'))
+    return rows
+
+
 def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     """Return (figure, goal, measured, verdict, how) rows."""
-    table = []
-    for r in results.get('cpg_rate', []):
-        if 'error' in r:
-            table.append(('CPG node rate', '', r['error'], 'failed', ''))
-            continue
-        goal = 'p99 ≤ 0.2 ms, CPU ≤ 25 %' if r['rate_hz'] == 1000.0 else '—'
-        ok = r['period_error_p99_ms'] <= 0.2 and r['cpu_percent'] <= 25.0
-        table.append((
-            f'CPG node at {r["rate_hz"]:g} Hz: achieved rate, period error p50/p99/max, CPU',
-            goal,
-            f'{r["achieved_hz"]:.1f} Hz; {r["period_error_p50_ms"]:.3f} / '
-            f'{r["period_error_p99_ms"]:.3f} / {r["period_error_max_ms"]:.2f} ms; '
-            f'{r["cpu_percent"]:.1f} % of a core',
-            _verdict(r, ok) if r['rate_hz'] == 1000.0 else '—',
-            '10 s; receive intervals of servo_cmd in a separate process; psutil CPU'))
-    links = results.get('links', {})
-    if 'error' in links:
-        table.append(('Command / telemetry path latency', 'p99 ≤ 1 ms', links['error'],
-                      'not measured', ''))
-    else:
-        for key, label in (('command', 'servo_cmd publish → frame bytes on the fish side'),
-                           ('telemetry', 'telemetry bytes written → imu/data received')):
-            p50, p99 = _get(links, key, 'p50_ms'), _get(links, key, 'p99_ms')
-            table.append((label, 'p99 ≤ 1 ms',
-                          f'p50 {_fmt(p50)} ms, p99 {_fmt(p99)} ms' if p99 is not None
-                          else json.dumps(links.get(key)),
-                          _verdict(p99, p99 is not None and p99 <= 1.0),
-                          _fmt(links.get('how', 'see bench_links.py'))))
+    table = [*_cpg_rows(results), *_link_rows(results)]
     retune = results.get('retune', {})
     if 'error' in retune:
         table.append(('Retune of the §5.2 case', '≤ 0.2 s, ≥ 50× baseline', retune['error'],
@@ -67,13 +198,7 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                       _verdict(wall, wall is not None and ratio is not None and wall <= 0.2
                                and ratio >= 50),
                       _fmt(retune.get('how', 'see bench_retune.py'))))
-    for r in results.get('kinematics_cpu', []):
-        if 'error' in r:
-            table.append(('Kinematics node CPU', '—', r['error'], 'failed', ''))
-            continue
-        table.append((f'Kinematics node CPU, {r["stations"]} stations × {r["rate_hz"]:g} Hz',
-                      '—', f'{r["cpu_percent"]:.1f} % of a core', '—',
-                      '10 s with the CPG feeding servo_cmd; psutil'))
+    table += _kinematics_rows(results)
     rec = results.get('recording', {})
     if 'error' in rec:
         table.append(('Recording, 60 s at default rates', '0 lost', rec['error'], 'failed', ''))
@@ -88,23 +213,7 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                       "wirefish up --duration; the recorder counts each publisher's DDS "
                       'sequence numbers; skipped ticks from the stamps at the median period '
                       '(report.py)'))
-    for r in results.get('fleet', []):
-        if 'error' in r:
-            table.append(('Fish graphs on one machine', '8 at default rates', r['error'],
-                          'failed', ''))
-            continue
-        ok = (not r['crashed'] and r['servo_cmd_hz_min'] >= 0.95 * 200
-              and r['imu_hz_min'] >= 0.95 * 100)
-        mode = 'one process per fish' if r.get('single_process') else 'one process per node'
-        table.append((f'{r["fish"]} fish graph(s), {mode}, {r["processes"]} processes',
-                      '8 at default rates' if r['fish'] == 8 else '—',
-                      f'servo_cmd min {r["servo_cmd_hz_min"]:.1f} Hz, imu min '
-                      f'{r["imu_hz_min"]:.1f} Hz, CPU {r["cpu_percent_total"]:.0f} % '
-                      f'(of {results["machine"]["cores"]} cores × 100)'
-                      + (f', crashed: {r["crashed"]}' if r['crashed'] else ''),
-                      _verdict(r, ok),
-                      f'all streaming after {r.get("ready_s", float("nan")):.0f} s; then 3 s '
-                      'warm-up, 10 s window'))
+    table += _fleet_rows(results)
     return table
 
 
