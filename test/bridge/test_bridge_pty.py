@@ -44,11 +44,15 @@ def test_imu_data_arrives_at_100_hz(start_fish, start_bridge, probe, tmp_path):
 def test_bridge_reconnects_each_time_the_fish_reopens_its_device(
         start_fish, start_bridge, probe, tmp_path):
     link = tmp_path / 'tty'
-    start_fish(link, '--reopen-every', '1.5', '--reopen-count', '5', '--reopen-delay', '0.3')
+    # The bridge first, waiting for the device: its start-up (1-2 s on a loaded machine) must
+    # not overlap the fish's first reopen, 1.5 s after its device appears.
     bridge = start_bridge(link, 'reconnect_backoff_max_s:=0.5')
+    assert spin_until(probe.executor, lambda: probe.statuses(), 20.0)
+    start_fish(link, '--reopen-every', '1.5', '--reopen-count', '5', '--reopen-delay', '0.3')
     assert spin_until(probe.executor, lambda: len(probe.imu) > 0, 20.0)
     assert spin_until(probe.executor, lambda: probe.diagnostics and
-                      probe.last_diagnostics()['reconnects'] == '5', 20.0)
+                      probe.last_diagnostics()['reconnects'] == '5', 20.0), \
+        str(probe.last_diagnostics())
     probe.spin_for(1.5)
     stamps = [_stamp(m) for m in probe.imu]
     gaps = sorted(b - a for a, b in zip(stamps, stamps[1:]))[-5:]

@@ -3,8 +3,11 @@ The virtual fish's end of a pseudo-terminal pair, with a stable symlink to the d
 
 ``open_pair`` makes a new pty pair (raw mode), and atomically re-points the symlink (``link``)
 to its slave device, so a bridge that opens the link path always finds the current device, as with
-/dev/serial/by-id/ for a real board. ``close`` closes both ends, which the bridge sees as EIO
-on its old descriptor (the device was "unplugged").
+/dev/serial/by-id/ for a real board. ``close`` removes the link (if it is still ours) and then
+closes both ends, which the bridge sees as EIO on its old descriptor (the device was
+"unplugged", and like a by-id link its link is gone until it is back). The link never points at
+a closed device: its pts number may be taken by another terminal, or another virtual fish, at
+once.
 
 Beside the link, an owner record (``wirefish_bridge.link_owner``) names this process and the
 device, written before the link is re-pointed: if this process is killed and its pts number is
@@ -60,7 +63,8 @@ class PtyDevice:
         return self.path
 
     def close(self) -> None:
-        """Close both ends (the peer's reads fail with EIO); the symlink is left in place."""
+        """Remove our link, then close both ends (the peer's reads fail with EIO)."""
+        self.remove_link()
         for fd in (self._master, self._slave):
             if fd is not None:
                 os.close(fd)
