@@ -24,24 +24,32 @@ class RunningGraph:
     out_dir: Path
 
 
-def start_graph(domain_id: int, out_dir: Path, *options: str) -> RunningGraph:
-    """Start `wirefish up --sim [options]` (the launcher behind `make run`) on its own domain."""
+def start_graph(domain_id: int, out_dir: Path, *options: str,
+                namespace: str = NAMESPACE) -> RunningGraph:
+    """
+    Start `wirefish up --sim [options]` (the launcher behind `make run`) on its own domain.
+
+    Give each test that starts a graph a ``namespace`` of its own: a graph that is still
+    stopping in the same namespace would make the new `wirefish up` refuse to start.
+    """
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
         [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
-         '--namespace', NAMESPACE, '--out', str(out_dir), *options],
+         '--namespace', namespace, '--out', str(out_dir), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     deadline = time.monotonic() + 60.0
+    seen = []
     while time.monotonic() < deadline:
         line = launcher.stdout.readline()
         if not line:
             break
+        seen.append(line)
         if line.startswith('running:'):
-            return RunningGraph(launcher, env, domain_id, NAMESPACE, out_dir)
+            return RunningGraph(launcher, env, domain_id, namespace, out_dir)
     stop_process(launcher)
-    raise RuntimeError('wirefish up did not start: ' + launcher.stdout.read())
+    raise RuntimeError('wirefish up did not start:\n' + ''.join(seen) + launcher.stdout.read())
 
 
 def descendants(pid: int) -> list[psutil.Process]:

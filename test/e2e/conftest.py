@@ -15,9 +15,10 @@ def e2e_domain_id() -> int:
 
 
 @pytest.fixture(scope='module')
-def running_graph(e2e_domain_id: int, tmp_path_factory) -> Iterator[RunningGraph]:
+def running_graph(e2e_domain_id: int, tmp_path_factory, request) -> Iterator[RunningGraph]:
     """Yield one whole graph shared by the module's observation tests; stop it afterwards."""
-    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'))
+    namespace = '/e2e_' + request.module.__name__.rsplit('.', 1)[-1]  # one per module
+    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'), namespace=namespace)
     children = descendants(graph.launcher.pid)
     try:
         yield graph

@@ -12,7 +12,7 @@ pytestmark = pytest.mark.ros
 
 
 def test_sigint_stops_every_process_cleanly_and_leaves_none(e2e_domain_id, tmp_path):
-    graph = start_graph(e2e_domain_id, tmp_path)
+    graph = start_graph(e2e_domain_id, tmp_path, namespace='/e2e_sigint_running')
     children = descendants(graph.launcher.pid)
     names = sorted(' '.join(p.cmdline()[:2]) for p in children)
     assert len(children) >= 5, names
@@ -39,8 +39,8 @@ def test_sigint_during_start_up_stops_every_process_cleanly(e2e_domain_id, tmp_p
     env = dict(os.environ, ROS_DOMAIN_ID=str(e2e_domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--namespace', '/e2e',
-         '--out', str(tmp_path)],
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--namespace',
+         '/e2e_sigint_starting', '--out', str(tmp_path)],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     try:

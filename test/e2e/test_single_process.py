@@ -11,7 +11,8 @@ pytestmark = pytest.mark.ros
 
 
 def test_retune_with_apply_succeeds_when_all_nodes_share_one_process(e2e_domain_id, tmp_path):
-    graph = start_graph(e2e_domain_id, tmp_path, '--single-process')
+    graph = start_graph(e2e_domain_id, tmp_path, '--single-process',
+                        namespace='/e2e_single_process')
     try:
         result = subprocess.run(
             [sys.executable, '-m', 'wirefish_bringup.cli', 'retune', '--namespace',

@@ -87,3 +87,47 @@ def measure_rates(node: Node, executor: SingleThreadedExecutor, namespace: str,
     for subscription in subscriptions:
         node.destroy_subscription(subscription)
     return {topic: (topics[topic], counts[topic] / elapsed) for topic in sorted(topics)}
+
+
+class StreamLog:
+    """
+    When each message of some topics arrived (monotonic seconds), from creation on.
+
+    Subscribes best effort, which matches reliable and best-effort publishers alike, and keeps
+    the raw bytes only of the ``keep`` topics (to read what was sent, not just when).
+    """
+
+    def __init__(self, node: Node, topics: dict[str, type], keep: tuple[str, ...] = ()) -> None:
+        """Subscribe to every topic of ``topics`` ({full name: message class})."""
+        from rclpy.qos import qos_profile_sensor_data
+
+        self.arrivals: dict[str, list[float]] = {topic: [] for topic in topics}
+        self.kept: dict[str, list[tuple[float, bytes]]] = {topic: [] for topic in keep}
+        for topic, msg_class in topics.items():
+            def on_message(data: bytes, topic: str = topic) -> None:
+                now = time.monotonic()
+                self.arrivals[topic].append(now)
+                if topic in self.kept:
+                    self.kept[topic].append((now, data))
+            node.create_subscription(msg_class, topic, on_message, qos_profile_sensor_data,
+                                     raw=True)
+
+    def rate(self, topic: str, since: float, until: float) -> float:
+        """Return the messages per second of ``topic`` that arrived in [since, until]."""
+        return rate_between(self.arrivals[topic], since, until)
+
+    def longest_pause(self, topic: str, since: float, until: float) -> float:
+        """Return the longest time in [since, until] without a message of ``topic``."""
+        return longest_pause(self.arrivals[topic], since, until)
+
+
+def rate_between(times: list[float], since: float, until: float) -> float:
+    """Return how many of ``times`` fall in [since, until], per second."""
+    return sum(since <= t <= until for t in times) / max(until - since, 1e-9)
+
+
+def longest_pause(times: list[float], since: float, until: float) -> float:
+    """Return the longest gap in [since, until] between ``times`` (or an end of the span)."""
+    inside = [t for t in times if since <= t <= until]
+    edges = [since, *inside, until]
+    return max(b - a for a, b in zip(edges, edges[1:]))

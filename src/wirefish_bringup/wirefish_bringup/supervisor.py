@@ -93,6 +93,11 @@ class Supervisor:
         return {name: proc.returncode for name, proc in self.processes.items()
                 if proc.poll() is not None}
 
+    def down(self) -> list[str]:
+        """Return the processes not running now that are not given up (exited or restarting)."""
+        return [key for key, proc in self.processes.items()
+                if key not in self.given_up and (key in self._pending or proc.poll() is not None)]
+
     def supervise(self, now: float | None = None) -> list[str]:
         """
         Answer each exit since the last call by its policy; return one report line per event.
