@@ -6,8 +6,9 @@ import subprocess
 import sys
 
 import pytest
-from wirefish_bridge.link_owner import (owner_record_path, process_start, remove_owner_record,
-                                        stale_link_problem, write_owner_record)
+from wirefish_bridge.link_owner import (open_refusal, owner_record_path, process_start,
+                                        remove_owner_record, stale_link_problem,
+                                        terminal_session, write_owner_record)
 
 
 @pytest.fixture
@@ -59,3 +60,39 @@ def test_an_unreadable_record_refuses_the_port(link, text):
 def test_process_start_is_known_for_a_running_process_only():
     assert process_start(os.getpid()) > 0
     assert process_start(2**22 + 12345) is None
+
+
+@pytest.fixture
+def terminal():
+    """Yield (pty path, pid of a session leader whose controlling terminal it is)."""
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    shell = subprocess.Popen([sys.executable, '-c',
+                              f'import os, sys; os.setsid(); os.open({path!r}, os.O_RDWR); '
+                              'print(flush=True); sys.stdin.read()'],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    shell.stdout.readline()   # the terminal is its controlling terminal from here on
+    yield path, shell.pid
+    shell.communicate('')
+    os.close(master)
+    os.close(slave)
+
+
+def test_a_controlling_terminal_is_refused_with_its_process(terminal):
+    path, pid = terminal
+    problem = open_refusal(path)
+    assert problem is not None and f'controlling terminal of pid {pid}' in problem
+
+
+def test_a_pty_that_is_nobody_s_terminal_may_be_opened(tmp_path):
+    master, slave = os.openpty()
+    try:
+        assert terminal_session(os.ttyname(slave)) is None
+        assert open_refusal(os.ttyname(slave)) is None
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+def test_a_path_that_is_no_device_has_no_terminal_session(link):
+    assert terminal_session(str(link)) is None

@@ -12,6 +12,11 @@ device; otherwise the link is stale and is not opened (the bridge retries: a new
 re-points the link and writes a new record). A port without a record (a real board's
 /dev/serial/by-id/... path) is opened as before; the fish-heartbeat rule still guards writes.
 
+``terminal_session`` covers the unrelated terminal itself, record or not: a device that is the
+controlling terminal of a process (a shell in a terminal window, an ssh session) is not a fish,
+and opening it would reconfigure it, flush its input and steal its keystrokes. ``open_refusal``
+is both checks, the one a bridge runs before each open.
+
 Linux (/proc); pure file reads, no rclpy. The virtual fish and the bridge must share a pid
 namespace (they do when launched together).
 """
@@ -21,6 +26,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+import stat
 
 
 def owner_record_path(link: Path) -> Path:
@@ -80,4 +86,46 @@ def stale_link_problem(port: str) -> str | None:
     if os.path.realpath(port) != os.path.realpath(device):
         return (f'stale virtual-fish link: {port} leads to {os.path.realpath(port)}, its owner '
                 f'(pid {pid}) serves {device}; not opening it')
+    return None
+
+
+def terminal_session(port: str) -> tuple[int, str] | None:
+    """
+    Return (pid, command) of a process whose controlling terminal is the device at ``port``.
+
+    None if there is none, or ``port`` is not a character device. Compares ``tty_nr`` of every
+    ``/proc/<pid>/stat`` (field 7, the kernel's device encoding, which is ``st_rdev``'s).
+    """
+    try:
+        info = os.stat(port)
+    except OSError:
+        return None
+    if not stat.S_ISCHR(info.st_mode) or info.st_rdev == 0:
+        return None
+    try:
+        entries = [entry.name for entry in os.scandir('/proc') if entry.name.isdigit()]
+    except OSError:
+        return None
+    for name in entries:
+        try:
+            text = Path(f'/proc/{name}/stat').read_text(encoding='ascii', errors='replace')
+        except OSError:
+            continue   # the process ended meanwhile
+        command, _, rest = text.partition(' (')[2].rpartition(')')
+        fields = rest.split()   # state, ppid, pgrp, session, tty_nr, ...
+        if len(fields) > 4 and fields[4].lstrip('-').isdigit() and int(fields[4]) == info.st_rdev:
+            return int(name), command
+    return None
+
+
+def open_refusal(port: str) -> str | None:
+    """Return why a bridge must not open ``port`` now (stale link, a terminal), or None."""
+    problem = stale_link_problem(port)
+    if problem is not None:
+        return problem
+    session = terminal_session(port)
+    if session is not None:
+        pid, command = session
+        return (f'{port} ({os.path.realpath(port)}) is the controlling terminal of pid {pid} '
+                f'({command}), not a fish: not opening it')
     return None
