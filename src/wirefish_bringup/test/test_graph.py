@@ -41,7 +41,9 @@ def test_single_process_is_the_virtual_fish_and_one_process_of_every_node_class(
 def test_a_bag_adds_the_recorder_last_with_its_own_options_only():
     specs = fish_graph('/wirefish', sim=True, bag=Path('/tmp/b'))
     recorder = specs[-1]
-    assert recorder.command_arguments() == ('record', '-o', '/tmp/b', '--namespace', '/wirefish')
+    assert recorder.command_arguments() == ('record', '-o', '/tmp/b', '--namespace', '/wirefish',
+                                            '--resume')  # a restart records on into the bag
+    assert recorder.restart.respawn
     assert recorder.ros_nodes == ()  # its node is not in the namespace: not waited for
 
 

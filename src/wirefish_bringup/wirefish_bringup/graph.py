@@ -151,11 +151,11 @@ NODES: tuple[NodeEntry, ...] = (
               min_rates_hz={'speed_estimate': 0.5}, fed_by=('cpg_node',)),
     NodeEntry('wirefish_cpg', 'tuner_node', 'tuner_node', start_order=40,
               node_class='wirefish_cpg.tuner_node:TunerNode', own_executor=True),
-    # `wirefish up --duration`: not restarted, since `wirefish record` refuses an existing bag
-    # and a second bag of the run is not written yet; its exit is reported, the rest runs on.
+    # `wirefish up --duration`. Restarted with --resume: a killed recorder's bag is reindexed
+    # and the new one records on into its next split file (the run keeps one bag).
     NodeEntry('wirefish_bringup', 'wirefish', 'wirefish_recorder', start_order=50, when=RECORD,
-              arguments=('record', '-o', '{bag}', '--namespace', '{namespace}'),
-              ros_args=False, restart=NO_RESTART),
+              arguments=('record', '-o', '{bag}', '--namespace', '{namespace}', '--resume'),
+              ros_args=False),
 )
 
 # The process that hosts every entry with a node_class in single-process mode.
