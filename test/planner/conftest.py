@@ -90,6 +90,7 @@ class Recording:
     truth: list = field(default_factory=list)  # (t, x, y, yaw, speed, yaw_rate)
     servo: list = field(default_factory=list)  # (stamp s, p1, p2, v1, v2)
     state: list = field(default_factory=list)  # (t, PlannerState)
+    diagnostics: list = field(default_factory=list)  # (t, DiagnosticStatus) of the planner
 
 
 class Driver:
@@ -97,6 +98,7 @@ class Driver:
 
     def __init__(self, context, namespace: str) -> None:
         """Create the node, its subscriptions and the cmd_vel timer; spin on a thread."""
+        from diagnostic_msgs.msg import DiagnosticArray
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
         import rclpy
@@ -115,6 +117,7 @@ class Driver:
         self.node.create_subscription(JointState, 'servo_cmd', self._on_servo,
                                       qos_profile_sensor_data)
         self.node.create_subscription(PlannerState, 'planner_state', self._on_state, 50)
+        self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 50)
         self.node.create_timer(1.0 / CMD_RATE_HZ, self._on_timer)
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
@@ -146,6 +149,11 @@ class Driver:
 
     def _on_state(self, msg) -> None:
         self.recording.state.append((self.now(), msg))
+
+    def _on_diagnostics(self, msg) -> None:
+        for status in msg.status:
+            if status.name.endswith('/planner_node'):
+                self.recording.diagnostics.append((self.now(), status))
 
     def set_parameters(self, node_name: str, **values) -> None:
         """Set parameters of a node of the graph (raises if refused)."""
