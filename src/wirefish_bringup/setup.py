@@ -24,6 +24,7 @@ setup(
     entry_points={
         'console_scripts': [
             'wirefish = wirefish_bringup.cli:main',
+            'link_relay = wirefish_bringup.link_relay:main',
         ],
     },
 )

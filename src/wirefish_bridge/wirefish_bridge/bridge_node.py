@@ -20,11 +20,8 @@ counted (``telemetry_rejected``) and dropped, never published.
 The port is read by the transport's thread. Telemetry is published straight from that thread
 (publishing is thread-safe): the 100 Hz path then costs no executor wake-up, which was the larger
 part of the bridge's CPU and of the bytes -> imu/data latency. Every other frame and link event
-goes into an inbox that the executor drains: the reader hands it over with ``create_task`` on
-the node's executor (one task pending at most; the events executor has no guard conditions,
-and this works on both), and each diagnostics tick drains it too (events from before the node
-was spun), so the executor never waits on the device. An unplugged device is reopened by the
-transport with backoff; the node keeps running.
+reaches the executor through a guard condition, so the executor never waits on the device. An
+unplugged device is reopened by the transport with backoff; the node keeps running.
 """
 
 from __future__ import annotations
@@ -55,6 +52,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, servo_state_message)
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
                                        SerialLink)
+from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
@@ -68,6 +66,7 @@ class BridgeNode(Node):
         """Declare the parameters, wire topics and timers, start the serial link."""
         super().__init__('bridge_node', **kwargs)
         declare(self, PARAMETERS, check_combination)
+        self._frame_prefix = declare_frame_prefix(self)  # fish_1 -> fish_1/imu_link
         self._values = {s.name: self.get_parameter(s.name).value for s in PARAMETERS}
         self._started = time.monotonic()
         self._encoder = FrameEncoder()
@@ -77,7 +76,6 @@ class BridgeNode(Node):
                                  self._values['servo_limit_rad'])
         self._inbox: deque = deque(maxlen=1000)  # reader thread -> executor; bounded
         self._inbox_lock = threading.Lock()
-        self._drain_scheduled = False  # a drain task is pending on the executor (inbox lock)
         self._health = LinkHealth(self._values['heartbeat_timeout_s'], time.monotonic())
 
         self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
@@ -90,6 +88,7 @@ class BridgeNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA)
+        self._wake = self.create_guard_condition(self._drain_inbox)
         self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
         self.add_on_set_parameters_callback(self._validate)
@@ -153,7 +152,7 @@ class BridgeNode(Node):
         if others:
             with self._inbox_lock:
                 self._inbox.extend(others)
-            self._hand_over()
+            self._wake.trigger()
 
     def _publish_from_reader(self, telemetry: Telemetry) -> None:
         problem = self._health.on_telemetry(telemetry, time.monotonic())
@@ -174,23 +173,13 @@ class BridgeNode(Node):
             self._health.on_new_device()
         with self._inbox_lock:
             self._inbox.append((state, detail))
-        self._hand_over()
-
-    def _hand_over(self) -> None:
-        """Have the executor drain the inbox soon: one pending drain task at most."""
-        with self._inbox_lock:
-            executor = self.executor
-            if self._drain_scheduled or executor is None:  # None: not spun yet (see module doc)
-                return
-            self._drain_scheduled = True
-        executor.create_task(self._drain_inbox)
+        self._wake.trigger()
 
     # --- executor side ----------------------------------------------------------------------
     def _drain_inbox(self) -> None:
         with self._inbox_lock:
             items = list(self._inbox)
             self._inbox.clear()
-            self._drain_scheduled = False
         for item in items:
             if isinstance(item, tuple):
                 state, detail = item
@@ -214,7 +203,7 @@ class BridgeNode(Node):
 
     def _publish_telemetry(self, telemetry: Telemetry) -> None:
         stamp = self.get_clock().now().to_msg()
-        frame_id = self._values['imu_frame_id']
+        frame_id = prefixed(self._frame_prefix, self._values['imu_frame_id'])
         tilt = self._values['orientation_stddev_rad']
         self._imu_pub.publish(imu_message(
             telemetry, stamp, frame_id, (tilt, tilt, self._values['yaw_stddev_rad']),
@@ -223,7 +212,8 @@ class BridgeNode(Node):
         self._attitude_pub.publish(attitude_message(telemetry, stamp, frame_id))
         self._servo_pub.publish(servo_state_message(telemetry, stamp))
         self._battery_pub.publish(battery_message(
-            telemetry, stamp, bool(telemetry.status & Status.LOW_BATTERY)))
+            telemetry, stamp, bool(telemetry.status & Status.LOW_BATTERY),
+            prefixed(self._frame_prefix, 'base_link')))
 
     def _on_servo_cmd(self, msg: JointState) -> None:
         angles = servo_angles(msg)
@@ -260,7 +250,6 @@ class BridgeNode(Node):
         self._health.out.sent += 1
 
     def _publish_diagnostics(self) -> None:
-        self._drain_inbox()  # heartbeats first, so the status is up to date
         now = time.monotonic()
         port, state, stats = self._values['port'], self._link.state, self._link.stats
         level, message = self._health.level(now, state, port, stats, self._gate.failsafe)

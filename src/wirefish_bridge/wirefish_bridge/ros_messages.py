@@ -61,11 +61,12 @@ def servo_state_message(telemetry: Telemetry, stamp: Time) -> JointState:
     return servo_joint_state((telemetry.servo_1, telemetry.servo_2), stamp=stamp)
 
 
-def battery_message(telemetry: Telemetry, stamp: Time, low_battery: bool) -> BatteryState:
+def battery_message(telemetry: Telemetry, stamp: Time, low_battery: bool,
+                    frame_id: str = 'base_link') -> BatteryState:
     """Return a sensor_msgs/BatteryState with the voltage; unmeasured fields are NaN."""
     msg = BatteryState()
     msg.header.stamp = stamp
-    msg.header.frame_id = 'base_link'
+    msg.header.frame_id = frame_id
     msg.voltage = telemetry.battery_v
     nan = math.nan
     msg.temperature = msg.current = msg.charge = msg.capacity = nan

@@ -3,6 +3,8 @@ Start one fish's graph on a full ROS 2 Jazzy install.
 
     ros2 launch wirefish_bringup wirefish.launch.py sim:=true namespace:=/wirefish
     ros2 launch wirefish_bringup wirefish.launch.py sim:=false port:=/dev/ttyUSB0
+    ros2 launch wirefish_bringup wirefish.launch.py role:=fish   # on the fish's computer
+    ros2 launch wirefish_bringup wirefish.launch.py role:=shore  # on the shore's
 
 The nodes, names, parameters, start order and restart policies come from the registry in
 `wirefish_bringup.graph`, the one `wirefish up` (the launcher for machines without ros2 launch)
@@ -14,7 +16,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph
+from wirefish_bringup.graph import ALL, DEFAULT_NAMESPACE, fish_graph, ROLES
 
 
 def _shutdown_after_last_retry(spec):
@@ -34,8 +36,11 @@ def _nodes(context):
     port = LaunchConfiguration('port').perform(context) or None
     namespace = LaunchConfiguration('namespace').perform(context)
     params_file = LaunchConfiguration('params_file').perform(context) or None
+    role = LaunchConfiguration('role').perform(context)
+    frame_prefix = LaunchConfiguration('frame_prefix').perform(context)
     actions = []
-    for spec in fish_graph(namespace, sim=sim, port=port, params_file=params_file):
+    for spec in fish_graph(namespace, sim=sim, port=port, params_file=params_file, role=role,
+                           frame_prefix=frame_prefix):
         # The recorder (the only entry that parses its own options) runs with --duration
         # under `wirefish up` only: fish_graph adds it only when given a bag.
         actions.append(Node(
@@ -59,5 +64,10 @@ def generate_launch_description():
                               description='ROS namespace of every node and topic of the fish'),
         DeclareLaunchArgument('params_file', default_value='',
                               description='parameter YAML (default: config/wirefish.yaml)'),
+        DeclareLaunchArgument('role', default_value=ALL, choices=list(ROLES),
+                              description='fish: the nodes that keep the fish swimming (and '
+                              'the link relay to shore); shore: tuner (and recorder); all: both'),
+        DeclareLaunchArgument('frame_prefix', default_value='',
+                              description='prefix of frame ids (fish_1 -> fish_1/base_link)'),
         OpaqueFunction(function=_nodes),
     ])

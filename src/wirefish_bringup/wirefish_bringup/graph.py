@@ -26,13 +26,19 @@ from pathlib import Path
 import re
 
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
+from wirefish_common.frames import frame_prefix_problem
 
 DEFAULT_NAMESPACE = '/wirefish'
 PARAMS_FILE_NAME = 'wirefish.yaml'
 _NAMESPACE_PATTERN = re.compile(r'^(/[A-Za-z][A-Za-z0-9_]*)+$|^/$')
 
-# When an entry is part of the graph: always, only with the virtual fish, only when recording.
-ALWAYS, SIM, RECORD = 'always', 'sim', 'record'
+# When an entry is part of the graph: always, only with the virtual fish, only when recording,
+# only when the fish runs apart from its shore (role fish: the link relay, see crossing.py).
+ALWAYS, SIM, RECORD, APART = 'always', 'sim', 'record', 'apart'
+# Which side of the radio link an entry runs on (issue 17). The fish side is everything that
+# keeps the fish safe and swimming without shore; the shore side only tunes, records, drives.
+FISH, SHORE, ALL = 'fish', 'shore', 'all'
+ROLES = (FISH, SHORE, ALL)
 
 
 @dataclass(frozen=True)
@@ -106,8 +112,9 @@ class NodeEntry:
     ``name`` is its ROS node name; ``node_class`` (``'module:Class'``, taking rclpy Node
     keyword arguments) lets the single-process mode host it, None keeps it a process of its
     own. ``arguments`` go before ``--ros-args`` and ``parameters`` are set on top of the
-    parameter file; both may use ``{device}`` (the fish's serial device), ``{namespace}`` and
-    ``{bag}``; ``ros_args`` False: the process parses its own options only (no ``--ros-args``
+    parameter file; both may use ``{device}`` (the fish's serial device), ``{namespace}``,
+    ``{recorded}`` (the namespace a recorder records: the shore's copies with the shore role)
+    and ``{bag}``; ``ros_args`` False: the process parses its own options only (no ``--ros-args``
     section). ``start_order`` is the same whatever the role (lower first). ``creates_link``:
     the process publishes ``{device}`` as a symlink (the launcher removes a stale one before
     each start and waits for it at start-up). ``own_executor``: in one process it spins on a
@@ -115,6 +122,8 @@ class NodeEntry:
     answer). ``rates_hz`` are its streams at their nominal rates at the default parameters,
     ``min_rates_hz`` its slow streams (at least that often); ``fed_by`` names the nodes whose
     output its streams are computed from (they may pause while one of those is down).
+    ``role`` is the side of the radio link it runs on (FISH or SHORE); ``frames``: it writes
+    frame ids and takes the ``frame_prefix`` parameter (a fleet's fish_1/base_link).
     """
 
     package: str
@@ -132,30 +141,39 @@ class NodeEntry:
     rates_hz: Mapping[str, float] = field(default_factory=dict)
     min_rates_hz: Mapping[str, float] = field(default_factory=dict)
     fed_by: tuple[str, ...] = ()
+    role: str = FISH
+    frames: bool = False
 
 
 NODES: tuple[NodeEntry, ...] = (
     NodeEntry('wirefish_sim', 'fish_sim', 'fish_sim', start_order=0, when=SIM,
-              arguments=('--link', '{device}', '--ros'), creates_link=True,
+              arguments=('--link', '{device}', '--ros'), creates_link=True, frames=True,
               restart=RestartPolicy(required=True), rates_hz={'sim/ground_truth': 50.0}),
     NodeEntry('wirefish_bridge', 'bridge_node', 'bridge_node', start_order=10,
               node_class='wirefish_bridge.bridge_node:BridgeNode',
-              parameters={'port': '{device}'}, restart=RestartPolicy(required=True),
+              parameters={'port': '{device}'}, restart=RestartPolicy(required=True), frames=True,
               rates_hz={'imu/data': 100.0, 'attitude': 100.0, 'servo_state': 100.0},
               min_rates_hz={'/diagnostics': 0.5, 'battery': 0.5}, fed_by=('fish_sim',)),
     NodeEntry('wirefish_cpg', 'cpg_node', 'cpg_node', start_order=20,
               node_class='wirefish_cpg.cpg_node:CpgNode', rates_hz={'servo_cmd': 200.0}),
     NodeEntry('wirefish_kinematics', 'kinematics_node', 'kinematics_node', start_order=30,
-              node_class='wirefish_kinematics.kinematics_node:KinematicsNode',
+              node_class='wirefish_kinematics.kinematics_node:KinematicsNode', frames=True,
               rates_hz={'body_wave': 50.0, 'body_wave_markers': 10.0},
               min_rates_hz={'speed_estimate': 0.5}, fed_by=('cpg_node',)),
+    # rest_at_start false: cpg_node keeps the default gait until the first cmd_vel (the graph's
+    # other users expect it); the cmd_vel timeout still rests the fish when commands stop.
+    NodeEntry('wirefish_planner', 'planner_node', 'planner_node', start_order=35,
+              node_class='wirefish_planner.planner_node:PlannerNode',
+              parameters={'rest_at_start': 'false'}, fed_by=('bridge_node',)),
     NodeEntry('wirefish_cpg', 'tuner_node', 'tuner_node', start_order=40,
-              node_class='wirefish_cpg.tuner_node:TunerNode', own_executor=True),
+              node_class='wirefish_cpg.tuner_node:TunerNode', own_executor=True, role=SHORE),
+    # The fish's side of the radio: the decimated copies the shore sees (config/crossing.yaml).
+    NodeEntry('wirefish_bringup', 'link_relay', 'link_relay', start_order=45, when=APART),
     # `wirefish up --duration`. Restarted with --resume: a killed recorder's bag is reindexed
     # and the new one records on into its next split file (the run keeps one bag).
     NodeEntry('wirefish_bringup', 'wirefish', 'wirefish_recorder', start_order=50, when=RECORD,
-              arguments=('record', '-o', '{bag}', '--namespace', '{namespace}', '--resume'),
-              ros_args=False),
+              arguments=('record', '-o', '{bag}', '--namespace', '{recorded}', '--resume'),
+              role=SHORE, ros_args=False),
 )
 
 # The process that hosts every entry with a node_class in single-process mode.
@@ -228,10 +246,20 @@ def sim_tty_link(namespace: str) -> Path:
     return Path('/tmp', f'wirefish-{token}-tty')
 
 
-def entries(*, sim: bool, record: bool = False) -> list[NodeEntry]:
-    """Return the registry entries of a graph with or without the virtual fish, in start order."""
-    active = {ALWAYS, *([SIM] if sim else []), *([RECORD] if record else [])}
-    return sorted((e for e in NODES if e.when in active), key=lambda e: e.start_order)
+def entries(*, sim: bool, record: bool = False, role: str = ALL) -> list[NodeEntry]:
+    """
+    Return the registry entries of a graph, in start order.
+
+    ``sim``: with the virtual fish; ``record``: with the recorder; ``role``: one side of the
+    radio link (FISH, SHORE) or both on one machine (ALL). The link relay runs with the fish
+    role only: with both sides on one host nothing crosses a radio.
+    """
+    if role not in ROLES:
+        raise ValueError(f'unknown role {role!r}: choose one of {", ".join(ROLES)}')
+    active = {ALWAYS, *([SIM] if sim else []), *([RECORD] if record else []),
+              *([APART] if role == FISH else [])}
+    return sorted((e for e in NODES if e.when in active and role in (ALL, e.role)),
+                  key=lambda e: e.start_order)
 
 
 def composable_entries() -> list[NodeEntry]:
@@ -279,7 +307,8 @@ def expected_rates(*, sim: bool = True) -> tuple[dict[str, float], dict[str, flo
 
 def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
                port: str | None = None, params_file: Path | str | None = None,
-               single_process: bool = False, bag: Path | None = None) -> list[NodeSpec]:
+               single_process: bool = False, bag: Path | None = None, role: str = ALL,
+               frame_prefix: str = '') -> list[NodeSpec]:
     """
     Return the processes of one fish's graph, in start order (the virtual fish first).
 
@@ -287,8 +316,9 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     points the bridge at its pseudo-terminal, otherwise ``port`` names the real fish's serial
     device; ``params_file`` is the parameter YAML (the installed default when None);
     ``single_process`` runs the ROS nodes with a node class in one process (`wirefish
-    compose`); ``bag`` adds the recorder, writing there.
-
+    compose`); ``bag`` adds the recorder, writing there; ``role`` starts one side of the radio
+    link only (FISH or SHORE; ALL: both); ``frame_prefix`` goes to every node that writes frame
+    ids (``fish_1``: ``fish_1/base_link``).
     """
     namespace = validate_namespace(namespace)
     if not sim and not port:
@@ -298,10 +328,20 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
                          'choose sim or a port (sim:=false port:=...)')
     params = str(params_file or default_params_file())
     device = str(sim_tty_link(namespace)) if sim else str(port)
-    values = {'device': device, 'namespace': namespace, **({'bag': str(bag)} if bag else {})}
+    # The shore alone records what crosses the link (shore/...), never the fish's fast streams.
+    recorded = f'{namespace.rstrip("/")}/shore' if role == SHORE else namespace
+    values = {'device': device, 'namespace': namespace, 'recorded': recorded,
+              **({'bag': str(bag)} if bag else {})}
     specs: list[NodeSpec] = []
     composed: list[NodeEntry] = []
-    for e in entries(sim=sim, record=bag is not None):
+    prefix_problem = frame_prefix_problem(frame_prefix)
+    if prefix_problem is not None:
+        raise ValueError(prefix_problem)
+    if single_process and (role != ALL or frame_prefix):
+        raise ValueError('the single-process mode hosts one whole fish (wirefish compose): '
+                         'a role or a frame prefix needs one process per node')
+    with_prefix = {'frame_prefix': frame_prefix} if frame_prefix else {}
+    for e in entries(sim=sim, record=bag is not None, role=role):
         if single_process and e.node_class is not None:
             composed.append(e)
             continue
@@ -310,7 +350,8 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
             arguments=tuple(resolve(a, **values) for a in e.arguments),
             namespace=namespace if e.ros_args else None,
             params_file=params,
-            parameters={k: resolve(v, **values) for k, v in e.parameters.items()},
+            parameters={**{k: resolve(v, **values) for k, v in e.parameters.items()},
+                        **(with_prefix if e.frames else {})},
             # A process that parses its own options names its node itself (the recorder's
             # is outside the namespace): nothing to wait for or to look for there.
             restart=e.restart, ros_nodes=(e.name,) if e.ros_args else (),

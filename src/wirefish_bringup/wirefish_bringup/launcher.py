@@ -18,7 +18,8 @@ import sys
 import time
 
 from wirefish_bringup.cli import duration_s
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, NodeSpec, validate_namespace
+from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
+                                    validate_namespace)
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
@@ -38,7 +39,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     target.add_argument('--sim', action='store_true', default=True,
                         help='drive the virtual fish on a pseudo-terminal (default)')
     target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
-    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
+                        help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
+    parser.add_argument('--role', choices=ROLES, default=ALL,
+                        help='one side of a radio link: fish (virtual fish or port, bridge, '
+                        'CPG, kinematics, planner, link relay) or shore (tuner, recorder); '
+                        'all: both on this machine (default). See README: two hosts')
+    parser.add_argument('--fleet', type=fleet_size, default=None, metavar='N',
+                        help='N virtual fish, each its whole graph in <namespace>/fish_<i> with '
+                        'frames fish_<i>/...; one recorder of them all with --duration')
+    parser.add_argument('--frame-prefix', default='',
+                        help='prefix of the frame ids (fish_1 -> fish_1/base_link)')
     parser.add_argument('--duration', type=duration_s, default=None,
                         help='run this many seconds, record a bag and write a report')
     parser.add_argument('--params-file', type=Path, default=None,
@@ -53,13 +64,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         '(e.g. a graph that just died is still discovered)')
 
 
-def _registry_nodes(specs: list[NodeSpec]) -> list[str]:
-    return [name for spec in specs for name in spec.ros_nodes]
+def fleet_size(text: str) -> int:
+    """Return a --fleet option: a whole number of fish >= 1 (argparse type)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a whole number of fish: {text!r}') from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f'a fleet has at least 1 fish, got {value}')
+    return value
+
+
+def _node_names(spec: NodeSpec, namespace: str) -> list[str]:
+    """Return the fully qualified names of the nodes ``spec`` hosts (a fleet's: per fish)."""
+    return [f'{(spec.namespace or namespace).rstrip("/")}/{name}' for name in spec.ros_nodes]
+
+
+def _registry_nodes(specs: list[NodeSpec], namespace: str) -> list[str]:
+    """Return the graph's node names relative to ``namespace`` (fish_1/cpg_node in a fleet)."""
+    prefix = namespace.rstrip('/') + '/'
+    return [name[len(prefix):] for spec in specs for name in _node_names(spec, namespace)]
 
 
 def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], supervisor: Supervisor,
                 show_status: bool, stop_requested: list,
-                timeout_s: float = READY_TIMEOUT_S) -> str | None:
+                timeout_s: float = READY_TIMEOUT_S, role: str = ALL) -> str | None:
     """
     Wait until every node of the graph is on the ROS graph; return the status table or None.
 
@@ -70,10 +99,8 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
     from wirefish_bringup.monitor import discovered_nodes, measure_rates, settle_discovery
 
     def expected() -> set[str]:
-        given_up = {name for key in supervisor.given_up
-                    for name in supervisor.specs[key].ros_nodes}
-        return {f'{namespace.rstrip("/")}/{name}'
-                for name in _registry_nodes(specs) if name not in given_up}
+        return {name for key, spec in supervisor.specs.items() if key not in supervisor.given_up
+                for name in _node_names(spec, namespace)}
 
     def up() -> bool:  # discovered, and no process down (a node dying at start-up is seen)
         return expected() <= discovered_nodes(node) and not supervisor.down()
@@ -95,7 +122,10 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
     if not show_status:
         return ''
     settle_discovery(node, executor, namespace, should_stop=lambda: bool(stop_requested))
-    rates = measure_rates(node, executor, namespace, STATUS_WINDOW_S,
+    # The shore watches what crosses the link only: measuring the fish's own streams would
+    # pull them over the radio.
+    watched = f'{namespace.rstrip("/")}/shore' if role == SHORE else namespace
+    rates = measure_rates(node, executor, watched, STATUS_WINDOW_S,
                           should_stop=lambda: bool(stop_requested))
     if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
         return None
@@ -139,8 +169,18 @@ def run(args: argparse.Namespace) -> int:
     try:
         namespace = validate_namespace(args.namespace)
         sim = args.port is None
-        specs = fish_graph(namespace, sim=sim, port=args.port, params_file=args.params_file,
-                           single_process=args.single_process, bag=bag_path)
+        if args.fleet is not None:
+            if args.port is not None or args.single_process or args.frame_prefix:
+                raise ValueError('--fleet starts virtual fish, one process per node, each '
+                                 'with frames fish_<i>/...: no --port, --single-process or '
+                                 '--frame-prefix with it')
+            from wirefish_bringup.fleet import fleet_graph
+            specs = fleet_graph(namespace, args.fleet, params_file=args.params_file,
+                                bag=bag_path, role=args.role)
+        else:
+            specs = fish_graph(namespace, sim=sim, port=args.port,
+                               params_file=args.params_file, single_process=args.single_process,
+                               bag=bag_path, role=args.role, frame_prefix=args.frame_prefix)
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2
@@ -162,7 +202,8 @@ def run(args: argparse.Namespace) -> int:
             if not args.allow_duplicate:
                 from wirefish_bringup.monitor import registry_nodes_present
                 present = registry_nodes_present(node, executor, namespace,
-                                                 _registry_nodes(specs), DUPLICATE_CHECK_S,
+                                                 _registry_nodes(specs, namespace),
+                                                 DUPLICATE_CHECK_S,
                                                  should_stop=lambda: bool(stop_requested))
                 if present:
                     domain = os.environ.get('ROS_DOMAIN_ID', '0')
@@ -183,7 +224,7 @@ def run(args: argparse.Namespace) -> int:
             print(f'started {len(supervisor.processes)} processes in {namespace}; '
                   f'logs in {run_dir / "logs"}', flush=True)
             status = _wait_ready(node, executor, namespace, specs, supervisor,
-                                 not args.no_status, stop_requested)
+                                 not args.no_status, stop_requested, role=args.role)
         if status and status.startswith('not up'):
             raise RuntimeError(status)
         if status:

@@ -4,7 +4,8 @@ fish_sim: the virtual fish on a pseudo-terminal, playing the board's firmware in
 ``fish_sim --link /tmp/wirefish-tty`` opens a pty pair, prints the device path on stdout (one
 line, flushed), points the link at it and runs until SIGINT/SIGTERM (exit code 0). The core
 (``VirtualFish``) needs no ROS; with ``--ros`` the process also publishes ``sim/ground_truth``
-(nav_msgs/Odometry, frame ``odom``, child ``base_link``). Fault flags: ``--corrupt-fraction``,
+(nav_msgs/Odometry, frame ``odom``, child ``base_link``, both under the ROS parameter
+``frame_prefix`` when set). Fault flags: ``--corrupt-fraction``,
 ``--drop-fraction``, ``--stall-every/--stall-for`` (firmware freezes: no output, input lost),
 ``--reopen-every/--reopen-count/--reopen-delay`` (close the device, wait, open a new one).
 Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns the fish) and
@@ -88,10 +89,13 @@ class GroundTruthPublisher:
         import rclpy
         from rclpy.signals import SignalHandlerOptions
         from nav_msgs.msg import Odometry
+        from wirefish_common.frames import declare_frame_prefix, prefixed
 
         self._rclpy = rclpy
         rclpy.init(args=ros_args, signal_handler_options=SignalHandlerOptions.NO)
         self.node = rclpy.create_node('fish_sim')
+        prefix = declare_frame_prefix(self.node)  # fish_1: fish_1/odom, fish_1/base_link
+        self._frames = prefixed(prefix, 'odom'), prefixed(prefix, 'base_link')
         self._odometry = Odometry
         self.publisher = self.node.create_publisher(Odometry, 'sim/ground_truth', 10)
 
@@ -100,8 +104,7 @@ class GroundTruthPublisher:
         s = fish.state
         msg = self._odometry()
         msg.header.stamp = self.node.get_clock().now().to_msg()
-        msg.header.frame_id = 'odom'
-        msg.child_frame_id = 'base_link'
+        msg.header.frame_id, msg.child_frame_id = self._frames
         msg.pose.pose.position.x, msg.pose.pose.position.y = s.x, s.y
         msg.pose.pose.orientation.z = math.sin(s.yaw / 2.0)
         msg.pose.pose.orientation.w = math.cos(s.yaw / 2.0)

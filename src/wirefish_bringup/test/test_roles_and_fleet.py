@@ -1,0 +1,117 @@
+"""Roles (fish / shore), the crossing table, frame prefixes and fleets (issue 17), pure."""
+
+from pathlib import Path
+
+import pytest
+from wirefish_bringup.crossing import (crossing_table, default_crossing_file, LatestHold,
+                                       load_crossing)
+from wirefish_bringup.fleet import fleet_graph, fleet_namespaces
+from wirefish_bringup.graph import entries, FISH, fish_graph, SHORE
+from wirefish_bringup.launcher import _registry_nodes
+
+CONFIG = Path(__file__).resolve().parents[1] / 'config' / 'crossing.yaml'
+
+
+def _names(specs):
+    return [s.name for s in specs]
+
+
+def test_the_fish_role_holds_what_keeps_the_fish_swimming_and_the_relay():
+    assert _names(fish_graph('/w', role=FISH)) == [
+        'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'planner_node', 'link_relay']
+
+
+def test_the_shore_role_holds_the_tuner_and_the_recorder_of_the_shore_copies():
+    specs = fish_graph('/w', role=SHORE, bag=Path('/tmp/b'))
+    assert _names(specs) == ['tuner_node', 'wirefish_recorder']
+    assert specs[-1].command_arguments()[-2:] == ('--namespace', '/w/shore')
+
+
+def test_both_roles_together_are_the_one_host_graph_without_a_relay():
+    together = set(_names(fish_graph('/w')))
+    apart = set(_names(fish_graph('/w', role=FISH))) | set(_names(fish_graph('/w', role=SHORE)))
+    assert apart - together == {'link_relay'}
+
+
+def test_an_unknown_role_is_refused_naming_the_choices():
+    with pytest.raises(ValueError, match='fish, shore, all'):
+        entries(sim=True, role='boat')
+
+
+def test_a_frame_prefix_goes_to_every_node_that_writes_frames_and_only_those():
+    specs = {s.name: s for s in fish_graph('/w', frame_prefix='fish_7')}
+    given = {name for name, s in specs.items() if 'frame_prefix:=fish_7' in s.command_arguments()}
+    assert given == {'fish_sim', 'bridge_node', 'kinematics_node'}
+
+
+def test_no_frame_prefix_passes_no_parameter():
+    assert not any('frame_prefix' in ' '.join(s.command_arguments()) for s in fish_graph('/w'))
+
+
+def test_a_bad_frame_prefix_is_refused_before_anything_starts():
+    with pytest.raises(ValueError, match='frame_prefix'):
+        fish_graph('/w', frame_prefix='fish-1')
+
+
+def test_a_fleet_is_one_namespace_and_one_frame_prefix_per_fish():
+    specs = fleet_graph('/tank', 3)
+    for i in (1, 2, 3):
+        mine = [s for s in specs if s.namespace == f'/tank/fish_{i}']
+        assert _names(mine) == _names(fish_graph('/w'))
+        sim = next(s for s in mine if s.name == 'fish_sim')
+        assert f'frame_prefix:=fish_{i}' in sim.command_arguments()
+        assert f'/tmp/wirefish-tank_fish_{i}-tty' in sim.command_arguments()
+
+
+def test_a_fleet_recording_is_one_recorder_of_the_base_namespace():
+    specs = fleet_graph('/tank', 2, bag=Path('/tmp/b'))
+    recorders = [s for s in specs if s.name == 'wirefish_recorder']
+    assert len(recorders) == 1 and recorders[0].command_arguments()[-1] == '/tank'
+
+
+@pytest.mark.parametrize('count', [0, 17])
+def test_a_fleet_size_outside_its_bounds_is_refused(count):
+    with pytest.raises(ValueError, match='fleet'):
+        fleet_namespaces('/tank', count)
+
+
+def test_the_launcher_names_a_fleets_nodes_relative_to_its_base():
+    names = _registry_nodes(fleet_graph('/tank', 2), '/tank')
+    assert 'fish_1/cpg_node' in names and 'fish_2/cpg_node' in names
+
+
+def test_the_shipped_crossing_table_relays_the_fast_streams_slowly():
+    table = {row.topic: row for row in load_crossing(CONFIG)}
+    assert table['imu/data'].shore_topic == 'shore/imu/data'
+    assert 0 < table['imu/data'].rate_hz <= 20 and 0 < table['servo_state'].rate_hz <= 20
+    assert 'servo_cmd' not in table and 'body_wave' not in table
+
+
+def test_the_installed_crossing_table_is_the_shipped_one():
+    assert load_crossing(default_crossing_file()) == load_crossing(CONFIG)
+
+
+@pytest.mark.parametrize('row, reason', [
+    ({'topic': '/abs', 'type': 'a/msg/B', 'rate_hz': 1, 'qos': 'sensor'}, 'relative'),
+    ({'topic': 'x', 'type': 'Imu', 'rate_hz': 1, 'qos': 'sensor'}, 'type'),
+    ({'topic': 'x', 'type': 'a/msg/B', 'rate_hz': -1, 'qos': 'sensor'}, 'rate_hz'),
+    ({'topic': 'x', 'type': 'a/msg/B', 'rate_hz': 1, 'qos': 'fast'}, 'qos'),
+    ({'topic': 'x', 'type': 'a/msg/B', 'rate_hz': 1}, 'exactly'),
+])
+def test_a_bad_crossing_row_is_refused_with_the_reason(row, reason):
+    with pytest.raises(ValueError, match=reason):
+        crossing_table({'relayed': [row]})
+
+
+def test_a_topic_relayed_twice_is_refused():
+    row = {'topic': 'x', 'type': 'a/msg/B', 'rate_hz': 1, 'qos': 'sensor'}
+    with pytest.raises(ValueError, match='twice'):
+        crossing_table({'relayed': [row, row]})
+
+
+def test_a_hold_sends_the_newest_message_once():
+    hold = LatestHold()
+    hold.put(b'1')
+    hold.put(b'2')
+    assert hold.take() == b'2'
+    assert hold.take() is None
