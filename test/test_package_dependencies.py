@@ -148,23 +148,34 @@ def undeclared_imports(package: Path) -> list[str]:
     return problems
 
 
+def used_dependencies(files: list[Path], known_ros: set[str]) -> set[str]:
+    """Return the dependency keys that ``files`` import or name in a string."""
+    used = set()
+    for module in imported_modules(files):
+        try:
+            used.add(dependency_key(module, known_ros))
+        except LookupError:
+            pass  # reported by test_every_import_is_declared
+    return used | named_in_strings(files, known_ros)
+
+
 def unused_declarations(package: Path) -> list[str]:
     """Return one line per declared dependency that ``package`` never imports nor names."""
     tags = declared(package)
     code, tests = python_files(package)
     known_ros = ros_packages()
-    used = set()
-    for module in imported_modules(code + tests):
-        try:
-            used.add(dependency_key(module, known_ros))
-        except LookupError:
-            pass  # reported by the other test
-    used |= named_in_strings(code + tests, known_ros)
+    used_by_code = used_dependencies(code, known_ros)
+    used_by_tests = used_dependencies(tests, known_ros)
     runtime = declared_under(tags, RUNTIME_TAGS) - TOOLING
     test_only = tags.get('test_depend', set()) - TOOLING
-    return [f'{package.name}: declares <{tag}>{name}</{tag}> but never imports it'
-            for tag, names in (('exec_depend', runtime), ('test_depend', test_only))
-            for name in sorted(names - used)]
+    problems = []
+    for name in sorted(runtime - used_by_code):
+        problems.append(f'{package.name}: declares <exec_depend>{name}</exec_depend> but '
+                        + ('only its tests use it: make it a test_depend'
+                           if name in used_by_tests else 'never imports it'))
+    problems += [f'{package.name}: declares <test_depend>{name}</test_depend> but never '
+                 'imports it' for name in sorted(test_only - used_by_tests - used_by_code)]
+    return problems
 
 
 def interface_problems(package: Path) -> list[str]:
