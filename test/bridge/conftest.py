@@ -5,6 +5,7 @@ import os
 from pathlib import Path
 import select
 import subprocess
+import sys
 import time
 import tty
 
@@ -171,3 +172,16 @@ def fake_device(tmp_path: Path) -> Iterator[FakeDevice]:
     device = FakeDevice(tmp_path / 'tty')
     yield device
     device.close()
+
+
+@pytest.fixture
+def terminal_of_a_shell(fake_device: FakeDevice) -> Iterator[int]:
+    """Make ``fake_device`` the controlling terminal of a waiting process; yield its pid."""
+    path = os.ttyname(fake_device.slave)
+    shell = subprocess.Popen([sys.executable, '-c',
+                              f'import os, sys; os.setsid(); os.open({path!r}, os.O_RDWR); '
+                              'print(flush=True); sys.stdin.read()'],
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    shell.stdout.readline()   # from here on the device is its controlling terminal
+    yield shell.pid
+    shell.communicate('')

@@ -67,6 +67,18 @@ def test_the_bridge_writes_nothing_into_a_device_that_is_not_a_fish(
     assert any(isinstance(m, Heartbeat) and m.role is Role.HOST for m in heard)
 
 
+def test_a_device_that_is_someone_s_terminal_is_never_opened(
+        fake_device, terminal_of_a_shell, start_bridge, probe):
+    start_bridge(fake_device.link)
+    assert spin_until(probe.executor, lambda: len(probe.statuses()) >= 3, 20.0)
+    status, values = probe.statuses()[-1], probe.last_diagnostics()
+    print(f'{status.message!r}')
+    fake_device.read_available()
+    assert fake_device.received == b'' and values['opens'] == '0'
+    assert status.level == DiagnosticStatus.ERROR
+    assert f'controlling terminal of pid {terminal_of_a_shell}' in status.message
+
+
 def test_a_stale_link_to_a_reused_terminal_gets_no_byte_and_a_new_fish_is_found(
         start_fish, start_bridge, probe, fake_device, tmp_path):
     link = tmp_path / 'fish-tty'

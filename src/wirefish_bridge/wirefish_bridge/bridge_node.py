@@ -11,17 +11,21 @@ Publishes (sensor-data QoS, stamped on receipt with the node clock)
     measured angles), ``battery`` (sensor_msgs/BatteryState); and ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, reliable) at ``diagnostics_rate_hz``: one status named
     ``<namespace>/bridge_node: serial link <port>``, hardware_id ``<node> on <port> (<device>)``.
-Only the fish it was started for: a virtual fish's link whose owner record says it is stale is
-not opened (``link_owner``); the port is locked (a second bridge on it cannot open it and keeps
-retrying); nothing is written to it until the device has sent a fish HEARTBEAT (a device
-silent for ``fish_identify_timeout_s`` is closed and reopened: a stale link may point at an
-unrelated terminal). Telemetry outside the physical limits of ``telemetry_limits`` is
-counted (``telemetry_rejected``) and dropped, never published.
+Only the fish it was started for: a virtual fish's link whose owner record says it is stale,
+or a device that is some process's controlling terminal, is not opened (``link_owner``); the
+port is locked (a second bridge on it cannot open it and keeps retrying); nothing is written to
+it until the device has sent a fish HEARTBEAT (a device silent for ``fish_identify_timeout_s``
+is closed and reopened: a stale link may point at an unrelated terminal). Telemetry outside
+the physical limits of ``telemetry_limits`` is counted (``telemetry_rejected``) and dropped,
+never published.
 The port is read by the transport's thread. Telemetry is published straight from that thread
 (publishing is thread-safe): the 100 Hz path then costs no executor wake-up, which was the larger
 part of the bridge's CPU and of the bytes -> imu/data latency. Every other frame and link event
-reaches the executor through a guard condition, so the executor never waits on the device. An
-unplugged device is reopened by the transport with backoff; the node keeps running.
+goes into an inbox that the executor drains: the reader hands it over with ``create_task`` on
+the node's executor (one task pending at most; the events executor has no guard conditions,
+and this works on both), and each diagnostics tick drains it too (events from before the node
+was spun), so the executor never waits on the device. An unplugged device is reopened by the
+transport with backoff; the node keeps running.
 """
 
 from __future__ import annotations
@@ -44,7 +48,7 @@ from wirefish_bridge.bridge_parameters import (check_combination, LINK_PARAMETER
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
-from wirefish_bridge.link_owner import stale_link_problem
+from wirefish_bridge.link_owner import open_refusal
 from wirefish_bridge.protocol import (ErrorReport, Heartbeat,
                                       PROTOCOL_VERSION, ProtocolMessage, Role, ServoCommand,
                                       Status, Telemetry)
@@ -76,6 +80,7 @@ class BridgeNode(Node):
                                  self._values['servo_limit_rad'])
         self._inbox: deque = deque(maxlen=1000)  # reader thread -> executor; bounded
         self._inbox_lock = threading.Lock()
+        self._drain_scheduled = False  # a drain task is pending on the executor (inbox lock)
         self._health = LinkHealth(self._values['heartbeat_timeout_s'], time.monotonic())
 
         self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
@@ -88,7 +93,6 @@ class BridgeNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA)
-        self._wake = self.create_guard_condition(self._drain_inbox)
         self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
         self.add_on_set_parameters_callback(self._validate)
@@ -136,7 +140,7 @@ class BridgeNode(Node):
                           backoff_min_s=self._values['reconnect_backoff_min_s'],
                           backoff_max_s=self._values['reconnect_backoff_max_s'],
                           identify_timeout_s=self._values['fish_identify_timeout_s'],
-                          open_check=stale_link_problem)
+                          open_check=open_refusal)
 
     # --- reader thread side: decode, publish telemetry, hand the rest over ------------------
     def _on_bytes(self, chunk: bytes) -> None:
@@ -152,7 +156,7 @@ class BridgeNode(Node):
         if others:
             with self._inbox_lock:
                 self._inbox.extend(others)
-            self._wake.trigger()
+            self._hand_over()
 
     def _publish_from_reader(self, telemetry: Telemetry) -> None:
         problem = self._health.on_telemetry(telemetry, time.monotonic())
@@ -173,13 +177,23 @@ class BridgeNode(Node):
             self._health.on_new_device()
         with self._inbox_lock:
             self._inbox.append((state, detail))
-        self._wake.trigger()
+        self._hand_over()
+
+    def _hand_over(self) -> None:
+        """Have the executor drain the inbox soon: one pending drain task at most."""
+        with self._inbox_lock:
+            executor = self.executor
+            if self._drain_scheduled or executor is None:  # None: not spun yet (see module doc)
+                return
+            self._drain_scheduled = True
+        executor.create_task(self._drain_inbox)
 
     # --- executor side ----------------------------------------------------------------------
     def _drain_inbox(self) -> None:
         with self._inbox_lock:
             items = list(self._inbox)
             self._inbox.clear()
+            self._drain_scheduled = False
         for item in items:
             if isinstance(item, tuple):
                 state, detail = item
@@ -250,6 +264,7 @@ class BridgeNode(Node):
         self._health.out.sent += 1
 
     def _publish_diagnostics(self) -> None:
+        self._drain_inbox()  # heartbeats first, so the status is up to date
         now = time.monotonic()
         port, state, stats = self._values['port'], self._link.state, self._link.stats
         level, message = self._health.level(now, state, port, stats, self._gate.failsafe)
