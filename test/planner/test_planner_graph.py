@@ -10,6 +10,7 @@ servo commands of the whole drive are checked for steps at every switch. Then th
 mission through `wirefish mission` (bag and PNG). Wall time ~3.7 min.
 """
 
+from collections import Counter
 import math
 import re
 import subprocess
@@ -105,7 +106,9 @@ def test_drive_the_virtual_fish(driver):
         start, end = _hold(driver, (0.2, 0.0), OFF_WINDOW_S)
         off = _window(rec.truth, start, end)
         drifts[name] = math.degrees(_wrap(off[-1, 3] - off[0, 3]))
-        print(f'{name}: heading drifts {drifts[name]:+.1f} deg in {end - start:.0f} s')
+        modes = Counter(m.mode for t, m in rec.state if start <= t < end)
+        print(f'{name}: heading drifts {drifts[name]:+.1f} deg in {end - start:.0f} s '
+              f'(planner modes {dict(modes)})')
         driver.set_parameters('planner_node', heading_hold=True, yaw_control=True)
 
     driver.command = None  # cmd_vel stops
