@@ -27,3 +27,20 @@ def probe(ros_context) -> Iterator[Probe]:
     yield p
     executor.shutdown()
     node.destroy_node()
+
+
+@pytest.fixture
+def library_path(tmp_path: Path) -> Path:
+    """Return a gait library file of this test's own (never the user's ROS home)."""
+    return tmp_path / 'gaits.yaml'
+
+
+@pytest.fixture
+def tuner(spawn, library_path: Path):
+    """Return a starter of tuner_node on this test's library (extra --ros-args as arguments)."""
+    from cpg_probe import TUNER_NODE
+
+    def _tuner(*ros_args: str):
+        return spawn([TUNER_NODE, '--ros-args', '-p', f'library_path:={library_path}',
+                      *ros_args])
+    return _tuner

@@ -1,39 +1,76 @@
-"""`wirefish retune` against a tuner_node process: the fit, the tuner's refusals, bad options."""
+"""`wirefish retune` against a tuner_node process: the fit, refusals, Ctrl-C, bad options."""
 
+import signal
 import subprocess
 
-from cpg_probe import TUNER_NODE
 import pytest
 
 pytestmark = pytest.mark.ros
 NAMESPACE = '/wf_cli'
 
 
+def command(python: str, *options: str) -> list[str]:
+    return [python, '-m', 'wirefish_bringup.cli', 'retune', '--namespace', NAMESPACE,
+            '--timeout', '60', *options]
+
+
 def retune(python: str, env: dict[str, str], *options: str) -> subprocess.CompletedProcess:
-    return subprocess.run([python, '-m', 'wirefish_bringup.cli', 'retune', '--namespace',
-                           NAMESPACE, '--timeout', '60', *options],
-                          env=env, capture_output=True, text=True, timeout=120)
+    return subprocess.run(command(python, *options), env=env, capture_output=True, text=True,
+                          timeout=120)
 
 
-def test_retune_prints_the_fit_and_its_progress(spawn, python, ros_env):
-    spawn([TUNER_NODE, '--ros-args', '-r', f'__ns:={NAMESPACE}'])
+def test_retune_prints_the_fit_and_a_line_per_iteration(tuner, python, ros_env):
+    tuner('-r', f'__ns:={NAMESPACE}')
     result = retune(python, ros_env, '--iterations', '20', '--swarm', '20')
     assert result.returncode == 0, result.stderr
     assert 'success                     True' in result.stdout
     assert 'RMSE theta1 / theta2 (deg)' in result.stdout
-    assert 'iteration 20/20' in result.stderr  # the bar, fed by retune_progress
+    assert 'from library                False' in result.stdout
+    # Not a terminal: plain lines from the action's feedback, one per iteration.
+    lines = [line for line in result.stderr.splitlines() if line.startswith('iteration ')]
+    assert lines[0].startswith('iteration 0/20 best loss ') and 'RMSE theta' in lines[0]
+    assert lines[-1].startswith('iteration 20/20 ')
+    assert len(lines) == 21
+
+
+def test_the_same_wave_again_comes_from_the_library(tuner, python, ros_env):
+    tuner('-r', f'__ns:={NAMESPACE}')
+    assert retune(python, ros_env, '--iterations', '20', '--swarm', '20').returncode == 0
+    again = retune(python, ros_env)
+    assert again.returncode == 0, again.stderr
+    assert 'from library                True' in again.stdout
 
 
 @pytest.mark.parametrize('options, reason', [
     (('--c1', 'nan'), 'wave.c1 must be finite'),
     (('--freq', '12'), 'wave.frequency_hz must be in (0, 10] Hz'),
+    (('--c1', '1e6'), 'servo amplitudes'),
 ])
-def test_a_refused_request_prints_the_reason_and_fails(spawn, python, ros_env, options, reason):
-    spawn([TUNER_NODE, '--ros-args', '-r', f'__ns:={NAMESPACE}'])
+def test_a_refused_goal_prints_the_reason_and_fails(tuner, python, ros_env, options, reason):
+    tuner('-r', f'__ns:={NAMESPACE}')
     result = retune(python, ros_env, *options)
     assert result.returncode == 1
-    assert f'wirefish retune: rejected: {reason}' in result.stderr, result.stderr
+    assert 'wirefish retune: rejected: ' in result.stderr and reason in result.stderr, \
+        result.stderr
     assert result.stdout == ''  # no table of zeros
+
+
+def test_ctrl_c_cancels_the_goal_and_the_tuner_is_free_again(tuner, python, ros_env):
+    tuner('-r', f'__ns:={NAMESPACE}', '-p', 'stall_iterations:=5000')
+    long_fit = subprocess.Popen(command(python, '--iterations', '5000', '--swarm', '2000'),
+                                env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+    try:
+        assert long_fit.stderr.readline().startswith('iteration 0/5000')  # the fit runs
+        long_fit.send_signal(signal.SIGINT)
+        _, stderr = long_fit.communicate(timeout=60)
+    finally:
+        long_fit.kill()
+    assert long_fit.returncode == 130
+    assert 'wirefish retune: canceled (nothing applied)' in stderr
+    assert 'Traceback' not in stderr
+    after = retune(python, ros_env, '--iterations', '5', '--no-library')
+    assert 'busy' not in after.stderr  # the canceled fit no longer holds the tuner
 
 
 @pytest.mark.parametrize('option', ['--seed', '--iterations', '--swarm'])

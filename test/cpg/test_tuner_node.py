@@ -1,12 +1,12 @@
-"""tuner_node as a separate process: fits, refusals, progress, and applying to cpg_node."""
+"""tuner_node as a separate process: fits, refusals, bursts, the library, applying to cpg_node."""
 
 import math
 
-from cpg_probe import CPG_NODE, LATCHED, max_step_ratio, TUNER_NODE, WAIT_S
+from cpg_probe import CPG_NODE, LATCHED, max_step_ratio, WAIT_S
 import numpy as np
 import pytest
 from ros_utils import spin_until
-from std_msgs.msg import Float64MultiArray
+from wirefish_cpg.gait_library import load_library
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
 
@@ -24,8 +24,8 @@ def retune_request(c1=0.15, c2=1.0, k=8.0, frequency_hz=1.0, apply=False, seed=0
     return request
 
 
-def test_retune_returns_success_with_the_fitted_parameters(spawn, probe):
-    spawn([TUNER_NODE])
+def test_retune_returns_success_with_the_fitted_parameters(spawn, tuner, probe):
+    tuner()
     client = probe.node.create_client(RetuneGait, 'retune_gait')
     response = probe.call(client, retune_request())
     assert response.success, response.message
@@ -50,9 +50,9 @@ BAD_REQUESTS = [
 ]
 
 
-def test_bad_requests_are_refused_with_reasons_and_leave_the_cpg_untouched(spawn, probe):
+def test_bad_requests_are_refused_with_reasons_and_leave_the_cpg_untouched(spawn, tuner, probe):
     spawn([CPG_NODE])
-    spawn([TUNER_NODE])
+    tuner()
     probe.wait_samples(20)
     # The latched cpg_params may arrive after the first samples on a loaded machine: count
     # the announcements only once it is in.
@@ -77,9 +77,9 @@ IMPOSSIBLE_WAVES = [
 ]
 
 
-def test_impossible_waves_are_refused_before_fitting_and_change_nothing(spawn, probe):
+def test_impossible_waves_are_refused_before_fitting_and_change_nothing(spawn, tuner, probe):
     spawn([CPG_NODE])
-    spawn([TUNER_NODE])
+    tuner()
     probe.wait_samples(20)
     assert spin_until(probe.executor, lambda: len(probe.cpg_params) > 0, WAIT_S)
     before = probe.get_parameters(CPG_NAMES)
@@ -101,9 +101,10 @@ def test_impossible_waves_are_refused_before_fitting_and_change_nothing(spawn, p
     assert waves == []  # nothing latched: no fit succeeded
 
 
-def test_a_fit_worse_than_max_rmse_is_answered_with_its_figures_and_not_applied(spawn, probe):
+def test_a_fit_worse_than_max_rmse_is_answered_with_its_figures_and_not_applied(
+        spawn, tuner, probe):
     spawn([CPG_NODE])
-    spawn([TUNER_NODE, '--ros-args', '-p', 'max_rmse_deg:=0.01'])
+    tuner('-p', 'max_rmse_deg:=0.01')
     probe.wait_samples(20)
     assert spin_until(probe.executor, lambda: len(probe.cpg_params) > 0, WAIT_S)
     before = probe.get_parameters(CPG_NAMES)
@@ -117,9 +118,10 @@ def test_a_fit_worse_than_max_rmse_is_answered_with_its_figures_and_not_applied(
     assert probe.get_parameters(CPG_NAMES) == before
 
 
-def test_apply_sets_the_cpg_parameters_and_the_output_converges_without_a_step(spawn, probe):
+def test_apply_sets_the_cpg_parameters_and_the_output_converges_without_a_step(
+        spawn, tuner, probe):
     spawn([CPG_NODE])
-    spawn([TUNER_NODE])
+    tuner()
     probe.wait_samples(200)
     start = len(probe.servo)
     client = probe.node.create_client(RetuneGait, 'retune_gait')
@@ -147,35 +149,29 @@ def test_apply_sets_the_cpg_parameters_and_the_output_converges_without_a_step(s
         0.10, 0.8, 6.0, 1.5)
 
 
-def test_progress_is_published_and_a_fit_not_applied_latches_no_target_wave(spawn, probe):
-    spawn([TUNER_NODE])
-    progress, waves = [], []
-    probe.node.create_subscription(Float64MultiArray, 'retune_progress',
-                                   lambda m: progress.append(list(m.data)), 100)
+def test_a_fit_not_applied_is_stored_in_the_library_and_latches_no_target_wave(
+        spawn, tuner, probe, library_path):
+    tuner()
     client = probe.node.create_client(RetuneGait, 'retune_gait')
-    assert spin_until(probe.executor, client.service_is_ready, WAIT_S)
-    spin_until(probe.executor, lambda: probe.node.count_publishers('retune_progress') > 0,
-               WAIT_S)
     response = probe.call(client, retune_request(c2=0.9, max_iterations=30, swarm_size=20))
     assert response.success, response.message
-    assert spin_until(probe.executor, lambda: len(progress) == response.iterations + 1, WAIT_S)
-    data = np.array(progress)
-    assert list(data[:, 0]) == list(range(response.iterations + 1))
-    assert np.all(np.diff(data[:, 1]) <= 0.0) and data[-1, 1] == response.loss
-    assert np.all(data[:, 2] == 30)
+    stored = load_library(library_path).gaits
+    assert [(g.wave.c1, g.wave.c2, g.wave.k, g.wave.frequency_hz) for g in stored] == [
+        (0.15, 0.9, 8.0, 1.0)]
+    assert stored[0].loss == response.loss and stored[0].params.w12 == response.params.w12
+    waves = []
     probe.node.create_subscription(BodyWaveSpec, 'target_wave', waves.append, LATCHED)
     spin_until(probe.executor, lambda: waves, 2.0)
     assert waves == []  # the CPG does not run this wave
 
 
-def test_a_second_request_while_one_runs_is_refused_as_busy(spawn, probe):
-    spawn([TUNER_NODE, '--ros-args', '-p', 'stall_iterations:=5000'])
+def test_a_second_request_while_one_runs_is_refused_as_busy(spawn, tuner, probe):
+    tuner('-p', 'stall_iterations:=5000')
     client = probe.node.create_client(RetuneGait, 'retune_gait')
     assert spin_until(probe.executor, client.service_is_ready, WAIT_S)
-    progress = []
-    probe.node.create_subscription(Float64MultiArray, 'retune_progress', progress.append, 10)
     long_run = client.call_async(retune_request(max_iterations=5000, swarm_size=2000))
-    assert spin_until(probe.executor, lambda: progress, WAIT_S)  # the long fit is running
+    spin_until(probe.executor, long_run.done, 1.0)  # let the long fit start first
+    assert not long_run.done()
     response = probe.call(client, retune_request())
     assert not response.success
     assert 'busy' in response.message
@@ -185,8 +181,8 @@ def test_a_second_request_while_one_runs_is_refused_as_busy(spawn, probe):
 # One client's own queue keeps 10 requests (rclpy's default service QoS): more at once are
 # lost inside that client before they are sent, which no server can answer.
 @pytest.mark.parametrize('clients, requests_each', [(50, 1), (1, 10)])
-def test_a_burst_of_requests_is_answered_every_one(spawn, probe, clients, requests_each):
-    spawn([TUNER_NODE])
+def test_a_burst_of_requests_is_answered_every_one(spawn, tuner, probe, clients, requests_each):
+    tuner()
     made = [probe.node.create_client(RetuneGait, 'retune_gait') for _ in range(clients)]
     assert spin_until(probe.executor, lambda: all(c.service_is_ready() for c in made), WAIT_S)
     futures = [c.call_async(retune_request(seed=i)) for c in made for i in range(requests_each)]
@@ -199,8 +195,8 @@ def test_a_burst_of_requests_is_answered_every_one(spawn, probe, clients, reques
     assert all(r.success or 'busy' in r.message for r in answered)
 
 
-def test_apply_without_a_cpg_node_fails_with_a_reason(spawn, probe):
-    spawn([TUNER_NODE, '--ros-args', '-p', 'apply_timeout_s:=1.0'])
+def test_apply_without_a_cpg_node_fails_with_a_reason(spawn, tuner, probe):
+    tuner('-p', 'apply_timeout_s:=1.0')
     client = probe.node.create_client(RetuneGait, 'retune_gait')
     response = probe.call(client, retune_request(apply=True, max_iterations=5))
     assert not response.success

@@ -1,9 +1,11 @@
 """
-`wirefish retune`: ask the tuner to fit the CPG to a desired body wave, with live progress.
+`wirefish retune`: fit the CPG to a desired body wave through the tuner's retune_gait action.
 
-The same request as ``ros2 service call /wirefish/retune_gait
-wirefish_msgs/srv/RetuneGait "{wave: {c1: 0.15, c2: 1.0, k: 8.0, frequency_hz: 1.0}}"``,
-with a progress bar fed by the tuner's ``retune_progress`` topic and a result table.
+The same goal as ``ros2 action send_goal --feedback /wirefish/retune_gait
+wirefish_msgs/action/RetuneGait "{wave: {c1: 0.15, c2: 1.0, k: 8.0, frequency_hz: 1.0}}"``:
+a live progress bar from the action's feedback on a terminal (plain lines otherwise), the
+result as a table. Ctrl-C cancels the goal (the tuner stops the fit within one iteration and
+applies nothing) and exits 130.
 """
 
 import argparse
@@ -14,12 +16,12 @@ import time
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 
 BAR_WIDTH = 30
-PROGRESS_DRAIN_S = 1.0  # how long the last progress messages may trail the answer
 UINT32_MAX = 2**32 - 1
+CANCEL_WAIT_S = 10.0
 
 
 def count(text: str) -> int:
-    """Return ``text`` as a whole number that fits the request's uint32 fields."""
+    """Return ``text`` as a whole number that fits the goal's uint32 fields."""
     value = int(text)
     if not 0 <= value <= UINT32_MAX:
         raise argparse.ArgumentTypeError(f'must be in [0, {UINT32_MAX}], got {value}')
@@ -37,103 +39,142 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--iterations', type=count, default=0,
                         help='PSO iterations (0: default)')
     parser.add_argument('--swarm', type=count, default=0, help='PSO particles (0: default)')
+    parser.add_argument('--no-library', action='store_true',
+                        help='always fit, even if the gait library holds this wave')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
     parser.add_argument('--timeout', type=float, default=120.0,
                         help='seconds to wait for the answer')
 
 
-def progress_line(iteration: float, best_loss: float, total: float) -> str:
-    """Return a one-line text progress bar for the tuner's progress message."""
+def progress_line(iteration: int, best_loss: float, total: int) -> str:
+    """Return a one-line text progress bar for one feedback message."""
     fraction = min(max(iteration / total, 0.0), 1.0) if total > 0 else 0.0
     filled = int(round(fraction * BAR_WIDTH))
     return (f'[{"#" * filled}{"." * (BAR_WIDTH - filled)}] '
-            f'iteration {int(iteration)}/{int(total)}  best loss {best_loss:.4f}')
+            f'iteration {iteration}/{total}  best loss {best_loss:.4f}')
 
 
-def result_table(response) -> str:
-    """Return the tuner's answer as an aligned text table."""
-    params = response.params
+def feedback_line(iteration: int, best_loss: float, total: int, rmse) -> str:
+    """Return one plain line for one feedback message (when stderr is not a terminal)."""
+    return (f'iteration {iteration}/{total} best loss {best_loss:.6g} m*s RMSE theta '
+            f'{rmse[0]:.3f}/{rmse[1]:.3f} deg')
+
+
+def result_table(result) -> str:
+    """Return the tuner's result as an aligned text table."""
+    params = result.params
     rows = [
-        ('success', str(response.success)),
-        ('message', response.message),
+        ('success', str(result.success)),
+        ('message', result.message),
         ('frequency_hz', f'{params.frequency_hz:.4f}'),
         ('amplitude_1 / _2 (rad)', f'{params.amplitude[0]:+.4f} / {params.amplitude[1]:+.4f}'),
         ('w12 / w21', f'{params.w12:+.4f} / {params.w21:+.4f}'),
         ('phi12 / phi21 (rad)', f'{params.phi12:+.4f} / {params.phi21:+.4f}'),
         ('alpha', f'{params.alpha:.2f}'),
-        ('loss', f'{response.loss:.5g}'),
+        ('loss', f'{result.loss:.5g}'),
         ('RMSE theta1 / theta2 (deg)',
-         f'{response.rmse_theta_deg[0]:.4f} / {response.rmse_theta_deg[1]:.4f}'),
-        ('iterations', str(response.iterations)),
-        ('elapsed (s)', f'{response.elapsed_s:.3f}'),
+         f'{result.rmse_theta_deg[0]:.4f} / {result.rmse_theta_deg[1]:.4f}'),
+        ('iterations', str(result.iterations)),
+        ('elapsed (s)', f'{result.elapsed_s:.3f}'),
+        ('applied', str(result.applied)),
+        ('from library', str(result.from_library)),
     ]
     width = max(len(name) for name, _ in rows)
     return '\n'.join(f'{name:<{width}}  {value}' for name, value in rows)
 
 
+def goal_of(args: argparse.Namespace, goal_type):
+    """Return the action goal of the command-line options."""
+    goal = goal_type()
+    goal.wave.c1, goal.wave.c2, goal.wave.k = args.c1, args.c2, args.k
+    goal.wave.frequency_hz = args.freq
+    goal.apply = args.apply
+    goal.seed = args.seed
+    goal.max_iterations = args.iterations
+    goal.swarm_size = args.swarm
+    goal.use_library = not args.no_library
+    return goal
+
+
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish retune`; return 0 when the tuner reports success."""
     import rclpy
+    from rclpy.action import ActionClient
     from rclpy.executors import SingleThreadedExecutor
-    from std_msgs.msg import Float64MultiArray
-    from wirefish_msgs.srv import RetuneGait
+    from rclpy.signals import SignalHandlerOptions
+    from wirefish_common.qos import reliable
+    from wirefish_msgs.action import RetuneGait
 
     try:
         namespace = validate_namespace(args.namespace)
     except ValueError as error:
         print(f'wirefish retune: {error}', file=sys.stderr)
         return 2
-    rclpy.init()
+    # Ctrl-C arrives as KeyboardInterrupt here (rclpy's handler off), so the goal is canceled.
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node('wirefish_retune', namespace=namespace)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
-    client = node.create_client(RetuneGait, 'retune_gait')
-    shown: list[int] = []  # iterations drawn
+    # Every iteration's feedback kept (the default depth of 10 drops most of a fast fit's).
+    client = ActionClient(node, RetuneGait, 'retune_gait',
+                          feedback_sub_qos_profile=reliable(1000))
+    terminal = sys.stderr.isatty()
+    drawn = [False]
 
-    def on_progress(msg: Float64MultiArray) -> None:
-        if len(msg.data) >= 3:
-            print('\r' + progress_line(msg.data[0], msg.data[1], msg.data[2]), end='',
+    def on_feedback(message) -> None:
+        f = message.feedback
+        if terminal:
+            print('\r' + progress_line(f.iteration, f.best_loss, f.max_iterations), end='',
                   file=sys.stderr, flush=True)
-            shown.append(int(msg.data[0]))
+            drawn[0] = True
+        else:
+            print(feedback_line(f.iteration, f.best_loss, f.max_iterations, f.rmse_theta_deg),
+                  file=sys.stderr, flush=True)
 
-    node.create_subscription(Float64MultiArray, 'retune_progress', on_progress, 10)
+    def spin_until(done, deadline: float) -> bool:
+        while not done() and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        return done()
+
+    handle = None
     try:
-        if not client.wait_for_service(timeout_sec=10.0):
-            print(f'wirefish retune: no {namespace}/retune_gait service: is the graph running '
+        if not client.wait_for_server(timeout_sec=10.0):
+            print(f'wirefish retune: no {namespace}/retune_gait action: is the graph running '
                   '(wirefish up / make run)?', file=sys.stderr)
             return 1
-        request = RetuneGait.Request()
-        request.wave.c1, request.wave.c2, request.wave.k = args.c1, args.c2, args.k
-        request.wave.frequency_hz = args.freq
-        request.apply = args.apply
-        request.seed = args.seed
-        request.max_iterations = args.iterations
-        request.swarm_size = args.swarm
-        time.sleep(0.3)  # let the progress subscription match before the run starts
-        future = client.call_async(request)
         deadline = time.monotonic() + args.timeout
-        while not future.done() and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.1)
-        if future.done() and future.result().success:
-            # The answer can overtake the last progress messages: draw them before the table.
-            drain_until = time.monotonic() + PROGRESS_DRAIN_S
-            while (not shown or shown[-1] < future.result().iterations) \
-                    and time.monotonic() < drain_until:
-                executor.spin_once(timeout_sec=0.05)
-        if shown:
-            print(file=sys.stderr)
-        if not future.done():
+        sent = client.send_goal_async(goal_of(args, RetuneGait.Goal),
+                                      feedback_callback=on_feedback)
+        if not spin_until(sent.done, deadline):
             print(f'wirefish retune: no answer within {args.timeout:g} s', file=sys.stderr)
             return 1
-        response = future.result()
-        if not response.success:  # nothing was fitted or applied: the reason is the answer
-            print(f'wirefish retune: {response.message}', file=sys.stderr)
+        handle = sent.result()
+        if not handle.accepted:
+            print('wirefish retune: busy: the tuner rejected the goal because a fit is '
+                  'running; retry when it finishes', file=sys.stderr)
             return 1
-        print(result_table(response))
-        return 0 if math.isfinite(response.loss) else 1
+        result_future = handle.get_result_async()
+        if not spin_until(result_future.done, deadline):
+            print(f'wirefish retune: no result within {args.timeout:g} s', file=sys.stderr)
+            return 1
+        if drawn[0]:
+            print(file=sys.stderr)
+        result = result_future.result().result
+        if not result.success:  # nothing was fitted or applied: the reason is the answer
+            print(f'wirefish retune: {result.message}', file=sys.stderr)
+            return 1
+        print(result_table(result))
+        return 0 if math.isfinite(result.loss) else 1
     except KeyboardInterrupt:
+        if drawn[0]:
+            print(file=sys.stderr)
+        if handle is not None and handle.accepted:
+            canceling = handle.cancel_goal_async()
+            spin_until(canceling.done, time.monotonic() + CANCEL_WAIT_S)
+            print('wirefish retune: canceled (nothing applied)', file=sys.stderr)
         return 130
     finally:
+        client.destroy()
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()

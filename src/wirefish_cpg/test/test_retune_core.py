@@ -1,12 +1,17 @@
 """The one fitting core of the retune service and action (wirefish_cpg.retune_core)."""
 
+from dataclasses import replace
 import math
 
 import numpy as np
 import pytest
 from wirefish_cpg.feasibility import FitLimits
+from wirefish_cpg.gait_library import GaitLibrary
 from wirefish_cpg.pso import PsoOptions
-from wirefish_cpg.retune_core import FitCancelled, retune, RetuneOrder, RetuneSettings
+from wirefish_cpg.retune_core import (FitCancelled, gait_of, retune, RetuneOrder,
+                                      RetuneSettings)
+from wirefish_cpg.wave_loss import WaveSpec
+from wirefish_kinematics.geometry import FishGeometry
 
 SHORT = RetuneSettings(pso=PsoOptions(swarm_size=20, max_iterations=30))
 
@@ -77,3 +82,28 @@ def test_a_cancel_raised_by_progress_stops_the_fit_at_that_iteration():
 def test_the_same_seed_gives_the_same_fit():
     first, second = (retune(order(seed=7), SHORT) for _ in range(2))
     assert first.params == second.params and first.loss == second.loss
+
+
+def test_a_wave_in_the_library_is_answered_from_it_without_fitting():
+    fitted = retune(order(), SHORT)
+    library = GaitLibrary().with_gait(gait_of(order(), fitted, SHORT))
+    calls = []
+    again = retune(order(seed=5), SHORT, lambda *a: calls.append(a), library)
+    assert again.success and again.from_library and calls == []
+    assert again.params == fitted.params and again.iterations == 0
+    assert again.message.startswith('from the gait library')
+
+
+def test_the_library_is_not_used_for_another_geometry_or_when_not_asked():
+    fitted = retune(order(), SHORT)
+    library = GaitLibrary().with_gait(gait_of(order(), fitted, SHORT))
+    other_fish = RetuneSettings(pso=SHORT.pso, geometry=FishGeometry(l2=0.11))
+    assert not retune(order(), other_fish, library=library).from_library
+    assert not retune(order(use_library=False), SHORT, library=library).from_library
+
+
+def test_infeasible_waves_are_refused_even_when_the_library_holds_them():
+    fitted = retune(order(), SHORT)
+    bogus = replace(gait_of(order(), fitted, SHORT), wave=WaveSpec(c1=1e6))
+    outcome = retune(order(c1=1e6), SHORT, library=GaitLibrary().with_gait(bogus))
+    assert not outcome.success and outcome.message.startswith('rejected')

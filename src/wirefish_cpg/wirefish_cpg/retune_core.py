@@ -7,7 +7,8 @@ whoever asked (paper section 4, eqs 23-27):
 1. ``order_problem``: the order's values are valid (finite, in range);
 2. ``feasibility.wave_infeasibility``: the tail can follow the wave at all;
 3. the gait library, when asked (``use_library``): the same wave on the same geometry is
-   answered from it without fitting;
+   answered from it without fitting (``gait_library``; the caller stores new fits with
+   ``gait_of``);
 4. ``tuning.fit_gait``, with a per-iteration callback that may stop the fit (cancel);
 5. ``feasibility.fit_rejection``: the fit is good enough to run.
 
@@ -17,18 +18,20 @@ No rclpy here: the nodes translate messages to ``RetuneOrder`` and ``RetuneOutco
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import math
 import time
 
 import numpy as np
 from wirefish_cpg.feasibility import fit_rejection, FitLimits, wave_infeasibility
+from wirefish_cpg.gait_library import Gait, GaitLibrary
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait
 from wirefish_cpg.wave_loss import (PAPER_UPPER, swing_angle_rmse_deg, WaveFitProblem,
                                     WaveSpec)
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS
 
 MAX_SWARM_SIZE = 2000
 MAX_ITERATIONS = 5000
@@ -69,6 +72,10 @@ class RetuneSettings:
     upper: tuple[float, ...] = tuple(PAPER_UPPER)
     alpha: float = 20.0
     samples_per_period: int = 48
+
+    def geometry_fields(self) -> dict[str, float]:
+        """Return the geometry values the fit depends on (the library's geometry key), m."""
+        return {name: getattr(self.geometry, name) for name in BODY_WAVE_GEOMETRY_FIELDS}
 
     def options_for(self, order: RetuneOrder) -> PsoOptions:
         """Return the PSO options of an order: its counts where given, else the defaults."""
@@ -137,13 +144,16 @@ def order_problem(order: RetuneOrder) -> str | None:
 
 
 def retune(order: RetuneOrder, settings: RetuneSettings,
-           progress: RetuneProgress | None = None) -> RetuneOutcome:
+           progress: RetuneProgress | None = None, library: GaitLibrary | None = None
+           ) -> RetuneOutcome:
     """
-    Validate, judge feasible, fit and judge the fit of one order (steps 1, 2, 4, 5 above).
+    Validate, judge feasible, look up or fit, and judge the fit of one order (steps 1-5).
 
     ``progress`` is called after the initial swarm and after every PSO iteration; a
-    ``FitCancelled`` it raises propagates (the caller reports the cancel).
+    ``FitCancelled`` it raises propagates (the caller reports the cancel). The library is
+    consulted only when ``order.use_library``; a gait found there is given the current alpha.
     """
+    start = time.perf_counter()
     reason = order_problem(order)
     if reason is not None:
         return RetuneOutcome(False, f'rejected: {reason}')
@@ -154,7 +164,26 @@ def retune(order: RetuneOrder, settings: RetuneSettings,
     reason = wave_infeasibility(problem, settings.limits)
     if reason is not None:
         return RetuneOutcome(False, f'rejected: {reason}')
+    if order.use_library and library is not None:
+        gait = library.find(problem.wave, settings.geometry_fields())
+        if gait is not None:
+            return RetuneOutcome(
+                True, f'from the gait library (fitted {gait.fitted_at}): '
+                      f'{figures_phrase(gait.loss, 0, gait.rmse_theta_deg)}',
+                params=replace(gait.params, alpha=settings.alpha), loss=gait.loss,
+                rmse_theta_deg=gait.rmse_theta_deg, iterations=0,
+                elapsed_s=time.perf_counter() - start, from_library=True)
     return fit_order(order, problem, settings, progress)
+
+
+def gait_of(order: RetuneOrder, outcome: RetuneOutcome, settings: RetuneSettings) -> Gait:
+    """Return the library entry of a successful fit of ``order``."""
+    if not outcome.success or outcome.params is None:
+        raise ValueError('only a successful fit is a gait')
+    wave = settings.problem_for(order).wave
+    return Gait(wave=wave, geometry=tuple(sorted(settings.geometry_fields().items())),
+                params=outcome.params, loss=outcome.loss,
+                rmse_theta_deg=outcome.rmse_theta_deg)
 
 
 def fit_order(order: RetuneOrder, problem: WaveFitProblem, settings: RetuneSettings,

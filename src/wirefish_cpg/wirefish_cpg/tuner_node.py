@@ -1,55 +1,60 @@
 """
 tuner_node: fits the CPG to a desired body wave on request (paper section 4, eqs 23-27).
 
-Service
-    ``retune_gait`` (wirefish_msgs/srv/RetuneGait). Every request is answered, however many
-    arrive at once: the service keeps up to 1000 requests (``SERVICE_QOS``), refusals are
-    immediate, answers are paced 20 ms apart so that no client's answer is pushed out of its
-    queue by the others' (``answered_service``), and one fit runs at a time: a request arriving
-    while one runs is refused with ``success: false`` ("busy"), not queued. The request is
-    judged by ``wirefish_cpg.retune_core`` (values, then whether the tail can follow the wave
-    at all: ``wirefish_cpg.feasibility``), fitted, and the fit judged
-    (finite loss, swing-angle RMSE <= ``max_rmse_deg``); a refused wave or fit answers
-    ``success: false`` with the reason and the figures, and is never applied. With
-    ``apply: true`` the fitted parameters are set on the CPG node through its standard
-    ``<cpg_node_name>/set_parameters_atomically`` service (the same change as ``ros2 param
-    set``), and success is reported only after the CPG node accepted them. Offsets are not
-    touched (the fit assumes b = 0).
-Publishes
-    ``retune_progress`` (std_msgs/Float64MultiArray, reliable, depth 10) while a fit runs, once
-    per PSO iteration: ``data = [iteration, best_loss (m*s), max_iterations]``; iteration 0 is
-    the initial swarm, and the run can end before max_iterations when the loss stalls.
-    ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local, depth 1): the wave
-    the CPG runs, published only once a fit was applied.
-The fit runs in the service callback on a multi-threaded executor; the service and the
-parameter client sit in separate callback groups, so the node keeps serving (parameters,
-refusals, the parameter-service response) while a fit runs.
+Service ``retune_gait`` (wirefish_msgs/srv/RetuneGait) and action ``retune_gait``
+(wirefish_msgs/action/RetuneGait) share one fitting core (``wirefish_cpg.retune_core``) and
+one busy lock: one fit at a time. Every order is judged (values; whether the tail can follow
+the wave at all, ``wirefish_cpg.feasibility``), fitted, and the fit judged (finite loss,
+swing-angle RMSE <= ``max_rmse_deg``); a refused wave or fit answers ``success: false`` with
+the reason and the figures and is never applied. With ``apply: true`` the fitted parameters are
+set on the CPG node through its standard ``<cpg_node_name>/set_parameters_atomically`` service
+(the same change as ``ros2 param set``), and success is reported only after the CPG node
+accepted them. Offsets are not touched (the fit assumes b = 0).
+
+Service: every request is answered, however many arrive at once: the service keeps up to 1000
+requests (``SERVICE_QOS``), answers are paced 20 ms apart so that no client's answer is pushed
+out of its queue by the others' (``answered_service``), and a request during a fit is refused
+at once ("busy"), not queued. The service always fits (same seed, same result) and does not
+read the library.
+Action: feedback after the initial swarm and every PSO iteration (iteration, best loss, RMSE of
+the best so far); cancel stops the fit before the next iteration and applies nothing; a goal
+sent during a fit (from either) is REJECTED at once; ``use_library`` (default true) answers a
+wave the library holds for this geometry without fitting.
+Gait library (``library_path``, ``wirefish_cpg.gait_library``): every successful fit is stored
+(YAML, atomic write, merged with what other writers added); read at start-up and whenever the
+file changes.
+Publishes ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local, depth 1):
+the wave the CPG runs, only once a fit was applied.
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 import threading
 
 from rcl_interfaces.msg import Parameter as ParameterMsg, SetParametersResult
 from rcl_interfaces.srv import SetParametersAtomically
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from std_msgs.msg import Float64MultiArray
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
-from wirefish_common.qos import LATCHED, RELIABLE, reliable
+from wirefish_common.qos import LATCHED, reliable
 from wirefish_cpg.answered_service import pace_answers
 from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.feasibility import FitLimits
+from wirefish_cpg.gait_library import default_library_path, Gait, GaitLibrary, LibraryFile
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
-from wirefish_cpg.retune_core import (MAX_ITERATIONS, MAX_SWARM_SIZE, retune, RetuneOrder,
-                                      RetuneOutcome, RetuneSettings)
+from wirefish_cpg.retune_core import (FitCancelled, gait_of, MAX_ITERATIONS, MAX_SWARM_SIZE,
+                                      retune, RetuneOrder, RetuneOutcome, RetuneProgress,
+                                      RetuneSettings)
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS, geometry_parameters
+from wirefish_msgs.action import RetuneGait as RetuneGaitAction
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
 
@@ -88,19 +93,28 @@ TUNER_PARAMETERS = (
     ParameterSpec('samples_per_period', 48, 'Quadrature points of the loss per period', 8,
                   2000),
     ParameterSpec('apply_timeout_s', 5.0, 'Wait for the CPG node to accept (s)', 0.1, 60.0),
+    ParameterSpec('library_path', str(default_library_path()),
+                  'Gait library file (YAML): read at start-up and when changed, every '
+                  'successful fit stored; default $ROS_HOME/wirefish/gaits.yaml or '
+                  '~/.ros/wirefish/gaits.yaml'),
 ) + geometry_parameters(GEOMETRY_FIELDS)
 SPECS = {spec.name: spec for spec in TUNER_PARAMETERS}
 # A burst of requests must fit the service's own DDS queues while a fit holds the executor;
 # its clients' queues are protected by pacing the answers (answered_service).
 SERVICE_QOS = reliable(depth=1000)
+# Feedback of every iteration (hundreds per second) must not overwrite itself in the writer's
+# history before a client takes it; a client keeps what its own depth allows (rclpy: 10).
+FEEDBACK_QOS = reliable(depth=1000)
+BUSY = 'busy: a retune is already running; retry when it finishes'
+CANCELED = 'canceled: nothing applied'
 
 
-def order_of(request: RetuneGait.Request) -> RetuneOrder:
-    """Return the retune order of a service request (the library is not used by the service)."""
+def order_of(request, use_library: bool = False) -> RetuneOrder:
+    """Return the retune order of a service request or action goal (same fields)."""
     wave = request.wave
     return RetuneOrder(c1=wave.c1, c2=wave.c2, k=wave.k, frequency_hz=wave.frequency_hz,
                        seed=request.seed, max_iterations=request.max_iterations,
-                       swarm_size=request.swarm_size, use_library=False)
+                       swarm_size=request.swarm_size, use_library=use_library)
 
 
 def parameter_messages(params: CpgParameters) -> list[ParameterMsg]:
@@ -113,25 +127,49 @@ def parameter_messages(params: CpgParameters) -> list[ParameterMsg]:
 
 
 class TunerNode(Node):
-    """Serves retune_gait: PSO fit of the CPG to a body wave, optionally applied."""
+    """Serves the retune_gait service and action: PSO fits of the CPG to a body wave."""
 
     def __init__(self, **kwargs) -> None:
-        """Declare the parameters; wire the service, publishers and the parameter client."""
+        """Declare the parameters; wire the service, the action, publishers, the library."""
         super().__init__('tuner_node', **kwargs)
         declare(self, TUNER_PARAMETERS)
         self.add_on_set_parameters_callback(self._validate)
-        self._busy = threading.Lock()
-        self._progress_pub = self.create_publisher(Float64MultiArray, 'retune_progress',
-                                                   RELIABLE)
+        self.add_post_set_parameters_callback(self._on_parameters_set)
+        self._busy = threading.Lock()  # one fit at a time, service or action
+        self._library = LibraryFile(Path(self._value('library_path')))
+        self._load_library()
         self._wave_pub = self.create_publisher(BodyWaveSpec, 'target_wave', LATCHED)
         self._client_group = MutuallyExclusiveCallbackGroup()
         self._param_clients: dict[str, object] = {}
+        serving = ReentrantCallbackGroup()
         pace_answers(self.create_service(
             RetuneGait, 'retune_gait', self._on_retune, qos_profile=SERVICE_QOS,
-            callback_group=ReentrantCallbackGroup()))
+            callback_group=serving))
+        self._action = ActionServer(
+            self, RetuneGaitAction, 'retune_gait', execute_callback=self._execute_goal,
+            goal_callback=self._on_goal, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
+            callback_group=serving, feedback_pub_qos_profile=FEEDBACK_QOS)
+
+    def destroy_node(self) -> None:
+        """Destroy the action server, then the node."""
+        self._action.destroy()
+        super().destroy_node()
 
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
         return validate_update(SPECS, {}, parameters)
+
+    def _on_parameters_set(self, parameters: list[Parameter]) -> None:
+        if any(p.name == 'library_path' for p in parameters):
+            self._library = LibraryFile(Path(self._value('library_path')))
+            self._load_library()
+
+    def _load_library(self) -> None:
+        try:
+            count = len(self._library.current().gaits)
+        except (OSError, ValueError) as error:
+            self.get_logger().error(f'gait library unreadable, not used: {error}')
+            return
+        self.get_logger().info(f'gait library {self._library.path}: {count} gaits')
 
     def _value(self, name: str):
         return self.get_parameter(name).value
@@ -165,17 +203,11 @@ class TunerNode(Node):
                    ) -> RetuneGait.Response:
         if not self._busy.acquire(blocking=False):
             response.success = False
-            response.message = 'busy: a retune is already running; retry when it finishes'
+            response.message = BUSY
             return response
         try:
-            max_iterations = float(request.max_iterations or self._value('max_iterations'))
-
-            def progress(iteration: int, best_loss: float, _rmse) -> None:
-                self._progress_pub.publish(Float64MultiArray(
-                    data=[float(iteration), best_loss, max_iterations]))
-
-            outcome = retune(order_of(request), self._settings(), progress)
-            success, message = self._conclude(outcome, request.apply, request.wave)
+            outcome, success, message, _applied = self._serve(order_of(request),
+                                                              request.apply, request.wave)
         except Exception as error:  # noqa: B902 (answer, and keep serving, whatever failed)
             self.get_logger().error(f'retune failed: {error!r}')
             response.success, response.message = False, f'failed: {error!r}'
@@ -186,16 +218,89 @@ class TunerNode(Node):
         response.success, response.message = success, message
         return response
 
-    def _conclude(self, outcome: RetuneOutcome, apply: bool, wave: BodyWaveSpec
-                  ) -> tuple[bool, str]:
-        """Apply a successful outcome if asked; return (success, message) of the answer."""
-        if not outcome.success or not apply:
-            return outcome.success, outcome.message
+    def _on_goal(self, _goal: RetuneGaitAction.Goal) -> GoalResponse:
+        # Documented: a goal during a fit is rejected at once (the client sees accepted false);
+        # an accepted goal holds the busy lock until its execution ends.
+        return GoalResponse.ACCEPT if self._busy.acquire(blocking=False) else GoalResponse.REJECT
+
+    def _execute_goal(self, goal_handle) -> RetuneGaitAction.Result:
+        goal = goal_handle.request
+        result = RetuneGaitAction.Result()
+        try:
+            order = order_of(goal, use_library=goal.use_library)
+            limit = order.max_iterations or self._value('max_iterations')
+
+            def progress(iteration: int, best_loss: float, rmse) -> None:
+                if goal_handle.is_cancel_requested:
+                    raise FitCancelled(iteration)
+                goal_handle.publish_feedback(RetuneGaitAction.Feedback(
+                    iteration=iteration, max_iterations=limit, best_loss=float(best_loss),
+                    rmse_theta_deg=[float(v) for v in rmse]))
+
+            outcome, success, message, applied = self._serve(
+                order, goal.apply, goal.wave, progress,
+                cancelled=lambda: goal_handle.is_cancel_requested)
+            fill_response(result, outcome)
+            result.success, result.message, result.applied = success, message, applied
+            result.from_library = outcome.from_library
+            if message == CANCELED and not applied:
+                goal_handle.canceled()
+            elif success:
+                goal_handle.succeed()
+            else:
+                goal_handle.abort()
+        except FitCancelled as stop:
+            result.success, result.message = False, f'{CANCELED} at iteration {stop.args[0]}'
+            goal_handle.canceled()
+        except Exception as error:  # noqa: B902 (answer, and keep serving, whatever failed)
+            self.get_logger().error(f'retune goal failed: {error!r}')
+            result.success, result.message = False, f'failed: {error!r}'
+            goal_handle.abort()
+        finally:
+            self._busy.release()
+        return result
+
+    def _serve(self, order: RetuneOrder, apply: bool, wave: BodyWaveSpec,
+               progress: RetuneProgress | None = None,
+               cancelled=lambda: False) -> tuple[RetuneOutcome, bool, str, bool]:
+        """
+        Run one order through the core; store a new fit; apply it if asked.
+
+        Returns (outcome, success, message, applied); ``FitCancelled`` from ``progress``
+        propagates. A cancel that arrives after the fit but before applying still cancels.
+        """
+        settings = self._settings()
+        library = self._library_now() if order.use_library else None
+        outcome = retune(order, settings, progress, library)
+        if outcome.success and not outcome.from_library:
+            self._store(gait_of(order, outcome, settings))
+        if not outcome.success:
+            return outcome, False, outcome.message, False
+        if cancelled():
+            return outcome, False, CANCELED, False
+        if not apply:
+            return outcome, True, outcome.message, False
         reason = self._apply(outcome.params)
+        fitted = outcome.message if outcome.from_library else f'fitted ({outcome.summary()})'
         if reason is not None:
-            return False, f'fitted ({outcome.summary()}) but not applied: {reason}'
+            return outcome, False, f'{fitted} but not applied: {reason}', False
         self._wave_pub.publish(wave)  # the wave the CPG now runs (kinematics overlay)
-        return True, f'fitted and applied: {outcome.summary()}'
+        applied = (f'{outcome.message}; applied' if outcome.from_library
+                   else f'fitted and applied: {outcome.summary()}')
+        return outcome, True, applied, True
+
+    def _library_now(self) -> GaitLibrary | None:
+        try:
+            return self._library.current()
+        except (OSError, ValueError) as error:
+            self.get_logger().warning(f'gait library unreadable, fitting instead: {error}')
+            return None
+
+    def _store(self, gait: Gait) -> None:
+        try:
+            self._library.add([gait])
+        except (OSError, ValueError) as error:
+            self.get_logger().warning(f'fit not stored in the gait library: {error}')
 
     def _apply(self, params: CpgParameters) -> str | None:
         """Set the fit on the CPG node atomically; return why it failed, or None."""
@@ -216,8 +321,8 @@ class TunerNode(Node):
         return None
 
 
-def fill_response(response: RetuneGait.Response, outcome: RetuneOutcome) -> None:
-    """Copy an outcome's figures into a service response (success/message set by the caller)."""
+def fill_response(response, outcome: RetuneOutcome) -> None:
+    """Copy an outcome's figures into a service response or action result."""
     if outcome.params is not None:
         response.params = to_message(outcome.params)
     response.loss = float(outcome.loss)
