@@ -154,3 +154,19 @@ def test_a_port_refused_before_opening_is_never_opened_and_is_retried():
     assert opened == [] and link.stats.last_error == '/dev/fake is stale'
     assert [r for r in reports if 'stale' in r] == ['cannot open /dev/fake: /dev/fake is stale; '
                                                     'retrying']
+
+
+def test_a_later_open_failure_replaces_the_not_identified_reason():
+    written, attempts = [], []
+
+    def factory(*args, **kwargs):
+        attempts.append(args[0])
+        if len(attempts) > 1:
+            raise serial.SerialException('could not open port: gone')
+        return SilentPort(written)
+    link = SerialLink('/dev/fake', 115200, lambda chunk: None, identify_timeout_s=0.02,
+                      backoff_min_s=0.001, backoff_max_s=0.002, serial_factory=factory)
+    link.start()
+    assert _wait(lambda: link.stats.identify_timeouts == 1 and link.stats.open_failures >= 1)
+    link.stop()
+    assert not link.stats.last_open_unidentified and 'gone' in link.stats.last_error

@@ -77,7 +77,7 @@ class LinkStats:
     write_failures: int = 0
     writes_withheld: int = 0   # writes refused because the peer had not identified itself
     identify_timeouts: int = 0  # opens closed again: the peer never identified itself
-    last_open_unidentified: bool = False  # the last open ended so (reset when one identifies)
+    last_open_unidentified: bool = False  # the last open ended so (until the next event)
     last_error: str = ''
     callback_errors: int = 0  # exceptions raised by on_data (the reader goes on)
 
@@ -212,6 +212,7 @@ class SerialLink:
             port.reset_input_buffer()  # stale bytes from before we were listening
         except (LinkRefused, serial.SerialException, OSError, ValueError) as error:
             self.stats.open_failures += 1
+            self.stats.last_open_unidentified = False   # this failure is the news now
             reason = _open_failure(self.port, error)
             if reason != self.stats.last_error:  # say it once, not at every retry
                 self._on_state(self.state, f'cannot open {self.port}: {reason}; retrying')
@@ -259,6 +260,7 @@ class SerialLink:
             except (serial.SerialException, OSError, TypeError, AttributeError) as error:
                 # TypeError/AttributeError: pyserial's read on a port closed under it.
                 self.stats.disconnects += 1
+                self.stats.last_open_unidentified = False
                 self.stats.last_error = str(error)
                 self._close()
                 self._set_state(LinkState.DISCONNECTED, f'{self.port} lost: {error}')
