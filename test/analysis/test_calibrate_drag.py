@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from wirefish_analysis.calibrate_drag import (calibrated_drag_coefficient, least_squares_drag,
                                               PAPER_POINTS, point_means, predict)
-from wirefish_cpg.table1_gait import table1_locked_at, tip_half_amplitude
+from wirefish_cpg.table1_gait import amplitude_scale_for, table1_locked_at, tip_half_amplitude
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import steady_speed
 
@@ -84,3 +84,8 @@ def test_eq18_swimming_number_does_not_depend_on_frequency_for_one_tail_shape():
     sw = [float(steady_speed(*point_means(p, FishGeometry()), FishGeometry())) / p.frequency_hz
           for p in (slow, fast)]
     assert sw[0] == pytest.approx(sw[1], rel=1e-6)
+
+
+def test_an_unreachable_tip_amplitude_is_refused_with_its_reach():
+    with pytest.raises(ValueError, match='out of reach'):
+        amplitude_scale_for(0.5, 1.0, FishGeometry())

@@ -64,12 +64,20 @@ def locked_speed_estimate(params: CpgParameters, geometry: FishGeometry) -> Spee
 
 def amplitude_scale_for(tip_amplitude: float, frequency_hz: float,
                         geometry: FishGeometry) -> float:
-    """Return the factor on Table 1's R_i that gives the tail tip this half amplitude (m)."""
+    """
+    Return the factor on Table 1's R_i that gives the tail tip this half amplitude (m).
+
+    Raises ``ValueError`` when the amplitude is out of reach with |R_i| <= pi/2 on ``geometry``.
+    """
     limit = 0.999 * (math.pi / 2) / max(abs(r) for r in TABLE1.amplitude)  # |R_i| <= pi/2
 
     def miss(scale: float) -> float:
         return tip_half_amplitude(table1_locked_at(frequency_hz, scale), geometry) - tip_amplitude
 
+    if miss(limit) < 0.0:
+        raise ValueError(f'a tail-tip half amplitude of {100 * tip_amplitude:g} cm is out of '
+                         f'reach with |R_i| <= pi/2 on this geometry (at most '
+                         f'{100 * (miss(limit) + tip_amplitude):.2f} cm)')
     return float(brentq(miss, 1e-6, limit, xtol=1e-12))
 
 
