@@ -1,12 +1,19 @@
-"""The supervisor tracks and stops every process it starts, even several of the same name."""
+"""
+The supervisor tracks, restarts and stops every process it starts.
+
+Even several of the same name are stopped; an exiting one is restarted by its policy: back-off,
+a budget, then given up or, if required, an error that stops the graph.
+"""
+
+import time
 
 import psutil
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
-from wirefish_bringup.graph import NodeSpec
-from wirefish_bringup.supervisor import Supervisor
+from wirefish_bringup.graph import NO_RESTART, NodeSpec, RestartPolicy
+from wirefish_bringup.supervisor import ProcessExitedError, Supervisor
 
 pytestmark = pytest.mark.ros
 
@@ -32,3 +39,56 @@ def test_same_named_processes_are_all_stopped_with_exit_code_0(tmp_path, ros_env
     codes = supervisor.stop()
     assert codes == {'cpg_node_2': 0, 'cpg_node': 0}
     assert sorted(p.name for p in tmp_path.glob('*.log')) == ['cpg_node.log', 'cpg_node_2.log']
+
+
+def _failing_cpg(policy: RestartPolicy) -> NodeSpec:
+    # A rate the CPG refuses: it exits 1 at once at every start.
+    return NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node',
+                    ('--ros-args', '-p', 'publish_rate_hz:=-1.0'), restart=policy)
+
+
+def _supervise_until(supervisor: Supervisor, done, timeout_s: float = 60.0) -> list[str]:
+    lines: list[str] = []
+    deadline = time.monotonic() + timeout_s
+    while not done() and time.monotonic() < deadline:
+        lines += supervisor.supervise()
+        time.sleep(0.02)
+    return lines
+
+
+def test_an_exiting_process_is_restarted_with_back_off_until_given_up(tmp_path, ros_env):
+    supervisor = Supervisor(tmp_path, env=ros_env)
+    supervisor.start(_failing_cpg(RestartPolicy(delay_s=0.1, backoff=3.0, max_restarts=2)))
+    try:
+        lines = _supervise_until(supervisor, lambda: 'cpg_node' in supervisor.given_up)
+    finally:
+        supervisor.stop()
+    restarts = [line for line in lines if 'restarting it in' in line]
+    assert [line.split(' in ')[1].split(' s ')[0] for line in restarts] == ['0.1', '0.3']
+    assert lines[-1].startswith('cpg_node exited with code 1 after 2 restarts within 60 s: '
+                                'given up, the rest keeps running'), lines
+    assert supervisor.summary() == ('restarts: cpg_node 2; '
+                                    'given up: cpg_node (last exit code 1)')
+    log = (tmp_path / 'cpg_node.log').read_text()
+    assert log.count('restarted by wirefish up') == 2  # one log, every start in it
+
+
+def test_a_required_process_that_spends_its_budget_raises(tmp_path, ros_env):
+    supervisor = Supervisor(tmp_path, env=ros_env)
+    supervisor.start(_failing_cpg(RestartPolicy(delay_s=0.1, max_restarts=1, required=True)))
+    try:
+        with pytest.raises(ProcessExitedError, match='it is required: stopping the graph'):
+            _supervise_until(supervisor, lambda: False)
+    finally:
+        supervisor.stop()
+    assert supervisor.budgets['cpg_node'].total == 1
+
+
+def test_a_process_whose_policy_does_not_respawn_is_given_up_at_once(tmp_path, ros_env):
+    supervisor = Supervisor(tmp_path, env=ros_env)
+    supervisor.start(_failing_cpg(NO_RESTART))
+    try:
+        lines = _supervise_until(supervisor, lambda: bool(supervisor.given_up))
+    finally:
+        supervisor.stop()
+    assert len(lines) == 1 and 'is not restarted (its policy)' in lines[0], lines
