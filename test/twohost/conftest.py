@@ -10,9 +10,9 @@ test here is skipped with the reason (CI runs as root, so they run there).
 from collections.abc import Iterator
 import os
 
-from twohost.link_hosts import Hosts
 import pytest
 from ros_utils import stop_process
+from twohost.link_hosts import Hosts
 
 DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21'))
 

@@ -1,6 +1,8 @@
 """
-Issue 17's acceptance across two hosts: the fish role in one network namespace, the shore role
-in another, DDS over a veth pair between them (multicast discovery, UDPv4 only: see netns.py).
+Issue 17's acceptance across two hosts, a fish and a shore, over a radio that fails.
+
+The fish role runs in one network namespace, the shore role in another, DDS over a veth pair
+between them (multicast discovery, UDPv4 only: see netns.py).
 
 One run, in phases (each needs the graph up, which takes most of the time): the fish swims
 (servo_cmd >= 190 Hz measured inside the fish's namespace) and the shore gets its copies of
@@ -15,8 +17,8 @@ topic arrives at its configured rate, with the bytes per second crossing each wa
 import re
 import time
 
-from twohost.link_hosts import wait_for
 import pytest
+from twohost.link_hosts import wait_for
 from wirefish_bringup.crossing import default_crossing_file, load_crossing
 from wirefish_bringup.netns import FISH, SHORE
 
