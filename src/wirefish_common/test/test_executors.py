@@ -51,9 +51,21 @@ def test_spin_until_stopped_spins_until_the_flag_is_set():
     assert executor.spins == 3
 
 
-def test_spin_until_stopped_ends_when_the_context_ends():
-    executor = FakeExecutor(FakeContext(ok_calls=2))
-    spin_until_stopped(executor, lambda: False)
+class ShutDown(Exception):
+    pass
+
+
+class EndingExecutor(FakeExecutor):
+    def spin_once(self, timeout_sec: float) -> None:
+        super().spin_once(timeout_sec)
+        if self.spins == 2:  # as rclpy's executors do once their context is shut down
+            raise ShutDown
+
+
+def test_spin_until_stopped_ends_when_spin_once_raises_on_a_shut_down_context():
+    executor = EndingExecutor(FakeContext(ok_calls=100))
+    with pytest.raises(ShutDown):
+        spin_until_stopped(executor, lambda: False)
     assert executor.spins == 2
 
 
