@@ -87,3 +87,50 @@ def test_bisection_finds_the_feasible_scale_the_linear_rule_gives(gait_planner, 
     general = GaitPlanner(_Table1NotDeclaredLinear(), GaitLimits())
     assert general.feasible_scale(frequency)[0] == pytest.approx(
         gait_planner.feasible_scale(frequency)[0], rel=1e-6)
+
+
+@pytest.fixture(scope='module')
+def library_file(tmp_path_factory):
+    """
+    Return a gait library file holding a 4 x 2 family of the section 5.2 wave.
+
+    The gaits are Table 1 locked at (f, s), stored as if fitted to the scaled wave: the test is
+    of the planner's plumbing (family, grid bounds, blending), not of a fit.
+    """
+    from wirefish_cpg.gait_family import scaled_wave
+    from wirefish_cpg.gait_library import Gait, GaitLibrary, geometry_key, save_library
+    from wirefish_cpg.wave_loss import WaveSpec
+    from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS
+
+    geometry = {name: getattr(FishGeometry(), name) for name in BODY_WAVE_GEOMETRY_FIELDS}
+    gaits = tuple(Gait(wave=scaled_wave(WaveSpec(), f, s), geometry=geometry_key(geometry),
+                       params=table1_locked_at(f, s), loss=0.0, rmse_theta_deg=(0.0, 0.0))
+                  for f in (0.5, 1.5, 2.5, 3.5) for s in (0.5, 1.0))
+    path = tmp_path_factory.mktemp('library') / 'gaits.yaml'
+    save_library(GaitLibrary(gaits), path)
+    return path
+
+
+def test_the_library_family_is_used_inside_its_grid(library_file, make_planner):
+    gaits = make_planner(gait_source='library', library_path=str(library_file)).gaits
+    assert gaits.family.name == 'library' and gaits.family_note == ''
+    choice = gaits.choose(0.2)
+    assert 0.5 <= choice.point.frequency_hz <= 3.5 and choice.point.amplitude_scale <= 1.0
+    assert choice.predicted_speed == pytest.approx(0.2, rel=1e-3)
+    assert gaits.fastest.frequency_hz <= 3.5  # the grid bounds the planner
+
+
+def test_without_a_library_family_the_planner_says_so_and_uses_table1(tmp_path, make_planner):
+    gaits = make_planner(gait_source='library', library_path=str(tmp_path / 'none.yaml')).gaits
+    assert gaits.family.name == 'table1' and 'gait library not used' in gaits.family_note
+
+
+def test_an_unknown_gait_source_is_refused(make_planner):
+    with pytest.raises(ValueError, match='gait_source'):
+        make_planner(gait_source='magic')
+
+
+def test_on_a_grid_point_the_library_family_gives_the_stored_gait(library_file, make_planner):
+    gaits = make_planner(gait_source='library', library_path=str(library_file)).gaits
+    stored = locked_speed_estimate(table1_locked_at(1.5, 1.0), FishGeometry()).speed
+    assert gaits.frontier_point(1.5).speed == pytest.approx(stored, rel=1e-6)

@@ -1,8 +1,11 @@
 """
 Forward speed -> gait: eq 18 inverted over a family of gaits (pure; no rclpy).
 
-A gait family maps (tail-beat frequency f, amplitude scale s) to CPG parameters. Today's family
-is Table 1 locked at f with both R_i scaled by s (``wirefish_cpg.table1_gait``). Each gait is
+A gait family maps (tail-beat frequency f, amplitude scale s) to CPG parameters: Table 1 locked
+at f with both R_i scaled by s (``Table1Family``, ``wirefish_cpg.table1_gait``), or the gait
+library's fitted family of a reference wave, envelope scaled by s at frequency f, interpolated
+between the fitted grid points (``LibraryFamily``, ``wirefish_cpg.gait_family``; only inside
+its grid, which bounds the planner's f and s). Each gait is
 judged on one locked period of its servo commands: the eq 18 speed (eqs 16-22, servos that
 follow exactly), the peak servo rate and the peak servo angle.
 
@@ -23,15 +26,20 @@ reason names the binding limit.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import functools
 import math
+from pathlib import Path
 from typing import Protocol
 
 import numpy as np
 from scipy.optimize import brentq
+from wirefish_cpg.gait_family import (family as library_members, FamilyMember,
+                                      interpolated_parameters)
+from wirefish_cpg.gait_library import load_library
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.table1_gait import one_locked_period, table1_locked_at
+from wirefish_cpg.wave_loss import WaveSpec
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import estimate_speed
 
@@ -44,6 +52,8 @@ class GaitFamily(Protocol):
 
     name: str
     linear_in_scale: bool  # servo angles and rates proportional to the amplitude scale
+    frequency_range: tuple[float, float] | None  # where the family is defined (Hz)
+    scale_range: tuple[float, float] | None
 
     def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
         """Return the CPG parameters of this gait."""
@@ -52,12 +62,63 @@ class GaitFamily(Protocol):
 class Table1Family:
     """Table 1 locked at f with R_i scaled by s (the analytic family, no fit needed)."""
 
-    name = 'table1'
-    linear_in_scale = True
+    name: str = 'table1'
+    linear_in_scale: bool = True
+    frequency_range: tuple[float, float] | None = None
+    scale_range: tuple[float, float] | None = None
 
     def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
         """Return Table 1 locked at ``frequency_hz`` with R_i scaled by ``amplitude_scale``."""
         return table1_locked_at(frequency_hz, amplitude_scale)
+
+
+class LibraryFamily:
+    """The gait library's fitted gaits of a reference wave, blended inside their grid."""
+
+    name: str = 'library'
+    linear_in_scale: bool = False
+    frequency_range: tuple[float, float] | None
+    scale_range: tuple[float, float] | None
+
+    def __init__(self, members: list[FamilyMember]) -> None:
+        """Keep a grid of at least 2 x 2 members (ValueError otherwise)."""
+        frequencies = sorted({m.frequency_hz for m in members})
+        scales = sorted({m.scale for m in members})
+        if len(frequencies) < 2 or len(scales) < 2:
+            raise ValueError(f'the library family has {len(members)} gaits over '
+                             f'{len(frequencies)} frequencies x {len(scales)} scales: a 2 x 2 '
+                             'grid at least is needed (wirefish gaits build)')
+        self.members = members
+        self.frequency_range = (frequencies[0], frequencies[-1])
+        self.scale_range = (scales[0], scales[-1])
+
+        self._frequencies, self._scales = frequencies, scales
+
+    def gait(self, frequency_hz: float, amplitude_scale: float) -> CpgParameters:
+        """Return the gait blended from the four fitted members around (f, s)."""
+        # wirefish_cpg.gait_family.interpolated_parameters gives amplitude 0 on a grid line
+        # (its corner weights share dict keys there); the blend is continuous, so a query a
+        # 1e-9 relative step inside the cell gives the value on the line.
+        return interpolated_parameters(self.members, _off_grid(frequency_hz, self._frequencies),
+                                       _off_grid(amplitude_scale, self._scales))
+
+
+def _off_grid(x: float, grid: list[float]) -> float:
+    """Return ``x``, moved a 1e-9 relative step towards the grid's inside if it is on a line."""
+    if not any(math.isclose(x, g, rel_tol=1e-12, abs_tol=0.0) for g in grid):
+        return x
+    step = 1e-9 * (grid[-1] - grid[0])
+    return x - step if x >= grid[-1] else x + step
+
+
+def library_family(path: Path, reference: WaveSpec, geometry: dict[str, float]
+                   ) -> LibraryFamily:
+    """Return the library file's family of ``reference`` on ``geometry`` (ValueError: none)."""
+    try:
+        library = load_library(path)
+    except OSError as error:
+        raise ValueError(f'gait library {path}: {error}') from error
+    return LibraryFamily(library_members(library, reference, geometry))
 
 
 @dataclass(frozen=True)
@@ -128,10 +189,12 @@ class GaitPlanner:
     """Chooses gaits by the policy above; caches gait evaluations (they are deterministic)."""
 
     def __init__(self, family: GaitFamily, limits: GaitLimits,
-                 geometry: FishGeometry | None = None) -> None:
+                 geometry: FishGeometry | None = None, family_note: str = '') -> None:
         """Scan the feasible frontier once (FRONTIER_SAMPLES gaits) for the fastest gait."""
         self.family = family
-        self.limits = limits
+        self.family_note = family_note  # why this family (e.g. the library was not usable)
+        self.limits = limits = _within_family(limits, family)
+        self._min_scale = family.scale_range[0] if family.scale_range else 0.0
         self.geometry = geometry or FishGeometry()
         self._point = functools.lru_cache(maxsize=4096)(self._evaluate)
         frequencies = np.linspace(limits.min_frequency_hz, limits.max_frequency_hz,
@@ -168,7 +231,7 @@ class GaitPlanner:
         high = self.limits.max_amplitude_scale
         if ok(self._point(frequency_hz, high)):
             return high
-        low = 0.0
+        low = self._min_scale  # below it a library family has no gait (taken even if not ok)
         for _ in range(iterations):
             middle = 0.5 * (low + high)
             if ok(self._point(frequency_hz, middle)):
@@ -205,10 +268,27 @@ class GaitPlanner:
         slowest = self.frontier_point(lim.min_frequency_hz)
         if target_speed <= slowest.speed:
             top = slowest.amplitude_scale
+            bottom = max(1e-6 * top, self._min_scale)
+            least = self._point(lim.min_frequency_hz, bottom)
+            if target_speed <= least.speed:  # only a library family has a smallest gait
+                return GaitChoice(target_speed, least, f'{target_speed:.3f} m/s is below the '
+                                  f"family's slowest gait ({least.speed:.3f} m/s)")
             scale = brentq(lambda s: self._point(lim.min_frequency_hz, s).speed - target_speed,
-                           1e-6 * top, top, xtol=1e-9 * top)
+                           bottom, top, xtol=1e-9 * top)
             return GaitChoice(target_speed, self._point(lim.min_frequency_hz, float(scale)))
         frequency = brentq(lambda f: self.frontier_point(f).speed - target_speed,
                            lim.min_frequency_hz, fastest.frequency_hz, xtol=1e-6,
                            rtol=SPEED_TOLERANCE_M_S)
         return GaitChoice(target_speed, self.frontier_point(float(frequency)))
+
+
+def _within_family(limits: GaitLimits, family: GaitFamily) -> GaitLimits:
+    """Return ``limits`` narrowed to where ``family`` is defined (ValueError if disjoint)."""
+    changes: dict[str, float] = {}
+    if family.frequency_range is not None:
+        low, high = family.frequency_range
+        changes['min_frequency_hz'] = max(limits.min_frequency_hz, low)
+        changes['max_frequency_hz'] = min(limits.max_frequency_hz, high)
+    if family.scale_range is not None:
+        changes['max_amplitude_scale'] = min(limits.max_amplitude_scale, family.scale_range[1])
+    return replace(limits, **changes)

@@ -9,16 +9,22 @@ planner output into the cpg_node parameters to set.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any, Mapping
 
 from wirefish_common.parameter_table import ParameterSpec
-from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
-from wirefish_planner.gait_family import GaitFamily, GaitLimits, GaitPlanner, Table1Family
+from wirefish_cpg.gait_library import default_library_path
+from wirefish_cpg.wave_loss import WaveSpec
+from wirefish_kinematics.node_parameters import (BODY_WAVE_GEOMETRY_FIELDS, geometry_from,
+                                                 geometry_parameters)
+from wirefish_planner.gait_family import (GaitFamily, GaitLimits, GaitPlanner, library_family,
+                                          Table1Family)
 from wirefish_planner.planner_core import Planner, PlannerOutput, PlannerSettings
 from wirefish_planner.yaw_control import YawGains
 
 HALF_PI = math.pi / 2
-_LIMITS, _GAINS = GaitLimits(), YawGains()
+_LIMITS, _GAINS, _WAVE = GaitLimits(), YawGains(), WaveSpec()
+GAIT_SOURCES = ('table1', 'library')
 PLANNER_PARAMETERS = (
     ParameterSpec('cpg_node_name', 'cpg_node',
                   'Name (relative or absolute) of the CPG node the planner drives'),
@@ -64,6 +70,20 @@ PLANNER_PARAMETERS = (
                   'angular.z = 0 holds the heading the turn ended on (else yaw rate 0)'),
     ParameterSpec('yaw_control', True,
                   'Close the yaw loops on imu/data (false: feed-forward offsets only)'),
+    ParameterSpec('gait_source', 'table1',
+                  "Gait family: 'table1' (Table 1 locked at f, R_i scaled) or 'library' (the "
+                  "gait library's fits of the reference wave, blended inside their grid; Table "
+                  '1 while the library has no such family)'),
+    ParameterSpec('library_path', str(default_library_path()),
+                  "Gait library file (tuner_node's library_path); read at start-up and on any "
+                  'parameter change'),
+    ParameterSpec('reference_wave_c1', _WAVE.c1,
+                  "Library family's reference wave c1 (m/m), eq 23; scaled by s", -10.0, 10.0),
+    ParameterSpec('reference_wave_c2', _WAVE.c2,
+                  "Library family's reference wave c2 (1/m), eq 23; scaled by s", -100.0,
+                  100.0),
+    ParameterSpec('reference_wave_k', _WAVE.k, "Library family's reference wave k (rad/m)", 0.0,
+                  100.0, low_exclusive=True),
     ParameterSpec('rest_at_start', True,
                   'Rest the CPG at start-up (no cmd_vel yet: the fish rests); false: leave '
                   'cpg_node as it is until the first cmd_vel'),
@@ -95,8 +115,32 @@ def planner_from(values: Mapping[str, Any], family: GaitFamily | None = None) ->
                                imu_timeout_s=values['imu_timeout_s'],
                                heading_hold=values['heading_hold'],
                                yaw_control=values['yaw_control'])
-    return Planner(GaitPlanner(family or Table1Family(), limits, geometry_from(values)), gains,
-                   settings)
+    geometry = geometry_from(values)
+    note = ''
+    if family is None:
+        family, note = gait_family_from(values)
+    return Planner(GaitPlanner(family, limits, geometry, note), gains, settings)
+
+
+def gait_family_from(values: Mapping[str, Any]) -> tuple[GaitFamily, str]:
+    """
+    Return the gait family the parameters ask for, and why it is not that one ('' if it is).
+
+    The library family needs a 2 x 2 grid of fits of the reference wave on this geometry;
+    until the library has one, Table 1's family is used and the note says why.
+    """
+    source = values['gait_source']
+    if source not in GAIT_SOURCES:
+        raise ValueError(f'gait_source must be one of {GAIT_SOURCES}, got {source!r}')
+    if source == 'table1':
+        return Table1Family(), ''
+    reference = WaveSpec(values['reference_wave_c1'], values['reference_wave_c2'],
+                         values['reference_wave_k'], 1.0)
+    body = {name: float(values[name]) for name in BODY_WAVE_GEOMETRY_FIELDS}
+    try:
+        return library_family(Path(values['library_path']), reference, body), ''
+    except ValueError as error:
+        return Table1Family(), f'gait library not used ({error}); Table 1 family'
 
 
 def default_values() -> dict[str, Any]:

@@ -165,7 +165,7 @@ class PlannerNode(Node):
         msg.target_speed = float(out.gait.target_speed)
         msg.predicted_speed = float(out.gait.predicted_speed)
         msg.clamp_reason = out.gait.clamp_reason
-        msg.note = out.note
+        msg.note = out.note or self._planner.gaits.family_note
         msg.gait_family = self._planner.gaits.family.name
         if point is not None:
             msg.tail_beat_hz = float(point.frequency_hz)
@@ -192,6 +192,8 @@ class PlannerNode(Node):
             level, message = DiagnosticStatus.WARN, f'speed clamped: {out.gait.clamp_reason}'
         elif out is not None and out.mode == 'open_loop' and self._values['yaw_control']:
             level, message = DiagnosticStatus.WARN, 'no imu/data: turning open loop'
+        elif self._planner.gaits.family_note:
+            level, message = DiagnosticStatus.WARN, self._planner.gaits.family_note
         values = {} if out is None else {
             'mode': out.mode, 'target_speed': f'{out.gait.target_speed:.3f}',
             'predicted_speed': f'{out.gait.predicted_speed:.3f}',
