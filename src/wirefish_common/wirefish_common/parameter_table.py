@@ -86,13 +86,6 @@ def wrong_type_reason(node_name: str, spec: ParameterSpec, rclpy_reason: str) ->
     return line
 
 
-def create_node_or_exit(node_class):
-    """Use ``wirefish_common.node_main`` (this name stays until every node's main() moved)."""
-    from wirefish_common.node_main import create_node_or_exit as create
-
-    return create(node_class)
-
-
 def declare(node, specs: tuple[ParameterSpec, ...], combination=None) -> None:
     """
     Declare every spec on ``node`` with a descriptor carrying its description and range.
