@@ -1,8 +1,14 @@
-"""The bootstrap (`make setup`) stops with one clear line when a system tool is missing."""
+"""
+The bootstrap (`make setup`) says what is missing in one line and redoes only what changed.
+
+A missing system tool stops it with one line naming the package; nothing changed, nothing is
+rebuilt; new requirements are installed into the existing venv (not a new one).
+"""
 
 import os
 from pathlib import Path
 import subprocess
+import sys
 
 import pytest
 
@@ -67,3 +73,26 @@ def test_second_setup_with_nothing_changed_rebuilds_nothing():
     assert 'is up to date' in result.stdout
     assert 'install/ is up to date' in result.stdout
     assert 'colcon build' not in result.stdout
+
+
+def test_changed_requirements_are_installed_into_the_venv_in_place(tmp_path):
+    # A venv made by an earlier setup with other requirements: its python runs the workspace
+    # venv's (whose packages already satisfy every requirement, so pip installs nothing).
+    venv = tmp_path / 'venv'
+    (venv / 'bin').mkdir(parents=True)
+    python = venv / 'bin' / 'python'
+    python.write_text(f'#!/bin/sh\nexec {sys.executable} "$@"\n')
+    python.chmod(0o755)
+    keep = venv / 'kept-by-an-update'
+    keep.write_text('')
+    interpreter = os.environ.get('WIREFISH_PYTHON', 'python3.11')
+    version = subprocess.run([interpreter, '-c', 'import sys; print(sys.version)'],
+                             capture_output=True, text=True, check=True).stdout.strip()
+    (venv / '.wirefish-stamp').write_text(f'wheels {version} an-older-requirements-hash  -\n')
+    env = dict(os.environ, WIREFISH_VENV=str(venv))
+    env.pop('ROS_DISTRO', None)
+    result = run_bootstrap(env)
+    assert result.returncode == 0, result.stderr
+    assert 'updating' in result.stdout and 'creating' not in result.stdout, result.stdout
+    assert keep.exists()  # the venv was not recreated
+    assert 'an-older-requirements-hash' not in (venv / '.wirefish-stamp').read_text()
