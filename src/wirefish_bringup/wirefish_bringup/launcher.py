@@ -25,6 +25,11 @@ from wirefish_bringup.supervisor import Supervisor, wait_for_path
 STATUS_WINDOW_S = 3.0
 STOP_GRACE_S = 10.0  # after a Ctrl-C during start-up, how long the nodes may take to be up
 DEVICE_TIMEOUT_S = 15.0
+# How long the processes may take to stop after the SIGINT, together: one fish's 6 stop well
+# within 5 s; a fleet's 19 on the loaded 2 cores needed more (a kinematics_node of 3 fish was
+# still stopping after 5 s), since each process needs CPU time to finish.
+STOP_TIMEOUT_S = 5.0
+STOP_S_PER_PROCESS = 1.0
 # Start-up may include restarts with back-off (1 + 2 + 4 s) of a node that fails at once.
 READY_TIMEOUT_S = 60.0
 # How long a new `wirefish up` listens for the registry's nodes already in its namespace (it
@@ -245,7 +250,8 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish up: {error}', file=sys.stderr)
         code = 1
     finally:
-        codes = supervisor.stop()
+        codes = supervisor.stop(timeout_s=max(STOP_TIMEOUT_S,
+                                              STOP_S_PER_PROCESS * len(supervisor.processes)))
     summary = supervisor.summary()
     if summary:
         print(f'wirefish up: {summary}', file=sys.stderr)
