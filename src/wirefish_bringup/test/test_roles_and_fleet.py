@@ -16,6 +16,11 @@ def _names(specs):
     return [s.name for s in specs]
 
 
+def _option(spec, name: str) -> str:
+    args = spec.command_arguments()
+    return args[args.index(name) + 1]
+
+
 def test_the_fish_role_holds_what_keeps_the_fish_swimming_and_the_relay():
     assert _names(fish_graph('/w', role=FISH)) == [
         'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'planner_node', 'link_relay']
@@ -24,7 +29,7 @@ def test_the_fish_role_holds_what_keeps_the_fish_swimming_and_the_relay():
 def test_the_shore_role_holds_the_tuner_and_the_recorder_of_the_shore_copies():
     specs = fish_graph('/w', role=SHORE, bag=Path('/tmp/b'))
     assert _names(specs) == ['tuner_node', 'wirefish_recorder']
-    assert specs[-1].command_arguments()[-2:] == ('--namespace', '/w/shore')
+    assert _option(specs[-1], '--namespace') == '/w/shore'
 
 
 def test_both_roles_together_are_the_one_host_graph_without_a_relay():
@@ -66,7 +71,7 @@ def test_a_fleet_is_one_namespace_and_one_frame_prefix_per_fish():
 def test_a_fleet_recording_is_one_recorder_of_the_base_namespace():
     specs = fleet_graph('/tank', 2, bag=Path('/tmp/b'))
     recorders = [s for s in specs if s.name == 'wirefish_recorder']
-    assert len(recorders) == 1 and recorders[0].command_arguments()[-1] == '/tank'
+    assert len(recorders) == 1 and _option(recorders[0], '--namespace') == '/tank'
 
 
 @pytest.mark.parametrize('count', [0, 17])

@@ -15,10 +15,13 @@ import sys
 SUBCOMMANDS = {
     'up': ('wirefish_bringup.launcher', 'start the whole graph (virtual fish by default)'),
     'record': ('wirefish_bringup.record', 'record the graph into a rosbag2 (MCAP) bag'),
-    'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait service)'),
+    'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait action)'),
+    'gaits': ('wirefish_bringup.gaits', 'build, list and plot the gait library'),
     'report': ('wirefish_bringup.report', 'plots and a summary table from a recorded bag'),
     'bag': ('wirefish_bringup.bag_command', 'reindex a killed recording; bag info'),
     'compose': ('wirefish_bringup.compose', "one fish's ROS nodes in a single process"),
+    'twohost': ('wirefish_bringup.twohost',
+                'fish and shore on two network-namespace hosts over DDS (root)'),
 }
 # Other packages add subcommands through this entry-point group ('name = module'), as ros2cli
 # extensions do: wirefish_analysis adds `sweep`, and bringup needs no import of them.
