@@ -127,7 +127,7 @@ def test_a_goal_sent_during_a_fit_is_rejected_and_the_service_answers_busy(
 
 
 @pytest.mark.parametrize('fields, words', [
-    ({'c1': 1.0e6}, 'servo amplitudes'),
+    ({'c1': 1.0e6}, 'beyond any bend of the tail'),
     ({'frequency_hz': 12.0}, 'wave.frequency_hz must be in (0, 10] Hz'),
     ({'swarm_size': 1}, 'swarm_size'),
 ])

@@ -44,7 +44,7 @@ def test_the_same_wave_again_comes_from_the_library(tuner, python, ros_env):
 @pytest.mark.parametrize('options, reason', [
     (('--c1', 'nan'), 'wave.c1 must be finite'),
     (('--freq', '12'), 'wave.frequency_hz must be in (0, 10] Hz'),
-    (('--c1', '1e6'), 'servo amplitudes'),
+    (('--c1', '1e6'), 'beyond any bend of the tail'),
 ])
 def test_a_refused_goal_prints_the_reason_and_fails(tuner, python, ros_env, options, reason):
     tuner('-r', f'__ns:={NAMESPACE}')

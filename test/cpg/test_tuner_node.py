@@ -69,7 +69,7 @@ def test_bad_requests_are_refused_with_reasons_and_leave_the_cpg_untouched(spawn
 
 
 IMPOSSIBLE_WAVES = [
-    ({'c1': 1.0e6}, 'servo amplitudes 3.49/4.19 rad; the servo range is +-1.571 rad'),
+    ({'c1': 1.0e6}, 'swing angles up to 90/90 deg, beyond any bend of the tail'),
     ({'k': 1.0e9}, 'k must be <= pi / 0.1 = 31.42 rad/m'),
     ({'c1': 1e308}, 'servo amplitudes'),
     ({'frequency_hz': 1e-300}, 'below the slowest beat'),

@@ -11,6 +11,11 @@ Both final positions are then scored with the exact loss, so "equal or better fi
 judged on one ruler. pyswarms draws from NumPy's global RNG, so the baseline seeds it.
 
 ``python -m wirefish_analysis.bench_retune`` prints the figures as JSON.
+
+Gait library rows (issue 13): ``library_answer`` times the same goal twice through a real
+tuner_node process and its retune_gait action (the first fits, the rest come from the
+library), client round trip and the tuner's own figure; ``gaits_build`` times
+``wirefish gaits build`` on its default grid.
 """
 
 from __future__ import annotations
@@ -104,6 +109,91 @@ def run(repeats: int = 5, seed: int = 0, baseline: bool = True,
                        'ratio': base['wall_s'] / result['wall_s_median'],
                        'loss_not_worse_than_baseline': first['loss'] <= base['loss']})
     return result
+
+
+def library_answer(repeats: int = 20, domain_id: int = 97) -> dict:
+    """
+    Return round-trip times (s) of a fitted goal and of ``repeats`` library answers.
+
+    Keys: fit_round_trip_s, library_round_trip_s_median / _max (client: send_goal to result),
+    library_tuner_s_median (the tuner's elapsed_s: look-up only), all_from_library, how.
+    """
+    import os
+    from pathlib import Path
+    import subprocess
+    import tempfile
+
+    from ament_index_python.packages import get_package_prefix
+    import rclpy
+    from rclpy.action import ActionClient
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from wirefish_msgs.action import RetuneGait
+
+    tuner = os.path.join(get_package_prefix('wirefish_cpg'), 'lib', 'wirefish_cpg',
+                         'tuner_node')
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    with tempfile.TemporaryDirectory() as scratch:
+        library = Path(scratch) / 'gaits.yaml'
+        process = subprocess.Popen([sys.executable, tuner, '--ros-args', '-r',
+                                    '__ns:=/bench_retune', '-p', f'library_path:={library}'],
+                                   env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        context = Context()
+        rclpy.init(context=context, domain_id=domain_id)
+        try:
+            node = rclpy.create_node('bench_retune', namespace='/bench_retune', context=context)
+            executor = SingleThreadedExecutor(context=context)
+            executor.add_node(node)
+            client = ActionClient(node, RetuneGait, 'retune_gait')
+            if not client.wait_for_server(timeout_sec=30.0):
+                raise RuntimeError('no retune_gait action server within 30 s')
+
+            def round_trip() -> tuple[float, object]:
+                goal = RetuneGait.Goal()
+                goal.wave.c1, goal.wave.c2, goal.wave.k, goal.wave.frequency_hz = (
+                    0.15, 1.0, 8.0, 1.0)
+                start = time.perf_counter()
+                sent = client.send_goal_async(goal)
+                executor.spin_until_future_complete(sent, timeout_sec=60.0)
+                result = sent.result().get_result_async()
+                executor.spin_until_future_complete(result, timeout_sec=120.0)
+                return time.perf_counter() - start, result.result().result
+
+            fit_s, first = round_trip()
+            answers = [round_trip() for _ in range(repeats)]
+        finally:
+            rclpy.try_shutdown(context=context)
+            process.terminate()
+            process.wait(timeout=10)
+    trips = [t for t, _ in answers]
+    return {'fit_round_trip_s': fit_s, 'fit_iterations': first.iterations,
+            'library_round_trip_s_median': statistics.median(trips),
+            'library_round_trip_s_max': max(trips),
+            'library_tuner_s_median': statistics.median(r.elapsed_s for _, r in answers),
+            'all_from_library': all(r.from_library for _, r in answers),
+            'how': (f'section 5.2 wave as a retune_gait action goal to a tuner_node process '
+                    f'(fresh library): 1 fit, then {repeats} identical goals; client round '
+                    'trip send_goal -> result; tuner figure = its elapsed_s')}
+
+
+def gaits_build(workers: int | None = None) -> dict:
+    """Return the wall time (s) of `wirefish gaits build` on its default grid."""
+    import os
+    from pathlib import Path
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as scratch:
+        command = [sys.executable, '-m', 'wirefish_bringup.cli', 'gaits', 'build', '--library',
+                   str(Path(scratch) / 'gaits.yaml'), '--workers',
+                   str(workers or os.cpu_count() or 1)]
+        start = time.perf_counter()
+        done = subprocess.run(command, capture_output=True, text=True, timeout=600)
+        wall = time.perf_counter() - start
+    stored = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else done.stderr
+    return {'wall_s': wall, 'returncode': done.returncode, 'summary': stored,
+            'how': 'wirefish gaits build, default grid (5 frequencies x 5 scales of the '
+                   'section 5.2 wave), all cores, fresh library'}
 
 
 if __name__ == '__main__':

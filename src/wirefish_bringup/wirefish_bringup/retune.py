@@ -18,6 +18,7 @@ from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 BAR_WIDTH = 30
 UINT32_MAX = 2**32 - 1
 CANCEL_WAIT_S = 10.0
+FEEDBACK_DRAIN_S = 1.0  # how long the last feedback may trail the result (separate topics)
 
 
 def count(text: str) -> int:
@@ -120,9 +121,11 @@ def run(args: argparse.Namespace) -> int:
                           feedback_sub_qos_profile=reliable(1000))
     terminal = sys.stderr.isatty()
     drawn = [False]
+    last_iteration = [-1]
 
     def on_feedback(message) -> None:
         f = message.feedback
+        last_iteration[0] = f.iteration
         if terminal:
             print('\r' + progress_line(f.iteration, f.best_loss, f.max_iterations), end='',
                   file=sys.stderr, flush=True)
@@ -157,9 +160,12 @@ def run(args: argparse.Namespace) -> int:
         if not spin_until(result_future.done, deadline):
             print(f'wirefish retune: no result within {args.timeout:g} s', file=sys.stderr)
             return 1
+        result = result_future.result().result
+        # The result can overtake the last feedback: draw it before the table.
+        spin_until(lambda: last_iteration[0] >= result.iterations,
+                   time.monotonic() + (FEEDBACK_DRAIN_S if result.iterations else 0.0))
         if drawn[0]:
             print(file=sys.stderr)
-        result = result_future.result().result
         if not result.success:  # nothing was fitted or applied: the reason is the answer
             print(f'wirefish retune: {result.message}', file=sys.stderr)
             return 1

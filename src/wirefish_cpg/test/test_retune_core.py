@@ -36,7 +36,7 @@ def test_the_section_5_2_wave_is_fitted_within_the_paper_rmse():
     ({'k': -1.0}, 'wave.k must be > 0'),
     ({'swarm_size': 1}, 'swarm_size must be 0 (default) or in [2, 2000]'),
     ({'max_iterations': 5001}, 'max_iterations must be 0 (default) or in [1, 5000]'),
-    ({'c1': 1.0e6}, 'servo amplitudes'),
+    ({'c1': 1.0e6}, 'beyond any bend of the tail'),
     ({'k': 1.0e9}, 'k must be <= pi'),
     ({'c1': 1e308}, 'servo amplitudes'),
     ({'frequency_hz': 1e-300}, 'slowest beat'),

@@ -30,6 +30,7 @@ paper's 3 Hz cap).
 from __future__ import annotations
 
 from dataclasses import dataclass
+import functools
 import math
 
 import numpy as np
@@ -39,8 +40,10 @@ from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.wire_coupling import servo_angles_for
 
 # Bends searched for beta_2 (rad) and the residual above which a swing angle counts as
-# unreachable: 0.05 deg, ten times the search's own resolution.
-_BEND_SEARCH = np.linspace(-math.pi, math.pi, 721)
+# unreachable: 0.05 deg (Newton's steps land within ~1e-9 rad of a reachable angle).
+_BEND_SEARCH = np.linspace(-math.pi, math.pi, 73)  # 5 deg: the start of Newton's steps
+_NEWTON_STEPS = 6
+_SLOPE_STEP = 1e-6
 _REACH_TOLERANCE_RAD = math.radians(0.05)
 
 
@@ -83,20 +86,29 @@ def bends_for_swing_angles(theta: np.ndarray, geometry: FishGeometry
     """
     Return the bends (beta1, beta2) (N,) rad giving swing angles theta (N, 2) (section 5.2).
 
-    theta_1 = beta_1 / 2 (chord of a circular arc); beta_2 minimises the swing-angle error of
-    O2 over a grid of bends in [-pi, pi], refined around the best. Where no bend reaches
+    theta_1 = beta_1 / 2 (chord of a circular arc); beta_2 starts at the best of a coarse grid
+    of bends in [-pi, pi] and is refined by Newton's method on theta_2. Where no bend reaches
     theta_2 within 0.05 deg, beta_2 is NaN.
     """
     beta1 = 2.0 * np.asarray(theta[:, 0], dtype=float)
-    step = _BEND_SEARCH[1] - _BEND_SEARCH[0]
-    # A coarse search over every bend, then a fine one around the best (resolution ~1e-4 rad).
+    # A coarse search over every bend for the start, then Newton steps on theta_2(beta_2).
     beta2, _ = _closest_bend(beta1, theta[:, 1], np.broadcast_to(
         _BEND_SEARCH, (beta1.size, _BEND_SEARCH.size)), geometry)
-    beta2, error = _closest_bend(beta1, theta[:, 1],
-                                 beta2[:, None] + np.linspace(-step, step, 201), geometry)
+    for _ in range(_NEWTON_STEPS):
+        miss = _theta2(beta1, beta2, geometry) - theta[:, 1]
+        slope = (_theta2(beta1, beta2 + _SLOPE_STEP, geometry)
+                 - _theta2(beta1, beta2 - _SLOPE_STEP, geometry)) / (2.0 * _SLOPE_STEP)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            step = np.where(np.abs(slope) > 1e-9, miss / slope, 0.0)
+        beta2 = np.clip(beta2 - step, -math.pi, math.pi)
+    error = np.abs(_theta2(beta1, beta2, geometry) - theta[:, 1])
     reached = error <= _REACH_TOLERANCE_RAD
     reached &= np.abs(beta1) <= math.pi
     return beta1, np.where(reached, beta2, np.nan)
+
+
+def _theta2(beta1: np.ndarray, beta2: np.ndarray, geometry: FishGeometry) -> np.ndarray:
+    return swing_angles(beta1, beta2, geometry)[1]
 
 
 def _closest_bend(beta1: np.ndarray, theta2: np.ndarray, candidates: np.ndarray,
@@ -125,12 +137,15 @@ def wave_demand(problem: WaveFitProblem) -> WaveDemand:
                       worst_swing_deg=worst)
 
 
+@functools.lru_cache(maxsize=256)
 def wave_infeasibility(problem: WaveFitProblem, limits: FitLimits = FitLimits()
                        ) -> str | None:
     """
     Return why the tail cannot follow ``problem``'s wave (eqs 2-4, 23), or None if it can.
 
     The reason names what the wave asks for against what the geometry and servos reach.
+    Pure and deterministic, so the answers of recent (frozen, hashable) arguments are kept:
+    a wave asked again, e.g. one the gait library answers, is judged in microseconds.
     """
     wave, geometry = problem.wave, problem.geometry
     if wave.frequency_hz < limits.min_frequency_hz:
