@@ -1,0 +1,21 @@
+"""The radio-link benchmark's BENCHMARKS.md row."""
+
+from wirefish_analysis.bench_radio_link import row
+
+
+def _mode(fish_to_shore: float) -> dict:
+    window = {'fish_to_shore_B_s': fish_to_shore, 'shore_to_fish_B_s': 2000.0}
+    return {'unshaped': window, 'shaped': window}
+
+
+def test_the_row_is_met_when_every_discovery_fits_the_limit_unshaped():
+    figure, goal, measured, verdict, _ = row({'multicast': _mode(10000.0)})
+    assert verdict == 'met' and 'multicast: 10000 / 2000 unshaped' in measured
+
+
+def test_the_row_is_missed_when_one_discovery_needs_more_than_the_limit():
+    assert row({'multicast': _mode(10000.0), 'static': _mode(42000.0)})[3] == 'missed'
+
+
+def test_a_machine_without_root_reports_why_nothing_was_measured():
+    assert row({'error': 'only root'})[2:4] == ('only root', 'not measured')
