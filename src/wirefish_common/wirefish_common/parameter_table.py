@@ -10,9 +10,18 @@ import at module level, so the validation is testable without ROS.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 import math
 import re
+from typing import Any, TYPE_CHECKING
+
+if TYPE_CHECKING:  # rclpy only for the type checker: the validation stays importable without it
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+
+# Judges a whole set of values (see validate_update): a reason, or anything else for "fine".
+Combination = Callable[[dict[str, object]], object]
 
 
 @dataclass(frozen=True)
@@ -86,7 +95,8 @@ def wrong_type_reason(node_name: str, spec: ParameterSpec, rclpy_reason: str) ->
     return line
 
 
-def declare(node, specs: tuple[ParameterSpec, ...], combination=None) -> None:
+def declare(node: Node, specs: tuple[ParameterSpec, ...],
+            combination: Combination | None = None) -> None:
     """
     Declare every spec on ``node`` with a descriptor carrying its description and range.
 
@@ -143,8 +153,9 @@ def merged_update(specs: dict[str, ParameterSpec], current: dict[str, object],
     return merged, None
 
 
-def validate_update(specs: dict[str, ParameterSpec], current: dict[str, object], parameters,
-                    combination=None):
+def validate_update(specs: dict[str, ParameterSpec], current: dict[str, object],
+                    parameters: Sequence[Parameter],
+                    combination: Combination | None = None) -> Any:
     """
     Return the ``SetParametersResult`` of a node's ``add_on_set_parameters_callback``.
 
@@ -162,7 +173,8 @@ def validate_update(specs: dict[str, ParameterSpec], current: dict[str, object],
 
 
 def update_problem(specs: dict[str, ParameterSpec], current: dict[str, object],
-                   updates: list[tuple[str, object]], combination=None) -> str | None:
+                   updates: list[tuple[str, object]],
+                   combination: Combination | None = None) -> str | None:
     """Return the first reason to refuse ``updates`` (values, then their combination), or None."""
     merged, reason = merged_update(specs, current, updates)
     if reason is None and combination is not None:
