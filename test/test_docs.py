@@ -1,0 +1,151 @@
+"""
+docs/ARCHITECTURE.md and docs/CONTRACTS.md say what the code is (pure: reads files and tables).
+
+Each test names what the docs miss or cite wrongly, so a renamed module, a new topic, node,
+parameter, package or message type fails here until the docs follow.
+"""
+
+import ast
+import importlib
+from pathlib import Path
+import re
+
+import pytest
+from wirefish_bringup.graph import NODES
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / 'src'
+ARCHITECTURE = ROOT / 'docs' / 'ARCHITECTURE.md'
+CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
+DOCS = (ARCHITECTURE, CONTRACTS)
+# Every node's parameter table: (module, attribute).
+PARAMETER_TABLES = [
+    ('wirefish_cpg.cpg_node_parameters', 'NODE_PARAMETERS'),
+    ('wirefish_kinematics.node_parameters', 'NODE_PARAMETERS'),
+    ('wirefish_bridge.bridge_parameters', 'PARAMETERS'),
+    ('wirefish_planner.planner_config', 'PLANNER_PARAMETERS'),
+    ('wirefish_cpg.tuner_node', 'TUNER_PARAMETERS'),
+]
+# A topic, service or action name given as a literal where a node or tool creates it.
+_CREATED = re.compile(
+    r'(?:create_(?:publisher|subscription|service)|ActionServer|ActionClient)'
+    r"\(\s*(?:[\w.]+,\s*)?\w+,\s*'([^']+)'")
+# A dotted wirefish name in backticks: `wirefish_pkg.module` or `wirefish_pkg.module.Name[.x]`.
+_DOTTED = re.compile(r'`(wirefish_[a-z]+(?:\.[A-Za-z_][A-Za-z0-9_]*)+)')
+# A repository path in backticks ending in .py or .md.
+_PATH = re.compile(r'`((?:src|test|docs)/[\w./-]+\.(?:py|md))`')
+
+
+def _text(path: Path) -> str:
+    return path.read_text(encoding='utf-8')
+
+
+def _packages() -> list[str]:
+    return sorted(p.name for p in SRC.iterdir() if (p / 'package.xml').exists())
+
+
+def _source_files() -> list[Path]:
+    return sorted(p for pkg in _packages() for p in (SRC / pkg / pkg).glob('*.py'))
+
+
+def _created_names() -> set[str]:
+    return {name for path in _source_files() for name in _CREATED.findall(_text(path))}
+
+
+def _defined_names(module_path: Path) -> dict[str, set[str]]:
+    """Return the top-level names of a module, each with its class's attributes (if a class)."""
+    names: dict[str, set[str]] = {}
+    for node in ast.parse(_text(module_path)).body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            names[node.name] = set()
+        elif isinstance(node, ast.ClassDef):
+            names[node.name] = {n.name for n in node.body
+                                if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))}
+            names[node.name] |= {t.id for n in node.body if isinstance(n, ast.AnnAssign)
+                                 for t in [n.target] if isinstance(t, ast.Name)}
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names.update({t.id: set() for t in targets if isinstance(t, ast.Name)})
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            names.update({(a.asname or a.name).split('.')[0]: set() for a in node.names})
+    return names
+
+
+def _dotted_problem(dotted: str) -> str | None:
+    """Return why ``dotted`` names nothing in src/, or None if it does."""
+    package, *rest = dotted.split('.')
+    if not rest:
+        return None
+    module = SRC / package / package / f'{rest[0]}.py'
+    if package == 'wirefish_msgs' or not (SRC / package).is_dir():
+        return None if (SRC / package).is_dir() else f'no package {package}'
+    if not module.exists():
+        return f'no module {package}.{rest[0]}'
+    if len(rest) == 1:
+        return None
+    defined = _defined_names(module)
+    if rest[1] not in defined:
+        return f'{package}.{rest[0]} defines no {rest[1]}'
+    if len(rest) > 2 and defined[rest[1]] and rest[2] not in defined[rest[1]]:
+        return f'{package}.{rest[0]}.{rest[1]} has no {rest[2]}'
+    return None
+
+
+@pytest.mark.parametrize('package', _packages())
+def test_every_package_has_its_row_in_the_architecture(package):
+    assert f'| `{package}` |' in _text(ARCHITECTURE)
+
+
+@pytest.mark.parametrize('doc', DOCS, ids=[d.name for d in DOCS])
+def test_every_registry_entry_is_named(doc):
+    missing = [e.name for e in NODES if f'`{e.name}`' not in _text(doc)
+               and e.name not in _text(doc)]
+    assert not missing, f'{doc.name} does not name the registry entries {missing}'
+
+
+def test_the_code_creates_topics_services_and_actions_to_be_found():
+    assert {'servo_cmd', 'imu/data', 'retune_gait', 'start'} <= _created_names()
+
+
+def test_every_topic_service_and_action_the_code_creates_is_in_the_contracts():
+    missing = sorted(n for n in _created_names() if f'`{n}`' not in _text(CONTRACTS))
+    assert not missing, f'CONTRACTS.md lacks {missing}'
+
+
+@pytest.mark.parametrize('module, table', PARAMETER_TABLES)
+def test_every_declared_parameter_is_in_the_contracts(module, table):
+    specs = getattr(importlib.import_module(module), table)
+    missing = [s.name for s in specs if f'`{s.name}`' not in _text(CONTRACTS)]
+    assert not missing, f'CONTRACTS.md lacks the {module} parameters {missing}'
+
+
+def test_every_message_type_is_in_the_contracts():
+    kinds = [f'{p.parent.name}/{p.stem}' for p in sorted((SRC / 'wirefish_msgs').glob('*/*'))
+             if p.suffix in ('.msg', '.srv', '.action')]
+    missing = [k for k in kinds if f'`{k}`' not in _text(CONTRACTS)]
+    assert kinds and not missing, f'CONTRACTS.md lacks the message types {missing}'
+
+
+@pytest.mark.parametrize('doc', DOCS, ids=[d.name for d in DOCS])
+def test_every_cited_module_and_name_exists(doc):
+    cited = sorted(set(_DOTTED.findall(_text(doc))))
+    problems = [p for p in map(_dotted_problem, cited) if p is not None]
+    assert cited and not problems, f'{doc.name}: {problems}'
+
+
+@pytest.mark.parametrize('doc', DOCS, ids=[d.name for d in DOCS])
+def test_every_cited_file_exists(doc):
+    missing = [p for p in _PATH.findall(_text(doc)) if not (ROOT / p).exists()
+               and 'foo_node' not in p]
+    assert not missing, f'{doc.name} cites files that do not exist: {missing}'
+
+
+@pytest.mark.parametrize('dotted, problem', [
+    ('wirefish_bridge.codec.FrameEncoder.encode', None),
+    ('wirefish_bridge.codec.FrameDecoder', 'wirefish_bridge.codec defines no FrameDecoder'),
+    ('wirefish_bridge.nothing', 'no module wirefish_bridge.nothing'),
+    ('wirefish_bridge.codec.FrameEncoder.decode',
+     'wirefish_bridge.codec.FrameEncoder has no decode'),
+])
+def test_a_wrong_citation_is_found(dotted, problem):
+    assert _dotted_problem(dotted) == problem
