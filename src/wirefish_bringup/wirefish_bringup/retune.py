@@ -40,6 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--iterations', type=count, default=0,
                         help='PSO iterations (0: default)')
     parser.add_argument('--swarm', type=count, default=0, help='PSO particles (0: default)')
+    parser.add_argument('--mode', choices=('phase_free', 'literal'), default='phase_free',
+                        help="fit mode: the locked output (default) or the paper's literal "
+                             'problem')
     parser.add_argument('--no-library', action='store_true',
                         help='always fit, even if the gait library holds this wave')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
@@ -94,6 +97,7 @@ def goal_of(args: argparse.Namespace, goal_type):
     goal.max_iterations = args.iterations
     goal.swarm_size = args.swarm
     goal.use_library = not args.no_library
+    goal.mode = args.mode
     return goal
 
 

@@ -107,3 +107,20 @@ def test_infeasible_waves_are_refused_even_when_the_library_holds_them():
     bogus = replace(gait_of(order(), fitted, SHORT), wave=WaveSpec(c1=1e6))
     outcome = retune(order(c1=1e6), SHORT, library=GaitLibrary().with_gait(bogus))
     assert not outcome.success and outcome.message.startswith('rejected')
+
+
+def test_the_literal_mode_is_fitted_and_kept_apart_in_the_library():
+    literal = retune(order(mode='literal'), SHORT)
+    assert literal.success, literal.message
+    phase_free = retune(order(), SHORT)
+    assert literal.params != phase_free.params
+    assert literal.params.frequency_hz == 1.0  # literal: v is the wave's frequency
+    library = GaitLibrary().with_gait(gait_of(order(mode='literal'), literal, SHORT))
+    assert retune(order(mode='literal'), SHORT, library=library).from_library
+    assert not retune(order(), SHORT, library=library).from_library
+
+
+def test_an_unknown_mode_is_rejected():
+    outcome = retune(order(mode='exact'), SHORT)
+    assert not outcome.success and 'mode must be empty or one of phase_free, literal' in \
+        outcome.message

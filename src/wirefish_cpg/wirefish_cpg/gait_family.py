@@ -59,13 +59,13 @@ def scale_of(wave: WaveSpec, reference: WaveSpec) -> float | None:
     return scale
 
 
-def family(library: GaitLibrary, reference: WaveSpec, geometry: dict[str, float]
-           ) -> list[FamilyMember]:
+def family(library: GaitLibrary, reference: WaveSpec, geometry: dict[str, float],
+           mode: str = 'phase_free') -> list[FamilyMember]:
     """Return the library's gaits of the reference's family on ``geometry``, by (f, s)."""
     members = []
     for gait in library.for_geometry(geometry):
         scale = scale_of(gait.wave, reference)
-        if scale is not None:
+        if scale is not None and gait.mode == mode:
             members.append(FamilyMember(gait.wave.frequency_hz, scale, gait))
     return sorted(members, key=lambda m: (m.frequency_hz, m.scale))
 

@@ -16,6 +16,7 @@ fish asks other servo angles. Its YAML file (``FILE_FORMAT``, version ``FILE_VER
       loss: 0.000413
       rmse_theta_deg: [0.254, 0.864]
       fitted_at: '2026-12-01T07:00:00.000000+00:00'
+      mode: phase_free                           # the fit mode; absent = phase_free
 
 Floats are written as Python's repr, so a wave read back compares equal to the one stored.
 ``save_library`` writes atomically (a temporary file in the same directory, flushed and fsynced,
@@ -62,10 +63,13 @@ class Gait:
     loss: float
     rmse_theta_deg: tuple[float, float]
     fitted_at: str = field(default_factory=lambda: datetime.now(timezone.utc).isoformat())
+    mode: str = 'phase_free'  # the fit mode (wave_loss.FIT_MODES)
 
-    def matches(self, wave: WaveSpec, geometry: dict[str, float]) -> bool:
-        """Return whether this gait was fitted to exactly ``wave`` on exactly ``geometry``."""
-        return self.wave == wave and dict(self.geometry) == dict(geometry)
+    def matches(self, wave: WaveSpec, geometry: dict[str, float],
+                mode: str = 'phase_free') -> bool:
+        """Return whether this gait was fitted to exactly ``wave`` on ``geometry`` in ``mode``."""
+        return (self.wave == wave and dict(self.geometry) == dict(geometry)
+                and self.mode == mode)
 
     def to_record(self) -> dict:
         """Return the gait as the plain mapping stored in the YAML file."""
@@ -78,7 +82,7 @@ class Gait:
                 'params': {name: float(values[name]) for name in PARAMETER_FIELDS},
                 'loss': float(self.loss),
                 'rmse_theta_deg': [float(v) for v in self.rmse_theta_deg],
-                'fitted_at': self.fitted_at}
+                'fitted_at': self.fitted_at, 'mode': self.mode}
 
     @classmethod
     def from_record(cls, record: dict) -> Gait:
@@ -95,12 +99,13 @@ class Gait:
             rmse = tuple(float(v) for v in record['rmse_theta_deg'])
             loss = float(record['loss'])
             fitted_at = str(record['fitted_at'])
+            mode = str(record.get('mode', 'phase_free'))
         except (KeyError, TypeError, AttributeError) as error:
             raise ValueError(f'a gait record lacks or mistypes {error}') from error
         if len(rmse) != 2 or not math.isfinite(loss):
             raise ValueError('a gait record needs a finite loss and two RMSE values')
         return cls(wave=wave, geometry=geometry, params=params, loss=loss,
-                   rmse_theta_deg=(rmse[0], rmse[1]), fitted_at=fitted_at)
+                   rmse_theta_deg=(rmse[0], rmse[1]), fitted_at=fitted_at, mode=mode)
 
 
 def geometry_key(geometry: dict[str, float]) -> tuple[tuple[str, float], ...]:
@@ -114,13 +119,15 @@ class GaitLibrary:
 
     gaits: tuple[Gait, ...] = ()
 
-    def find(self, wave: WaveSpec, geometry: dict[str, float]) -> Gait | None:
-        """Return the gait fitted to ``wave`` on ``geometry``, or None."""
-        return next((g for g in self.gaits if g.matches(wave, geometry)), None)
+    def find(self, wave: WaveSpec, geometry: dict[str, float], mode: str = 'phase_free'
+             ) -> Gait | None:
+        """Return the gait fitted to ``wave`` on ``geometry`` in ``mode``, or None."""
+        return next((g for g in self.gaits if g.matches(wave, geometry, mode)), None)
 
     def with_gait(self, gait: Gait) -> GaitLibrary:
         """Return the library with ``gait`` added (replacing one for the same wave, geometry)."""
-        kept = tuple(g for g in self.gaits if not g.matches(gait.wave, dict(gait.geometry)))
+        kept = tuple(g for g in self.gaits
+                     if not g.matches(gait.wave, dict(gait.geometry), gait.mode))
         return GaitLibrary(kept + (gait,))
 
     def for_geometry(self, geometry: dict[str, float]) -> tuple[Gait, ...]:
@@ -143,8 +150,8 @@ def library_from_document(document: object) -> GaitLibrary:
     by_key: dict[tuple, Gait] = {}
     for record in records:  # a later record of the same wave and geometry wins, as in with_gait
         gait = Gait.from_record(record)
-        by_key.pop((gait.wave, gait.geometry), None)
-        by_key[gait.wave, gait.geometry] = gait
+        by_key.pop((gait.wave, gait.geometry, gait.mode), None)
+        by_key[gait.wave, gait.geometry, gait.mode] = gait
     return GaitLibrary(tuple(by_key.values()))
 
 

@@ -28,11 +28,12 @@ from wirefish_cpg.gait_library import Gait, GaitLibrary
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait
-from wirefish_cpg.wave_loss import (PAPER_UPPER, swing_angle_rmse_deg, WaveFitProblem,
-                                    WaveSpec)
+from wirefish_cpg.wave_loss import (FIT_MODES, PAPER_UPPER, swarm_swing_rmse_deg,
+                                    WaveFitProblem, WaveSpec)
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS
 
+DEFAULT_MODE = 'phase_free'
 MAX_SWARM_SIZE = 2000
 MAX_ITERATIONS = 5000
 # (iteration, best loss (m*s), swing-angle RMSE (2,) deg of the best so far); may raise
@@ -56,6 +57,11 @@ class RetuneOrder:
     max_iterations: int = 0
     swarm_size: int = 0
     use_library: bool = True
+    mode: str = ''  # '' = 'phase_free'; FIT_MODES of wave_loss
+
+    def fit_mode(self) -> str:
+        """Return the fit mode the order asks for ('phase_free' when not given)."""
+        return self.mode or DEFAULT_MODE
 
     def wave_values(self) -> dict[str, float]:
         """Return the wave's four numbers by their message field names."""
@@ -137,6 +143,8 @@ def order_problem(order: RetuneOrder) -> str | None:
     if order.swarm_size != 0 and not 2 <= order.swarm_size <= MAX_SWARM_SIZE:
         return (f'swarm_size must be 0 (default) or in [2, {MAX_SWARM_SIZE}], '
                 f'got {order.swarm_size}')
+    if order.mode and order.mode not in FIT_MODES:
+        return f'mode must be empty or one of {", ".join(FIT_MODES)}, got {order.mode!r}'
     if order.max_iterations != 0 and not 1 <= order.max_iterations <= MAX_ITERATIONS:
         return (f'max_iterations must be 0 (default) or in [1, {MAX_ITERATIONS}], '
                 f'got {order.max_iterations}')
@@ -165,7 +173,7 @@ def retune(order: RetuneOrder, settings: RetuneSettings,
     if reason is not None:
         return RetuneOutcome(False, f'rejected: {reason}')
     if order.use_library and library is not None:
-        gait = library.find(problem.wave, settings.geometry_fields())
+        gait = library.find(problem.wave, settings.geometry_fields(), order.fit_mode())
         if gait is not None:
             return RetuneOutcome(
                 True, f'from the gait library (fitted {gait.fitted_at}): '
@@ -183,7 +191,7 @@ def gait_of(order: RetuneOrder, outcome: RetuneOutcome, settings: RetuneSettings
     wave = settings.problem_for(order).wave
     return Gait(wave=wave, geometry=tuple(sorted(settings.geometry_fields().items())),
                 params=outcome.params, loss=outcome.loss,
-                rmse_theta_deg=outcome.rmse_theta_deg)
+                rmse_theta_deg=outcome.rmse_theta_deg, mode=order.fit_mode())
 
 
 def fit_order(order: RetuneOrder, problem: WaveFitProblem, settings: RetuneSettings,
@@ -192,13 +200,16 @@ def fit_order(order: RetuneOrder, problem: WaveFitProblem, settings: RetuneSetti
     options = settings.options_for(order)
     upper = np.asarray(settings.upper, dtype=float)
 
+    mode = order.fit_mode()
+
     def on_iteration(iteration: int, best_loss: float, best: np.ndarray) -> None:
         if progress is not None:
-            progress(iteration, best_loss, swing_angle_rmse_deg(best[None, :], problem)[0])
+            progress(iteration, best_loss, swarm_swing_rmse_deg(
+                best[None, :], problem, mode, alpha=settings.alpha)[0])
 
     start = time.perf_counter()
     fit = fit_gait(problem, np.random.default_rng(order.seed), options, -upper, upper,
-                   alpha=settings.alpha, callback=on_iteration)
+                   alpha=settings.alpha, callback=on_iteration, mode=mode)
     figures = {'params': fit.params, 'loss': fit.loss,
                'rmse_theta_deg': tuple(float(v) for v in fit.rmse_theta_deg),
                'iterations': fit.iterations, 'elapsed_s': time.perf_counter() - start}

@@ -114,7 +114,8 @@ def order_of(request, use_library: bool = False) -> RetuneOrder:
     wave = request.wave
     return RetuneOrder(c1=wave.c1, c2=wave.c2, k=wave.k, frequency_hz=wave.frequency_hz,
                        seed=request.seed, max_iterations=request.max_iterations,
-                       swarm_size=request.swarm_size, use_library=use_library)
+                       swarm_size=request.swarm_size, use_library=use_library,
+                       mode=request.mode)
 
 
 def parameter_messages(params: CpgParameters) -> list[ParameterMsg]:
