@@ -79,3 +79,36 @@ def test_a_count_outside_uint32_is_an_option_error(python, ros_env, option):
     assert result.returncode == 2
     assert 'must be in [0, 4294967295]' in result.stderr
     assert 'Traceback' not in result.stderr
+
+
+def test_on_a_terminal_the_progress_is_one_live_bar(tuner, python, ros_env):
+    import os
+    import pty
+
+    tuner('-r', f'__ns:={NAMESPACE}')
+    controller, terminal = pty.openpty()
+    # Read after the run: 21 redraws (~1.5 kB) fit the pty's buffer, so the writer never blocks.
+    try:
+        done = subprocess.run(command(python, '--iterations', '20', '--swarm', '20'),
+                              env=ros_env, stdout=subprocess.PIPE, stderr=terminal, text=True,
+                              timeout=120)
+        os.close(terminal)
+        terminal = None
+        shown = b''
+        while True:
+            try:
+                chunk = os.read(controller, 65536)
+            except OSError:  # the pty is drained and closed
+                break
+            if not chunk:
+                break
+            shown += chunk
+    finally:
+        if terminal is not None:
+            os.close(terminal)
+        os.close(controller)
+    assert done.returncode == 0
+    text = shown.decode()
+    assert text.count('\r[') == 21  # redrawn in place once per iteration
+    assert '[##############################] iteration 20/20  best loss ' in text
+    assert 'RMSE theta' not in text  # the plain lines are for non-terminals
