@@ -18,14 +18,6 @@ SRC = ROOT / 'src'
 ARCHITECTURE = ROOT / 'docs' / 'ARCHITECTURE.md'
 CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
 DOCS = (ARCHITECTURE, CONTRACTS)
-# Every node's parameter table: (module, attribute).
-PARAMETER_TABLES = [
-    ('wirefish_cpg.cpg_node_parameters', 'NODE_PARAMETERS'),
-    ('wirefish_kinematics.node_parameters', 'NODE_PARAMETERS'),
-    ('wirefish_bridge.bridge_parameters', 'PARAMETERS'),
-    ('wirefish_planner.planner_config', 'PLANNER_PARAMETERS'),
-    ('wirefish_cpg.tuner_node', 'TUNER_PARAMETERS'),
-]
 # A topic, service or action name given as a literal where a node or tool creates it.
 _CREATED = re.compile(
     r'(?:create_(?:publisher|subscription|service)|ActionServer|ActionClient)'
@@ -50,6 +42,30 @@ def _source_files() -> list[Path]:
 
 def _created_names() -> set[str]:
     return {name for path in _source_files() for name in _CREATED.findall(_text(path))}
+
+
+def parameter_tables() -> list[tuple[str, str]]:
+    """
+    Return (module, name) of the table each registry node declares: ``declare(self, NAME, ...)``.
+
+    Read from each node class's module, so a node added to the registry is checked too.
+    """
+    tables = []
+    for entry in NODES:
+        if entry.node_class is None:
+            continue
+        module = entry.node_class.split(':')[0]
+        package, name = module.split('.')
+        tree = ast.parse(_text(SRC / package / package / f'{name}.py'))
+        imported = {a.asname or a.name: n.module for n in ast.walk(tree)
+                    if isinstance(n, ast.ImportFrom) for a in n.names}
+        for call in ast.walk(tree):
+            if (isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
+                    and call.func.id == 'declare' and len(call.args) >= 2
+                    and isinstance(call.args[1], ast.Name)):
+                table = call.args[1].id
+                tables.append((imported.get(table, module), table))
+    return tables
 
 
 def _defined_names(module_path: Path) -> dict[str, set[str]]:
@@ -112,7 +128,12 @@ def test_every_topic_service_and_action_the_code_creates_is_in_the_contracts():
     assert not missing, f'CONTRACTS.md lacks {missing}'
 
 
-@pytest.mark.parametrize('module, table', PARAMETER_TABLES)
+def test_every_node_class_of_the_registry_declares_a_table_found_here():
+    found = {module.split('.')[0] for module, _ in parameter_tables()}
+    assert found == {e.package for e in NODES if e.node_class is not None}
+
+
+@pytest.mark.parametrize('module, table', parameter_tables())
 def test_every_declared_parameter_is_in_the_contracts(module, table):
     specs = getattr(importlib.import_module(module), table)
     missing = [s.name for s in specs if f'`{s.name}`' not in _text(CONTRACTS)]
