@@ -1,13 +1,15 @@
 """
 Fixtures of the two-host tests: a fish host and a shore host in two network namespaces.
 
-The pair (``wirefish_bringup.netns.TwoHosts``) is made for this module and deleted at its end,
-also when a test fails; its names carry ``wf`` and a token of this run, its addresses are
-10.213.<WIREFISH_TEST_DOMAIN_BASE % 256>.1/.2. Making namespaces needs root: elsewhere every
-test here is skipped with the reason (CI runs as root, so they run there).
+The pair (``wirefish_bringup.netns.TwoHosts``) is made for each test and deleted at its end,
+also when it fails; its names carry ``wf`` and a token of this run, its addresses are
+10.213.<(WIREFISH_TEST_DOMAIN_BASE + n) % 256>.1/.2 for the n-th pair. Making namespaces needs
+root: elsewhere every test here is skipped with the reason (CI runs as root, so they run
+there).
 """
 
 from collections.abc import Iterator
+import itertools
 import os
 
 import pytest
@@ -15,21 +17,29 @@ from ros_utils import stop_process
 from twohost.link_hosts import Hosts
 
 DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21'))
+_pairs = itertools.count()
 
 
-@pytest.fixture(scope='module')
-def hosts(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Hosts]:
-    """Yield a fish host and a shore host joined by a veth pair; remove both at the end."""
-    from wirefish_bringup.netns import root_problem, TwoHosts
+@pytest.fixture
+def hosts(request: pytest.FixtureRequest, tmp_path) -> Iterator[Hosts]:
+    """
+    Yield a fish host and a shore host joined by a veth pair; remove both at the end.
+
+    DDS discovery across the pair is multicast unless the test asks for ``netns.STATIC``
+    (``@pytest.mark.parametrize('hosts', [STATIC], indirect=True)``).
+    """
+    from wirefish_bringup.netns import MULTICAST, root_problem, TwoHosts
 
     problem = root_problem()
     if problem is not None:
         pytest.skip(problem)
-    link = TwoHosts(f'{os.getpid():x}'[-6:], DOMAIN_BASE % 256)
+    # A pair of its own per test (names and subnet): nothing of the last test's pair is reused.
+    index = next(_pairs)
+    link = TwoHosts(f'{os.getpid():x}'[-5:] + str(index), (DOMAIN_BASE + index) % 256)
     link.remove()  # a pair of the same token left by a killed run
     link.create()
-    hosts = Hosts(link, DOMAIN_BASE + 19, f'/h{DOMAIN_BASE}_twohost',
-                  tmp_path_factory.mktemp('twohost'))
+    hosts = Hosts(link, DOMAIN_BASE + 19, f'/h{DOMAIN_BASE}_twohost', tmp_path,
+                  discovery=getattr(request, 'param', MULTICAST))
     try:
         yield hosts
     finally:

@@ -63,12 +63,14 @@ class Hosts:
     domain_id: int
     namespace: str
     out: Path
+    discovery: str
     processes: list = field(default_factory=list)
 
     def env(self, side: str) -> dict[str, str]:
         """Return the environment of a process on ``side``."""
         return dict(os.environ, ROS_DOMAIN_ID=str(self.domain_id), PYTHONUNBUFFERED='1',
-                    RCUTILS_COLORIZED_OUTPUT='0', **self.link.ros_environment(side))
+                    RCUTILS_COLORIZED_OUTPUT='0',
+                    **self.link.ros_environment(side, self.discovery))
 
     def start(self, side: str, args: list[str], **kwargs) -> subprocess.Popen:
         """Start ``args`` on ``side``'s host (its own process group, stopped at teardown)."""

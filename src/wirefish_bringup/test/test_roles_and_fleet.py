@@ -74,6 +74,23 @@ def test_a_fleet_recording_is_one_recorder_of_the_base_namespace():
     assert len(recorders) == 1 and _option(recorders[0], '--namespace') == '/tank'
 
 
+def _everything_named(specs) -> set[str]:
+    """Return every namespace and device path the processes of ``specs`` use."""
+    named = set()
+    for spec in specs:
+        args = spec.command_arguments()
+        named |= {a.split(':=', 1)[1] for a in args if a.startswith(('__ns:=', 'port:='))}
+        named |= {args[i + 1] for i, a in enumerate(args) if a == '--link'}
+    return named
+
+
+def test_two_fleets_share_no_namespace_and_no_virtual_fish_link():
+    one, other = _everything_named(fleet_graph('/tank_a', 3)), _everything_named(
+        fleet_graph('/tank_b', 3))
+    assert len(one) == 6 and len(other) == 6  # 3 namespaces and 3 links each
+    assert not one & other
+
+
 @pytest.mark.parametrize('count', [0, 17])
 def test_a_fleet_size_outside_its_bounds_is_refused(count):
     with pytest.raises(ValueError, match='fleet'):
