@@ -15,9 +15,14 @@ from wirefish_bringup.graph import NODES
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / 'src'
+README = ROOT / 'README.md'
 ARCHITECTURE = ROOT / 'docs' / 'ARCHITECTURE.md'
 CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
 DOCS = (ARCHITECTURE, CONTRACTS)
+# README.md's topic table disagrees with the code here today (reported to the README's owner):
+# it lists a topic that is gone and lacks two. Remove each name once the README is fixed.
+README_STALE = {'retune_progress'}  # removed by the RetuneGait action (4d7285e)
+README_MISSING = {'cmd_vel', 'planner_state'}  # the planner's (84e8ed5 and before)
 # A topic, service or action name given as a literal where a node or tool creates it.
 _CREATED = re.compile(
     r'(?:create_(?:publisher|subscription|service)|ActionServer|ActionClient)'
@@ -66,6 +71,20 @@ def parameter_tables() -> list[tuple[str, str]]:
                 table = call.args[1].id
                 tables.append((imported.get(table, module), table))
     return tables
+
+
+def readme_table_names() -> set[str]:
+    """Return the names in the first column of README.md's table of topics and services."""
+    names: set[str] = set()
+    in_table = False
+    for line in _text(README).splitlines():
+        if line.startswith('| name | kind |'):
+            in_table = True
+        elif in_table and not line.startswith('|'):
+            break
+        elif in_table:
+            names |= set(re.findall(r'`([^`]+)`', line.split('|')[1]))
+    return names
 
 
 def _defined_names(module_path: Path) -> dict[str, set[str]]:
@@ -131,6 +150,16 @@ def test_every_topic_service_and_action_the_code_creates_is_in_the_contracts():
 def test_every_node_class_of_the_registry_declares_a_table_found_here():
     found = {module.split('.')[0] for module, _ in parameter_tables()}
     assert found == {e.package for e in NODES if e.node_class is not None}
+
+
+def test_the_readme_topic_table_lists_what_the_code_creates():
+    listed, created = readme_table_names(), _created_names()
+    stale, missing = listed - created, created - listed
+    assert listed and stale <= README_STALE and missing <= README_MISSING, (
+        f'README.md topic table: {sorted(stale)} created nowhere, {sorted(missing)} not listed')
+    if stale or missing:
+        pytest.xfail(f'README.md topic table, known and reported: {sorted(stale)} gone, '
+                     f'{sorted(missing)} missing')
 
 
 @pytest.mark.parametrize('module, table', parameter_tables())
