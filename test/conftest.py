@@ -24,6 +24,20 @@ _DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21'))
 _domains = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 19))
 
 
+@pytest.fixture(autouse=True)
+def isolated_ros_home(tmp_path_factory: pytest.TempPathFactory,
+                      monkeypatch: pytest.MonkeyPatch) -> Path:
+    """
+    Give every test a ROS home of its own (``ROS_HOME``), for itself and its child processes.
+
+    The tuner's gait library defaults to ``$ROS_HOME/wirefish/gaits.yaml``: with the user's
+    ``~/.ros`` a test would answer from a fit that an earlier run stored, or leave one behind.
+    """
+    home = tmp_path_factory.mktemp('ros_home')
+    monkeypatch.setenv('ROS_HOME', str(home))
+    return home
+
+
 @pytest.fixture
 def ros_domain_id() -> int:
     """Return a ROS domain id that no other test in this run is using."""
