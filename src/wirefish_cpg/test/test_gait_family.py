@@ -81,3 +81,13 @@ def test_the_locked_form_folds_signs_without_changing_the_gait(grid_library):
 def test_interpolation_outside_the_grid_is_refused(grid_library, frequency, scale):
     with pytest.raises(ValueError, match='outside the family grid'):
         interpolated_parameters(family(grid_library, REFERENCE, FIELDS), frequency, scale)
+
+
+@pytest.mark.parametrize('frequency, scale', [(1.0, 0.8), (1.5, 1.2), (1.25, 0.8), (1.0, 1.0)])
+def test_a_query_on_a_grid_line_blends_within_the_family(grid_library, frequency, scale):
+    members = family(grid_library, REFERENCE, FIELDS)
+    r1, r2, _ = locked_form(interpolated_parameters(members, frequency, scale))
+    corners = np.array([locked_form(m.gait.params)[:2] for m in members])
+    # A blend is a convex combination: each amplitude within the corners' (never a zero gait).
+    assert corners[:, 0].min() - 1e-12 <= r1 <= corners[:, 0].max() + 1e-12
+    assert corners[:, 1].min() - 1e-12 <= r2 <= corners[:, 1].max() + 1e-12

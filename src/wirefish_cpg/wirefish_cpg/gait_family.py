@@ -121,8 +121,12 @@ def interpolated_parameters(members: list[FamilyMember], frequency_hz: float, sc
             corners[f, s] = locked_form(match[0].gait.params)
     u = 0.0 if f1 == f0 else (frequency_hz - f0) / (f1 - f0)
     v = 0.0 if s1 == s0 else (scale - s0) / (s1 - s0)
-    weights = {(f0, s0): (1 - u) * (1 - v), (f1, s0): u * (1 - v),
-               (f0, s1): (1 - u) * v, (f1, s1): u * v}
+    # Summed, not assigned: on a grid line two corners are one (f0 == f1 or s0 == s1), and
+    # assigning the second weight would overwrite the first (a zero gait on every grid line).
+    weights: dict[tuple[float, float], float] = {}
+    for key, weight in (((f0, s0), (1 - u) * (1 - v)), ((f1, s0), u * (1 - v)),
+                        ((f0, s1), (1 - u) * v), ((f1, s1), u * v)):
+        weights[key] = weights.get(key, 0.0) + weight
     anchor = corners[f0, s0][2]
     r1 = r2 = delta = 0.0
     for key, weight in weights.items():
