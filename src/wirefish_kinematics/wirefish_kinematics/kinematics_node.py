@@ -14,8 +14,9 @@ Publishes (frame ``tail_base`` = C0 of paper section 3.1)
     sample arrived: ``station_count`` stations, eqs 2-15; ``y_desired`` (eq 23) once the tail
     beats, shown at the tail's phase (see ``desired_wave.wave_time_at_phase``).
     ``body_wave_markers`` (visualization_msgs/MarkerArray, reliable depth 5, so RViz's default
-    subscription matches): tail polyline, desired
-    wave as dots, link ends O1 (sphere) and O2 (cube).
+    subscription matches) with every n-th body_wave, n = round(publish_rate_hz /
+    markers_rate_hz) (10 Hz by default: they cost more than the body wave): tail polyline,
+    desired wave as dots, link ends O1 (sphere) and O2 (cube).
     ``speed_estimate`` (wirefish_msgs/SpeedEstimate, reliable) once per completed tail beat
     (stamped at the end of the period), eqs 16-22; all zeros while the tail is at rest
     (``tail_beat_tracker`` decides when).
@@ -41,9 +42,9 @@ from wirefish_kinematics.desired_wave import desired_wave_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
 from wirefish_kinematics.kinematics_messages import (body_wave_markers, body_wave_message, FRAME,
                                                      speed_estimate_message, to_stamp)
-from wirefish_kinematics.node_parameters import (declare, geometry_from, NODE_PARAMETERS,
-                                                 SPECS, validate_update, wave_from,
-                                                 WAVE_PARAMETER_NAMES)
+from wirefish_kinematics.node_parameters import (declare, geometry_from, markers_every,
+                                                 NODE_PARAMETERS, SPECS, validate_update,
+                                                 wave_from, WAVE_PARAMETER_NAMES)
 from wirefish_kinematics.tail_beat_tracker import TailBeatTracker
 from wirefish_kinematics.tail_shape import tail_shape
 from wirefish_kinematics.wave_spec import wave_from_message
@@ -67,6 +68,9 @@ class KinematicsNode(Node):
         self._tracker = TailBeatTracker(self._values['max_tail_beat_period_s'])
         self._latest: tuple[int, int, tuple[float, float]] | None = None
         self._fresh = False
+        self._markers_every = 1
+        self._ticks_to_markers = 0  # body_wave ticks before the next markers (0: this one)
+        self._set_markers_rate()
         self._warned: dict[str, float] = {}
         self._body_pub = self.create_publisher(BodyWave, 'body_wave', SENSOR_DATA)
         # Reliable, unlike the data streams: RViz subscribes to markers reliably by default, and
@@ -99,10 +103,17 @@ class KinematicsNode(Node):
             self.destroy_timer(self._timer)
             self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'],
                                             self._on_tick)
+        if names & {'publish_rate_hz', 'markers_rate_hz'}:
+            self._set_markers_rate()
         if 'max_tail_beat_period_s' in names:
             self._tracker.max_period_s = self._values['max_tail_beat_period_s']
         if 'use_servo_state' in names:
             self._subscribe_servo()
+
+    def _set_markers_rate(self) -> None:
+        self._markers_every = markers_every(self._values['publish_rate_hz'],
+                                            self._values['markers_rate_hz'])
+        self._ticks_to_markers = 0
 
     def _subscribe_servo(self) -> None:
         if self._servo_sub is not None:
@@ -151,7 +162,10 @@ class KinematicsNode(Node):
                 self._frame))
         y_desired = self._desired_wave(self._tracker.history.last_time(), shape.stations)
         self._body_pub.publish(body_wave_message(shape, y_desired, stamp, self._frame))
-        self._marker_pub.publish(body_wave_markers(shape, y_desired, stamp, self._frame))
+        if self._ticks_to_markers == 0:
+            self._marker_pub.publish(body_wave_markers(shape, y_desired, stamp, self._frame))
+            self._ticks_to_markers = self._markers_every
+        self._ticks_to_markers -= 1
 
     def _desired_wave(self, t: float, stations: np.ndarray) -> np.ndarray | None:
         """Return y_body at the stations, shown at the tail's phase at t; None if unknown."""
