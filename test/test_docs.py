@@ -21,8 +21,6 @@ CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
 DOCS = (ARCHITECTURE, CONTRACTS)
 # README.md's topic table disagrees with the code here today (reported to the README's owner):
 # it lists a topic that is gone and lacks two. Remove each name once the README is fixed.
-README_STALE = {'retune_progress'}  # removed by the RetuneGait action (4d7285e)
-README_MISSING = {'cmd_vel', 'planner_state'}  # the planner's (84e8ed5 and before)
 # A topic, service or action name given as a literal where a node or tool creates it.
 _CREATED = re.compile(
     r'(?:create_(?:publisher|subscription|service)|ActionServer|ActionClient)'
@@ -155,11 +153,8 @@ def test_every_node_class_of_the_registry_declares_a_table_found_here():
 def test_the_readme_topic_table_lists_what_the_code_creates():
     listed, created = readme_table_names(), _created_names()
     stale, missing = listed - created, created - listed
-    assert listed and stale <= README_STALE and missing <= README_MISSING, (
+    assert listed and not stale and not missing, (
         f'README.md topic table: {sorted(stale)} created nowhere, {sorted(missing)} not listed')
-    if stale or missing:
-        pytest.xfail(f'README.md topic table, known and reported: {sorted(stale)} gone, '
-                     f'{sorted(missing)} missing')
 
 
 @pytest.mark.parametrize('module, table', parameter_tables())
