@@ -24,10 +24,5 @@ setup(
         'console_scripts': [
             'planner_node = wirefish_planner.planner_node:main',
         ],
-        # Subcommands of the `wirefish` command that live here (see wirefish_bringup.cli).
-        'wirefish.commands': [
-            'drive = wirefish_planner.drive',
-            'mission = wirefish_planner.mission',
-        ],
     },
 )

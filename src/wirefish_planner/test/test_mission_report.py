@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 from wirefish_planner.mission_plan import mission_from
-from wirefish_planner.mission_report import plot_mission, summarise, summary_text, Track
+from wirefish_planner.mission_report import (plot_mission, summarise, summary_text, Track,
+                                             turn_gain_text)
 
 MISSION = mission_from({'legs': [{'duration_s': 5.0, 'speed': 0.2},
                                  {'duration_s': 5.0, 'speed': 0.2, 'yaw_rate': 0.2}]})
@@ -61,14 +62,10 @@ def _states(offsets):
 
 
 def test_the_mission_prints_the_turn_gain_it_identifies():
-    from wirefish_planner.mission import turn_gain_text
-
     offsets = [0.0] * 60 + [-0.1] * 100 + [0.1] * 100
     assert 'k = -9.00' in turn_gain_text(_states(offsets))
     assert 'd = +0.0200' in turn_gain_text(_states(offsets))
 
 
 def test_a_straight_mission_says_why_no_turn_gain():
-    from wirefish_planner.mission import turn_gain_text
-
     assert 'not identified' in turn_gain_text(_states([0.0] * 100))

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from wirefish_planner.mission_plan import Mission
+from wirefish_planner.yaw_control import identify_turn_gain, steady_means
 
 ARROW_EVERY_S = 1.0
 SMOOTH_S = 1.0  # the ground truth beats with the tail: the plots also show a 1 s mean
@@ -124,3 +125,19 @@ def summary_text(mission: Mission, summary: MissionSummary) -> str:
         lines.append(f'  leg {index:>2}: speed {speed_set:.3f} -> {speed:.3f} m/s, yaw rate '
                      f'{rate_set:+.3f} -> {rate:+.3f} rad/s')
     return '\n'.join(lines)
+
+
+def turn_gain_text(states: list) -> str:
+    """Return the turn gain identified from recorded planner_state (or why it cannot be)."""
+    rows = [(t, m.predicted_speed, m.offset, m.yaw_rate_measured) for t, m in states
+            if m.mode in ('turn', 'hold', 'straight')]
+    if len(rows) < 3:
+        return 'turn gain: not identified (no planner_state of a closed-loop run recorded)'
+    data = np.array(rows)
+    try:
+        gain, bias = identify_turn_gain(*steady_means(*data.T))
+    except ValueError as error:
+        return f'turn gain: not identified: {error}'
+    return (f'turn gain identified from this run (r = k U b + d, steady 1 s means): '
+            f'k = {gain:.2f} rad/s per rad per m/s (planner parameter turn_gain), '
+            f'd = {bias:+.4f} rad/s (a current, or the gyro bias)')

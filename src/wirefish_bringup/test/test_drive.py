@@ -4,7 +4,7 @@ import math
 from types import SimpleNamespace
 
 import pytest
-from wirefish_planner.drive import DriveLimits, key_action, split_keys, state_line
+from wirefish_bringup.drive import DriveLimits, key_action, split_keys, state_line
 
 LIMITS = DriveLimits(speed_step=0.05, max_speed=0.1, turn_step=0.1, max_turn=0.2)
 

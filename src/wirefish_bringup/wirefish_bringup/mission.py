@@ -149,7 +149,7 @@ def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> in
     import numpy as np
     from wirefish_bringup.bagfile import read_bag
     from wirefish_planner.mission_report import (plot_mission, summarise, summary_text,
-                                                 Track)
+                                                 Track, turn_gain_text)
 
     topic = f'{namespace.rstrip("/")}/sim/ground_truth'
     state_topic = f'{namespace.rstrip("/")}/planner_state'
@@ -170,22 +170,3 @@ def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> in
     print(turn_gain_text(bag.messages.get(state_topic, [])))
     print(f'bag: {bag_path}\nreport: {png}')
     return 0
-
-
-def turn_gain_text(states: list) -> str:
-    """Return the turn gain identified from recorded planner_state (or why it cannot be)."""
-    import numpy as np
-    from wirefish_planner.yaw_control import identify_turn_gain, steady_means
-
-    rows = [(t, m.predicted_speed, m.offset, m.yaw_rate_measured) for t, m in states
-            if m.mode in ('turn', 'hold', 'straight')]
-    if len(rows) < 3:
-        return 'turn gain: not identified (no planner_state of a closed-loop run recorded)'
-    data = np.array(rows)
-    try:
-        gain, bias = identify_turn_gain(*steady_means(*data.T))
-    except ValueError as error:
-        return f'turn gain: not identified: {error}'
-    return (f'turn gain identified from this run (r = k U b + d, steady 1 s means): '
-            f'k = {gain:.2f} rad/s per rad per m/s (planner parameter turn_gain), '
-            f'd = {bias:+.4f} rad/s (a current, or the gyro bias)')
