@@ -53,7 +53,8 @@ def recording(duration_s: float, domain_id: int) -> dict:
                    timeout=duration_s + 120)
     bag = next(out.glob('run_*/bag'))
     stats = write_report(bag, bag.parent / 'report')
-    recorder_log = (bag.parent / 'logs' / 'recorder.log').read_text()
+    # The supervisor names each log after its registry entry (wirefish_recorder.log).
+    recorder_log = next((bag.parent / 'logs').glob('*recorder*.log')).read_text()
     transport = re.search(r'lost in transport: (\d+)', recorder_log)
     missing = re.search(r"missing from the publishers' sequences: (\d+)", recorder_log)
     return {'duration_s': duration_s,
