@@ -148,7 +148,7 @@ def library_answer(repeats: int = 20, domain_id: int = 97) -> dict:
             if not client.wait_for_server(timeout_sec=30.0):
                 raise RuntimeError('no retune_gait action server within 30 s')
 
-            def round_trip() -> tuple[float, object]:
+            def round_trip() -> tuple[float, RetuneGait.Result]:
                 goal = RetuneGait.Goal()
                 goal.wave.c1, goal.wave.c2, goal.wave.k, goal.wave.frequency_hz = (
                     0.15, 1.0, 8.0, 1.0)

@@ -301,8 +301,8 @@ def report(result: Identification) -> str:
             ('tip amp 1 Hz cm', '4-9', lambda e: f'{100 * e.tip_amplitude_m:.2f}'),
             ('U at 3 Hz m/s', f'{CALIBRATION_SPEED}', lambda e: f'{e.speed_3hz:.4f}'),
             ('l1+l2+l3 m', f'<= {BODY_LENGTH_M}', lambda e: f'{e.total_length_m:.4f}'))
-    for label, paper, value in rows:
-        lines.append(f'{label:18s} {paper:>12s} {value(before):>14s} {value(after):>14s}')
+    for label, paper, shown in rows:
+        lines.append(f'{label:18s} {paper:>12s} {shown(before):>14s} {shown(after):>14s}')
     try:
         fit = least_squares_drag(geometry_of(result.x))
         lines.append(f'least-squares C_D over the 3 speed points with the identified geometry: '

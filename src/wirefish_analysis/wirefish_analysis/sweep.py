@@ -13,6 +13,7 @@ drawn beside them.
 import argparse
 from dataclasses import dataclass
 from pathlib import Path
+from typing import overload
 
 import numpy as np
 from wirefish_cpg.table1_gait import PAPER_GRID_AMPLITUDES_M, PAPER_GRID_FREQUENCIES_HZ
@@ -20,7 +21,8 @@ from wirefish_cpg.table1_gait import PAPER_GRID_AMPLITUDES_M, PAPER_GRID_FREQUEN
 FIG11_AMPLITUDE_M = 0.05
 FIG11_FREQUENCIES_HZ = tuple(float(f) for f in np.arange(1.0, 8.01, 0.5))
 # The paper's figures as stated in its text: (f Hz, tip amplitude m or None for Table 1, U m/s).
-PAPER_POINTS = ((3.0, None, 0.39), (6.5, 0.05, 0.54), (1.0, 0.09, 0.33 * 1.0 * 0.53))
+PAPER_POINTS: tuple[tuple[float, float | None, float], ...] = (
+    (3.0, None, 0.39), (6.5, 0.05, 0.54), (1.0, 0.09, 0.33 * 1.0 * 0.53))
 
 
 @dataclass(frozen=True)
@@ -32,6 +34,15 @@ class SweepPoint:
     model_speed: float
     fish_speed: float | None
     body_length: float
+
+    @overload
+    def swimming_number(self, speed: float) -> float: ...
+
+    @overload
+    def swimming_number(self, speed: None) -> None: ...
+
+    @overload
+    def swimming_number(self, speed: float | None) -> float | None: ...
 
     def swimming_number(self, speed: float | None) -> float | None:
         """Return Sw = U / (f L) for ``speed``."""
@@ -93,13 +104,13 @@ def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> 
                      for p in points]
             line_ = ax.plot(f, model, '-', label=f'{amplitude * 100:g} cm model (eq 18)')[0]
             if points[0].fish_speed is not None:
-                fish = [p.fish_speed if quantity == 'speed' else p.swimming_number(p.fish_speed)
-                        for p in points]
-                ax.plot(f, fish, '--', color=line_.get_color())
-        for f, amplitude, speed in PAPER_POINTS:
-            if f <= 3.0:
-                value = speed if quantity == 'speed' else speed / (f * 0.53)
-                ax.plot(f, value, 'k*', markersize=12)
+                fish_values = [u if quantity == 'speed' else p.swimming_number(u)
+                               for p, u in zip(points, _fish_speeds(points))]
+                ax.plot(f, fish_values, '--', color=line_.get_color())
+        for frequency, _, speed in PAPER_POINTS:
+            if frequency <= 3.0:
+                value = speed if quantity == 'speed' else speed / (frequency * 0.53)
+                ax.plot(frequency, value, 'k*', markersize=12)
         ax.plot([], [], 'k--', label='virtual fish (dashed)')
         ax.plot([], [], 'k*', label='paper (stated in text)')
         ax.set(xlabel='tail-beat frequency (Hz)',
@@ -115,7 +126,7 @@ def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> 
     ax.plot([p.frequency_hz for p in line], [p.model_speed for p in line], '-',
             label='model (eq 18, ideal servos)')
     if line[0].fish_speed is not None:
-        ax.plot([p.frequency_hz for p in line], [p.fish_speed for p in line], 'o--',
+        ax.plot([p.frequency_hz for p in line], _fish_speeds(line), 'o--',
                 label='virtual fish (servo limits)')
     ax.plot(6.5, 0.54, 'k*', markersize=12, label='paper: 0.54 m/s at 6.5 Hz')
     ax.set(xlabel='tail-beat frequency (Hz)', ylabel='steady speed (m/s)',
@@ -126,6 +137,15 @@ def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> 
     plt.close(fig)
     paths.append(out / 'fig11_speed_5cm.png')
     return paths
+
+
+def _fish_speeds(points: list[SweepPoint]) -> list[float]:
+    """Return the points' virtual-fish speeds (m/s); raise ValueError if one has none."""
+    speeds = [p.fish_speed for p in points if p.fish_speed is not None]
+    if len(speeds) != len(points):
+        raise ValueError('a sweep with the virtual fish at some points only: every point needs '
+                         'its fish_speed to be plotted')
+    return speeds
 
 
 def _optional(value: float | None, spec: str) -> str:

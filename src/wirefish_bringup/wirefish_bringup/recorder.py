@@ -10,6 +10,7 @@ What arrived is flushed to the file every FLUSH_PERIOD_S, so a SIGKILL loses at 
 started with ``resume`` on such a bag reindexes it and goes on recording into its next file.
 """
 
+import functools
 from pathlib import Path
 
 from rclpy.event_handler import SubscriptionEventCallbacks
@@ -89,7 +90,7 @@ class BagRecorder(Node):
                 msg_class, topic, self._make_callback(topic),
                 matching_qos(self, topic, QUEUE_DEPTH), raw=True,
                 event_callbacks=SubscriptionEventCallbacks(
-                    message_lost=lambda info, topic=topic: self._on_lost(topic, info)))
+                    message_lost=functools.partial(self._on_lost, topic)))
             self.get_logger().info(f'recording {topic} [{type_name}]')
 
     def _make_callback(self, topic: str):

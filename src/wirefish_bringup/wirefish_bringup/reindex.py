@@ -9,7 +9,7 @@ of the old one (an atomic rename: a reindex that is itself killed changes nothin
 metadata.yaml from the summaries of all the bag's files. Finished files are left as they are.
 """
 
-from collections.abc import Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass
 import mmap
 import os
@@ -36,8 +36,9 @@ class Recovery:
 
 
 Decoded = rec.SchemaRecord | rec.ChannelRecord | rec.MessageRecord
-DECODERS = {rec.SCHEMA: rec.decode_schema, rec.CHANNEL: rec.decode_channel,
-            rec.MESSAGE: rec.decode_message}
+DECODERS: dict[int, Callable[[memoryview], Decoded]] = {
+    rec.SCHEMA: rec.decode_schema, rec.CHANNEL: rec.decode_channel,
+    rec.MESSAGE: rec.decode_message}
 
 
 @dataclass
@@ -51,7 +52,7 @@ def _decode_all(records: memoryview) -> list[Decoded]:
             if opcode in DECODERS]
 
 
-def _intact_chunks(data: memoryview, scan: _Scan) -> Iterator[list[Decoded]]:
+def _intact_chunks(data: memoryview, scan: _Scan) -> Generator[list[Decoded], None, None]:
     """
     Yield the decoded records of each intact chunk of an MCAP file's data, in file order.
 

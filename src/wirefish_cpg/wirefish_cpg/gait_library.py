@@ -26,6 +26,7 @@ or the new file, never a part of one. Offsets are not stored (the fit assumes b 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 import math
@@ -45,7 +46,7 @@ LIBRARY_FILE = Path('wirefish') / 'gaits.yaml'
 TEMPORARY_SUFFIX = '.tmp'
 
 
-def default_library_path(environ: dict[str, str] | None = None) -> Path:
+def default_library_path(environ: Mapping[str, str] | None = None) -> Path:
     """Return ``$ROS_HOME/wirefish/gaits.yaml``, else ``~/.ros/wirefish/gaits.yaml``."""
     environ = os.environ if environ is None else environ
     ros_home = environ.get('ROS_HOME')

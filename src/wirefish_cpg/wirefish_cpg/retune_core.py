@@ -210,12 +210,16 @@ def fit_order(order: RetuneOrder, problem: WaveFitProblem, settings: RetuneSetti
     start = time.perf_counter()
     fit = fit_gait(problem, np.random.default_rng(order.seed), options, -upper, upper,
                    alpha=settings.alpha, callback=on_iteration, mode=mode)
-    figures = {'params': fit.params, 'loss': fit.loss,
-               'rmse_theta_deg': tuple(float(v) for v in fit.rmse_theta_deg),
-               'iterations': fit.iterations, 'elapsed_s': time.perf_counter() - start}
+    rmse_1, rmse_2 = (float(v) for v in fit.rmse_theta_deg)  # (2,): theta1, theta2
+    elapsed_s = time.perf_counter() - start
+
+    def outcome(success: bool, message: str) -> RetuneOutcome:
+        return RetuneOutcome(success, message, params=fit.params, loss=fit.loss,
+                             rmse_theta_deg=(rmse_1, rmse_2), iterations=fit.iterations,
+                             elapsed_s=elapsed_s)
+
     phrase = figures_phrase(fit.loss, fit.iterations, fit.rmse_theta_deg)
     reason = fit_rejection(fit.loss, fit.rmse_theta_deg, settings.limits)
     if reason is not None:
-        return RetuneOutcome(False, f'fit refused, not applied: {reason} ({phrase})',
-                             **figures)
-    return RetuneOutcome(True, f'fitted: {phrase}', **figures)
+        return outcome(False, f'fit refused, not applied: {reason} ({phrase})')
+    return outcome(True, f'fitted: {phrase}')

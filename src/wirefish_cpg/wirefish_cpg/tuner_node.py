@@ -281,6 +281,7 @@ class TunerNode(Node):
             return outcome, False, CANCELED, False
         if not apply:
             return outcome, True, outcome.message, False
+        assert outcome.params is not None  # retune's every successful outcome carries its fit
         reason = self._apply(outcome.params)
         fitted = outcome.message if outcome.from_library else f'fitted ({outcome.summary()})'
         if reason is not None:
