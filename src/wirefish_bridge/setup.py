@@ -14,7 +14,7 @@ setup(
     zip_safe=True,
     maintainer='wirefish maintainers',
     maintainer_email='maintainers@wirefish.dev',
-    description='Serial bridge to the fish STM32 board and a virtual fish on a pseudo-terminal.',
+    description='Serial bridge to the fish STM32 board (protocol, codec, transport, bridge_node).',
     license='Apache-2.0',
     tests_require=['pytest'],
     entry_points={
