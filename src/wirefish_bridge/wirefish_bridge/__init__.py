@@ -1,1 +1,1 @@
-"""Serial bridge to the fish STM32 board and a virtual fish on a pseudo-terminal."""
+"""Serial bridge to the fish STM32 board (protocol, codec, transport, bridge_node)."""
