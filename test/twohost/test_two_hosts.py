@@ -72,12 +72,6 @@ def _applied(fish, frequency_hz: float, after: float) -> bool:
                for e in fish.events('cpg_params'))
 
 
-# Known failure, reported in the closing note of 2026-12-01: passed for its author at 08:38
-# (shore streams after 10.1 s), then failed in every run after 08:50 on the same machine, also at
-# the commit it passed on (the shore never hears shore/imu/data across the veth within 90 s;
-# the fish side runs and relays normally). Not strict: it runs in full and reports either way.
-@pytest.mark.xfail(reason='the shore hears nothing across the two netns since 08:50 '
-                   '(cause not found; see the closing note)', strict=False)
 def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
     link = hosts.link
     hosts.up(FISH, 'fish')

@@ -31,6 +31,7 @@ FISH, SHORE = 'fish', 'shore'
 MULTICAST, STATIC = 'multicast', 'static'
 _TOKEN = re.compile(r'^[a-z0-9]{1,8}$')  # wf + token + one letter fits IFNAMSIZ (15)
 COMMAND_TIMEOUT_S = 10.0
+MULTICAST_ROUTE = '224.0.0.0/4'  # IPv4 multicast, routed over the veth (see create())
 
 
 class NetnsError(RuntimeError):
@@ -112,7 +113,7 @@ class TwoHosts:
                 'ROS_STATIC_PEERS': self.address(self.other(side))}
 
     def create(self) -> None:
-        """Make both namespaces, the veth pair between them, addresses, and bring all up."""
+        """Make both namespaces, the veth pair between them, addresses, routes; bring all up."""
         try:
             for side in (FISH, SHORE):
                 _run('ip', 'netns', 'add', self.namespace(side))
@@ -125,6 +126,7 @@ class TwoHosts:
                      'dev', self.device(side))
                 _run('ip', '-n', ns, 'link', 'set', 'lo', 'up')
                 _run('ip', '-n', ns, 'link', 'set', self.device(side), 'up')
+                self._route_multicast(side)
         except NetnsError:
             self.remove()
             raise
@@ -139,16 +141,26 @@ class TwoHosts:
         listed = _run('ip', 'netns', 'list').stdout.split()
         return [self.namespace(s) for s in (FISH, SHORE) if self.namespace(s) in listed]
 
+    def _route_multicast(self, side: str) -> None:
+        # A real host sends multicast along its default route; a fresh namespace has only the
+        # veth's subnet route, so every multicast send fails (ENETUNREACH) and Fast DDS
+        # discovers nothing across the pair, with static peers too (its participant announces
+        # multicast locators). The kernel drops this route when the link goes down.
+        _run('ip', '-n', self.namespace(side), 'route', 'replace', MULTICAST_ROUTE,
+             'dev', self.device(side))
+
     def _set_links(self, state: str) -> None:
         for side in (FISH, SHORE):
             _run('ip', '-n', self.namespace(side), 'link', 'set', self.device(side), state)
+            if state == 'up':
+                self._route_multicast(side)
 
     def cut(self) -> None:
         """Set both veth ends down: nothing crosses (the radio is gone)."""
         self._set_links('down')
 
     def restore(self) -> None:
-        """Set both veth ends up again (addresses and routes come back with them)."""
+        """Set both veth ends up again; the subnet route returns by itself, multicast's here."""
         self._set_links('up')
 
     def shape(self, rate: str = '100kbit', burst: str = '16kbit', latency: str = '400ms'
