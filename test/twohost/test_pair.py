@@ -6,9 +6,9 @@ the veth's subnet route cannot send them (ENETUNREACH), and then no participant 
 ever finds one on the other, with static peers too. These tests caught that.
 """
 
-import sys
 from pathlib import Path
 import subprocess
+import sys
 
 import pytest
 from wirefish_bringup.netns import FISH, MULTICAST, MULTICAST_ROUTE, SHORE, STATIC
