@@ -1,5 +1,7 @@
 """Render benchmark results (the dict of `wirefish_analysis.bench`) as BENCHMARKS.md."""
 
+from wirefish_analysis.bench_radio_link import row as radio_row
+
 
 def _fmt(value, spec: str = '.3g') -> str:
     if isinstance(value, (int, float)):
@@ -181,6 +183,37 @@ def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
+LIBRARY_GOAL_S = 0.020  # issue 13: the same wave twice, the second from the library
+
+
+def _library_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+    table = []
+    lib = results.get('retune_library')
+    figure = 'Retune goal answered from the gait library (the same wave again): round trip'
+    if lib is not None and 'error' in lib:
+        table.append((figure, '< 20 ms', lib['error'], 'failed', ''))
+    elif lib is not None:
+        median = lib['library_round_trip_s_median']
+        table.append((
+            figure, '< 20 ms',
+            f'median {1e3 * median:.1f} ms, max {1e3 * lib["library_round_trip_s_max"]:.1f} '
+            f'ms (the tuner itself: {1e3 * lib["library_tuner_s_median"]:.2f} ms); every answer '
+            f'from the library: {lib["all_from_library"]}; the first goal (a fit of '
+            f'{lib["fit_iterations"]} iterations): {1e3 * lib["fit_round_trip_s"]:.0f} ms',
+            _verdict(median, median < LIBRARY_GOAL_S and lib['all_from_library']),
+            lib['how']))
+    build = results.get('gaits_build')
+    figure = '`wirefish gaits build`, default grid: wall time'
+    if build is not None and 'error' in build:
+        table.append((figure, 'finishes with a table', build['error'], 'failed', ''))
+    elif build is not None:
+        table.append((figure, 'finishes with a table',
+                      f'{build["wall_s"]:.1f} s; {build["summary"]}',
+                      'met' if build['returncode'] == 0 else
+                      f'failed (exit {build["returncode"]})', build['how']))
+    return table
+
+
 def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     """Return (figure, goal, measured, verdict, how) rows."""
     table = [*_cpg_rows(results), *_link_rows(results)]
@@ -198,6 +231,9 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                       _verdict(wall, wall is not None and ratio is not None and wall <= 0.2
                                and ratio >= 50),
                       _fmt(retune.get('how', 'see bench_retune.py'))))
+    table += _library_rows(results)
+    if 'radio_link' in results:
+        table.append(radio_row(results['radio_link']))
     table += _kinematics_rows(results)
     rec = results.get('recording', {})
     if 'error' in rec:
