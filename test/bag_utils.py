@@ -1,9 +1,12 @@
 """Checks of recorded bags for the cross-process tests (recorder kill, graph kill, e2e)."""
 
+from dataclasses import dataclass
 from pathlib import Path
 import subprocess
 import sys
 
+from wirefish_bringup import mcap_records as rec
+from wirefish_bringup.bag_storage import storage_files
 from wirefish_bringup.bagfile import read_bag
 import yaml
 
@@ -35,3 +38,76 @@ def assert_bag_readable(bag_path: Path) -> dict[str, int]:
 def counters(bag_path: Path, topic: str) -> list[int]:
     """Return the counter that ros_peers' body_wave_talker puts in y[2], per recorded message."""
     return [int(msg.y[2]) for _, msg in read_bag(Path(bag_path), [topic]).messages[topic]]
+
+
+@dataclass(frozen=True)
+class SequenceGap:
+    """Publisher sequence numbers absent from a bag: ``missing`` between two recorded times."""
+
+    topic: str
+    missing: int
+    after_s: float  # receive time of the last message before the gap (system clock)
+    before_s: float  # receive time of the first message after it
+
+    @property
+    def first_missing_s(self) -> float:
+        """Return about when the first missing message came (at the gap's mean spacing)."""
+        return self.after_s + (self.before_s - self.after_s) / (self.missing + 1)
+
+
+def sequence_gaps(bag_path: Path) -> tuple[list[SequenceGap], dict[str, int]]:
+    """
+    Return the gaps in every topic's publisher sequence numbers, and each topic's writer runs.
+
+    The recorder stores each message's DDS publication sequence number in the MCAP message.
+    Within one writer the numbers rise by one; a number at or below the last one starts a new
+    run (a restarted publisher, or a latched sample sent again to a restarted recorder), whose
+    first number is not a gap. Files are read in recording order.
+    """
+    runs: dict[str, int] = {}
+    last: dict[str, tuple[int, int]] = {}
+    gaps: list[SequenceGap] = []
+    for path in storage_files(Path(bag_path)):
+        topics: dict[int, str] = {}
+        data = path.read_bytes()
+        for opcode, _, content in rec.iter_records(data, len(rec.MAGIC)):
+            if opcode == rec.DATA_END:  # the summary and footer follow: no more messages
+                break
+            inner = [(opcode, content)]
+            if opcode == rec.CHUNK:
+                inner = [(op, c) for op, _, c in rec.iter_records(rec.decode_chunk(content))]
+            for op, body in inner:
+                if op == rec.CHANNEL:
+                    channel = rec.decode_channel(body)
+                    topics[channel.channel_id] = channel.topic
+                elif op == rec.MESSAGE:
+                    message = rec.decode_message(body)
+                    topic = topics[message.channel_id]
+                    previous = last.get(topic)
+                    if previous is None or message.sequence <= previous[0]:
+                        runs[topic] = runs.get(topic, 0) + 1
+                    elif message.sequence > previous[0] + 1:
+                        gaps.append(SequenceGap(topic, message.sequence - previous[0] - 1,
+                                                previous[1] * 1e-9, message.log_time_ns * 1e-9))
+                    last[topic] = (message.sequence, message.log_time_ns)
+    return gaps, runs
+
+
+def flushed_topics(path: Path) -> set[str]:
+    """Return the topics with a message in the flushed chunks of an MCAP file being written."""
+    found: set[str] = set()
+    topics: dict[int, str] = {}
+    try:
+        for opcode, _, content in rec.iter_records(Path(path).read_bytes(), len(rec.MAGIC)):
+            inner = [(opcode, content)]
+            if opcode == rec.CHUNK:
+                inner = [(op, c) for op, _, c in rec.iter_records(rec.decode_chunk(content))]
+            for op, body in inner:
+                if op == rec.CHANNEL:
+                    channel = rec.decode_channel(body)
+                    topics[channel.channel_id] = channel.topic
+                elif op == rec.MESSAGE:
+                    found.add(topics[rec.decode_message(body).channel_id])
+    except rec.RecordError:
+        pass  # the tail that is still being written
+    return found

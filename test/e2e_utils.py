@@ -41,13 +41,17 @@ def start_graph(domain_id: int, out_dir: Path, *options: str,
         start_new_session=True)
     deadline = time.monotonic() + 60.0
     seen = []
-    while time.monotonic() < deadline:
-        line = launcher.stdout.readline()
-        if not line:
-            break
-        seen.append(line)
-        if line.startswith('running:'):
-            return RunningGraph(launcher, env, domain_id, namespace, out_dir)
+    try:
+        while time.monotonic() < deadline:
+            line = launcher.stdout.readline()
+            if not line:
+                break
+            seen.append(line)
+            if line.startswith(('running:', 'recording to ')):  # up, or up --duration
+                return RunningGraph(launcher, env, domain_id, namespace, out_dir)
+    except BaseException:  # Ctrl-C or a timeout while waiting: leave no graph behind
+        stop_process(launcher)
+        raise
     stop_process(launcher)
     raise RuntimeError('wirefish up did not start:\n' + ''.join(seen) + launcher.stdout.read())
 

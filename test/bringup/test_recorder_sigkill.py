@@ -184,3 +184,24 @@ def test_a_recorder_killed_under_wirefish_up_leaves_a_bag_that_reindex_repairs(
     early = {topic: killed_at - max(t for t, _ in in_bag.messages[topic]) for topic in streams}
     print(f'the streams end {min(early.values()):.2f}-{max(early.values()):.2f} s before the kill')
     assert max(early.values()) <= KILL_MARGIN_S, early
+
+
+def test_a_graph_stopped_right_after_its_recorder_was_killed_leaves_a_readable_bag(
+        tmp_path, spawn, python):
+    # The stop comes before the restarted recorder (--resume) could reindex: the launcher,
+    # the last to see the run, finishes the bag itself.
+    namespace = '/wf_up_kill_stop'
+    launcher = spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+                      '--namespace', namespace, '--out', str(tmp_path), '--duration', '60'])
+    lines = _read_until(launcher, 'recording to', 120.0)
+    assert lines and lines[-1].startswith('recording to'), ''.join(lines)
+    bag = Path(lines[-1].split()[2].rstrip(';'))
+    (recorder,) = [p for p in descendants(launcher.pid) if 'record' in p.cmdline()]
+    assert _wait_flushed(bag, 60.0), 'recorder never flushed'
+    recorder.kill()
+    recorder.wait(10.0)
+    os.killpg(launcher.pid, signal.SIGINT)
+    output = launcher.communicate(timeout=120)[0]
+    assert 'reindexed it' in output, output
+    counts = assert_bag_readable(bag)  # no repair step by hand
+    assert counts.get(f'{namespace}/servo_cmd', 0) > 0, counts

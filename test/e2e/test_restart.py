@@ -1,19 +1,22 @@
 """
 Under `wirefish up` a node killed with SIGKILL is back and streaming, and the rest never stops.
 
-One graph for the module's kill tests; each kills one process of the registry and checks that
-it is restarted (a new PID, on the ROS graph again) and every stream runs at its rate again;
-that every other process kept its PID; and that no stream the killed node does not feed
-paused longer than MAX_PAUSE_S. Checks that belong to one victim (the bridge holding the fish
-neutral while the CPG is gone, the tuner answering again) are in VICTIM_CHECKS: to add a victim
-(the recorder and its bag), add it to the graph and give it a check there. The crash-loop
+One graph for the module's kill tests, recording the whole run (`--duration`: the recorder is
+one of the victims); each test kills one process of the registry and checks that it is
+restarted (a new PID, on the ROS graph again) and every stream runs at its rate again; that
+every other process kept its PID; and that no stream the killed node does not feed paused
+longer than MAX_PAUSE_S. Checks that belong to one victim (the bridge holding the fish neutral
+while the CPG is gone, the tuner answering again, the recorder writing on into the same bag)
+are in VICTIM_CHECKS. After the kills the graph is stopped and its one bag is read: it opens
+with rosbags, and no publisher sequence number of any topic is missing except while the
+recorder itself was down (from at most KILL_MARGIN_S before its kill). The crash-loop
 test gives the tuner a parameter it refuses at start-up, so it exits at once every time: the
 launcher backs off, gives up on it and keeps the rest running. (A required node that spends its
 budget stops the graph: test/bringup/test_supervisor.py, without the cost of a whole graph.)
 """
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import os
 from pathlib import Path
 import signal
@@ -22,6 +25,7 @@ import sys
 import threading
 import time
 
+from bag_utils import assert_bag_readable, flushed_topics, sequence_gaps
 from e2e_utils import descendants, RunningGraph, start_graph
 import numpy as np
 import psutil
@@ -42,8 +46,10 @@ import yaml
 pytestmark = pytest.mark.ros
 
 NAMESPACE = '/e2e_restart'
-GRAPH = entries(sim=True)
+GRAPH = entries(sim=True, record=True)
 VICTIMS = [e.name for e in GRAPH]
+RECORDER = 'wirefish_recorder'
+RUN_FOR_S = 3600  # `--duration`: longer than the module; the graph is stopped by SIGINT
 NOMINAL_HZ, SLOW_HZ = expected_rates(sim=True)
 BACK_WITHIN_S = 30.0  # the restart delay (1 s) and a start-up on a loaded 2-core machine
 RATE_WINDOW_S = 3.0
@@ -54,6 +60,12 @@ RESUMED_FRACTION = 0.75  # of the nominal rate, over RATE_WINDOW_S
 MAX_PAUSE_S = 1.5
 NEUTRAL_RAD = 0.05
 COMMAND_TIMEOUT_S = 0.5  # the bridge's default command_timeout_s (config/wirefish.yaml)
+KILL_MARGIN_S = 1.0  # the recorder flushes every 0.5 s: a kill loses at most about 1 s
+# The restarted recorder records again once it is up and has found the topics (it rescans the
+# graph every 0.5 s): a fresh process on the loaded machine, within this bound.
+RECORDER_BACK_S = 15.0
+# /diagnostics has a publisher per node: its numbers interleave several sequences.
+UNCHECKED_TOPICS = ('/diagnostics',)
 
 
 def _full(topic: str) -> str:
@@ -67,11 +79,13 @@ class WatchedGraph:
     graph: RunningGraph
     node: Node
     log: StreamLog
+    bag: Path
+    kills: dict[str, 'Kill'] = field(default_factory=dict)
 
     def pids(self) -> dict[str, int]:
         """Return {registry name: PID} of the graph's live processes."""
         by_path = {str(spec.executable_path()): spec.name
-                   for spec in fish_graph(NAMESPACE, sim=True)}
+                   for spec in fish_graph(NAMESPACE, sim=True, bag=self.bag)}
         found = {}
         for proc in descendants(self.graph.launcher.pid):
             try:
@@ -85,8 +99,11 @@ class WatchedGraph:
         return found
 
     def on_graph(self, name: str) -> bool:
-        """Return whether node ``name`` is discovered in the graph's namespace."""
-        return (name, NAMESPACE) in self.node.get_node_names_and_namespaces()
+        """Return whether node ``name`` is discovered (the recorder's is outside the namespace)."""
+        names = self.node.get_node_names_and_namespaces()
+        if name == RECORDER:
+            return any(n == RECORDER for n, _ in names)
+        return (name, NAMESPACE) in names
 
 
 @dataclass
@@ -95,6 +112,7 @@ class Kill:
 
     killed_at: float
     restarted_at: float
+    killed_wall: float  # the kill on the system clock, the bag's receive times' clock
 
 
 def _started_at(pid: int) -> float:
@@ -127,7 +145,8 @@ def _fed_by(victim: str) -> set[str]:
 
 @pytest.fixture(scope='module')
 def watched(e2e_domain_id: int, tmp_path_factory) -> Iterator[WatchedGraph]:
-    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('restart'), namespace=NAMESPACE)
+    out = tmp_path_factory.mktemp('restart')
+    graph = start_graph(e2e_domain_id, out, '--duration', str(RUN_FOR_S), namespace=NAMESPACE)
     children = descendants(graph.launcher.pid)
     context = Context()
     rclpy.init(context=context, domain_id=e2e_domain_id)
@@ -146,7 +165,8 @@ def watched(e2e_domain_id: int, tmp_path_factory) -> Iterator[WatchedGraph]:
                  if n in wanted}
         log = StreamLog(node, types, keep=(_full('servo_state'),))
         spinner.start()
-        yield WatchedGraph(graph, node, log)
+        (bag,) = out.glob('run_*/bag')
+        yield WatchedGraph(graph, node, log, bag)
     finally:
         executor.shutdown()
         if spinner.is_alive():
@@ -198,10 +218,23 @@ def _tuner_answers(watched: WatchedGraph, _kill: Kill) -> None:
         watched.node.destroy_client(client)
 
 
+def _recorder_records_on(watched: WatchedGraph, kill: Kill) -> None:
+    """Check that the restarted recorder writes on into the same bag, in a file of its own."""
+    # It reindexes the killed file first (--resume), then opens the bag's next split file.
+    assert _wait(lambda: len(list(watched.bag.glob('*.mcap'))) >= 2, RECORDER_BACK_S), \
+        f'no new split file in {watched.bag}: {sorted(watched.bag.iterdir())}'
+    newest = max(watched.bag.glob('*.mcap'), key=lambda p: p.stat().st_mtime)
+    # Every stream is in it again (the recorder finds topics by rescanning the graph).
+    wanted = {_full(t) for t in NOMINAL_HZ}
+    assert _wait(lambda: wanted <= flushed_topics(newest), RECORDER_BACK_S), \
+        f'{newest.name} lacks {sorted(wanted - flushed_topics(newest))}'
+
+
 # Checks that belong to one victim, run once it is back.
 VICTIM_CHECKS: dict[str, Callable[[WatchedGraph, Kill], None]] = {
     'cpg_node': _fish_held_neutral,
     'tuner_node': _tuner_answers,
+    RECORDER: _recorder_records_on,
 }
 
 
@@ -210,7 +243,7 @@ def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watche
     assert _wait(lambda: _all_streaming(watched.log), BACK_WITHIN_S), 'not streaming before'
     before = watched.pids()
     assert set(before) == set(VICTIMS), before
-    killed_at = time.monotonic()
+    killed_at, killed_wall = time.monotonic(), time.time()
     os.kill(before[victim], signal.SIGKILL)
 
     def back() -> bool:
@@ -218,7 +251,8 @@ def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watche
         return pid is not None and pid != before[victim] and watched.on_graph(victim)
 
     assert _wait(back, BACK_WITHIN_S), f'{victim} not restarted'
-    kill = Kill(killed_at, _started_at(watched.pids()[victim]))
+    kill = Kill(killed_at, _started_at(watched.pids()[victim]), killed_wall)
+    watched.kills[victim] = kill
     delay = next(e.restart.delay_s for e in GRAPH if e.name == victim)
     assert kill.restarted_at - killed_at >= delay - 0.05  # the policy's delay, then a restart
     assert _wait(lambda: _all_streaming(watched.log), BACK_WITHIN_S), 'streams did not resume'
@@ -236,6 +270,37 @@ def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watche
         assert pause < MAX_PAUSE_S, f'{topic} paused {pause:.2f} s'
     if victim in VICTIM_CHECKS:
         VICTIM_CHECKS[victim](watched, kill)
+
+
+def test_the_bag_of_the_whole_run_is_readable_and_lost_nothing_while_the_recorder_ran(watched):
+    # Runs after the kills above (pytest keeps the file's order); alone it checks a bag of a
+    # run without kills, which must hold up just the same.
+    code = stop_process(watched.graph.launcher, timeout_s=60.0)
+    print(f'wirefish up stopped ({code}) after killing {", ".join(watched.kills) or "nothing"}')
+    counts = assert_bag_readable(watched.bag)
+    for topic in [*NOMINAL_HZ, *SLOW_HZ]:
+        assert counts.get(_full(topic), 0) > 0, f'{topic} not in the bag: {counts}'
+    gaps, runs = sequence_gaps(watched.bag)
+    recorder = watched.kills.get(RECORDER)
+    if recorder is not None:  # its outage on the system clock: the bag's receive times
+        down_from = recorder.killed_wall - KILL_MARGIN_S
+        back_by = recorder.killed_wall + (recorder.restarted_at - recorder.killed_at) \
+            + RECORDER_BACK_S
+    print(f'{len(list(watched.bag.glob("*.mcap")))} files, {sum(counts.values())} messages; '
+          f'writer runs per topic: {runs}')
+    for gap in (g for g in gaps if g.topic not in UNCHECKED_TOPICS):
+        print(f'gap: {gap.topic} {gap.missing} missing between {gap.after_s:.2f} and '
+              f'{gap.before_s:.2f} (recorder killed at '
+              f'{recorder.killed_wall if recorder else float("nan"):.2f})')
+    # A gap of the recorder's own outage: its first missing message came at most
+    # KILL_MARGIN_S before the kill (a slow topic's last recorded one may be older), and the
+    # restarted recorder has the topic again by back_by.
+    lost = [gap for gap in gaps if gap.topic not in UNCHECKED_TOPICS
+            and not (recorder is not None and gap.first_missing_s >= down_from
+                     and gap.before_s <= back_by)]
+    assert lost == [], f'messages lost while the recorder ran: {lost}'
+    if recorder is not None:  # the recorder's own kill shows, and ends where it should
+        assert any(g.first_missing_s >= down_from and g.before_s <= back_by for g in gaps)
 
 
 # --- crash loops ----------------------------------------------------------------------------
@@ -291,7 +356,7 @@ def test_a_crash_loop_backs_off_is_given_up_and_the_rest_keeps_running(ros_env, 
         others = {p.pid for p in descendants(proc.pid)}
         time.sleep(2.0)
         assert others == {p.pid for p in descendants(proc.pid)}  # nothing else restarted
-        assert len(others) == len(VICTIMS) - 1
+        assert len(others) == len(entries(sim=True)) - 1  # no recorder in this graph
     finally:
         code = stop_process(proc, timeout_s=15.0)
         rest = proc.stdout.read()
@@ -299,4 +364,5 @@ def test_a_crash_loop_backs_off_is_given_up_and_the_rest_keeps_running(ros_env, 
     assert code == 1, rest  # the graph that ran was not whole
     assert 'restarts: tuner_node 3; given up: tuner_node (last exit code 1)' in rest, rest
     stopped = next(line for line in rest.splitlines() if line.startswith('stopped'))
-    assert 'tuner_node=1' in stopped and stopped.count('=0') == len(VICTIMS) - 1, stopped
+    assert 'tuner_node=1' in stopped and stopped.count('=0') == len(entries(sim=True)) - 1, \
+        stopped

@@ -166,6 +166,40 @@ def _graph_probe(namespace: str) -> Iterator[tuple]:
         rclpy.try_shutdown()
 
 
+def _finish_bag(bag_path: Path) -> None:
+    """
+    Reindex the run's bag if a recorder left a file of it unfinished (no summary, no footer).
+
+    A recorder that was killed, or stopped while its restart was still starting up (before
+    its --resume reindexed the last file), leaves the bag unfinished: the launcher is the last
+    to see the run, so it repairs the bag rather than leave `wirefish bag reindex` to the user.
+    """
+    from wirefish_bringup.bag_storage import IncompleteFile, read_file_info, storage_files
+    from wirefish_bringup.reindex import reindex
+
+    def finished(path: Path) -> bool:
+        try:
+            read_file_info(path)
+        except (IncompleteFile, OSError):
+            return False
+        return True
+
+    files = storage_files(bag_path)
+    if all(finished(path) for path in files) and (bag_path / 'metadata.yaml').exists():
+        return
+    if not files:
+        return
+    try:
+        recoveries = reindex(bag_path)
+    except (OSError, ValueError) as error:  # IncompleteFile is a ValueError
+        print(f'wirefish up: the bag {bag_path} was left unfinished and could not be '
+              f'reindexed: {error}; try `wirefish bag reindex {bag_path}`', file=sys.stderr)
+        return
+    print(f'wirefish up: the recorder left {bag_path} unfinished; reindexed it ('
+          + ', '.join(f'{r.name}: {r.messages} messages' for r in recoveries) + ')',
+          file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish up`; return the process exit code."""
     stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
@@ -261,6 +295,8 @@ def run(args: argparse.Namespace) -> int:
         code = code or 1
     print(f'stopped {len(codes)} processes: '
           + ', '.join(f'{name}={rc}' for name, rc in codes.items()))
+    if bag_path is not None and bag_path.exists():
+        _finish_bag(bag_path)
     if bag_path is not None and bag_path.exists() and code == 0:
         from wirefish_bringup.report import write_report
         report_dir = run_dir / 'report'
