@@ -27,6 +27,8 @@ pytestmark = pytest.mark.ros
 FISH_TOPICS = ('servo_cmd:sensor_msgs/msg/JointState:sensor',
                'planner_state:wirefish_msgs/msg/PlannerState:reliable',
                'cpg_params:wirefish_msgs/msg/CpgParams:latched')
+# The crossing topics the fish's probe hears at their source: published on change, not at a rate.
+FISH_SOURCES = ('planner_state', 'cpg_params')
 CROSSING = load_crossing(default_crossing_file())
 SHORE_TOPICS = tuple(f'{row.shore_topic}:{row.type_name}:{row.qos}' for row in CROSSING)
 UP_TIMEOUT_S = 90.0  # both graphs start on the loaded 2-core machine and discover each other
@@ -156,7 +158,10 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
         time.sleep(RATE_WINDOW_S)
         tx1, t1 = (link.tx_bytes(FISH), link.tx_bytes(SHORE)), time.monotonic()
         rates = {row.topic: _rate(shore, row.shore_topic, t0, t1) for row in CROSSING}
-        figures[shaped] = ((tx1[0] - tx0[0]) / (t1 - t0), (tx1[1] - tx0[1]) / (t1 - t0), rates)
+        sources = {row.topic: _rate(fish, row.topic, t0, t1) for row in CROSSING
+                   if row.topic in FISH_SOURCES}
+        figures[shaped] = ((tx1[0] - tx0[0]) / (t1 - t0), (tx1[1] - tx0[1]) / (t1 - t0), rates,
+                           sources)
         print(f'{"100 kbit/s tbf" if shaped else "unshaped":>15}: fish->shore '
               f'{figures[shaped][0]:.0f} B/s, shore->fish {figures[shaped][1]:.0f} B/s; '
               + ', '.join(f'{topic} {hz:.1f} Hz' for topic, hz in rates.items()))
@@ -164,9 +169,16 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
     print(qdisc)
     dropped = int(re.search(r'dropped (\d+)', qdisc).group(1))
     print(f'tbf on the fish side: {dropped} packets dropped in {RATE_WINDOW_S + 3:g} s')
+    print('on the fish in the shaped window: ' + ', '.join(
+        f'{topic} {hz:.2f} Hz' for topic, hz in figures[True][3].items()))
     for row in CROSSING:
         if row.rate_hz > 0:
-            assert figures[True][2][row.topic] >= RATE_FRACTION * row.rate_hz, row.topic
+            # An on-change topic (cpg_params, planner_state) crosses at most as often as it
+            # changes on the fish; the relay's newest-per-tick hold may merge two changes in one
+            # tick: one message of slack over the window.
+            wanted = min(row.rate_hz, figures[True][3].get(row.topic, row.rate_hz))
+            slack = 1.0 / RATE_WINDOW_S if row.topic in FISH_SOURCES else 0.0
+            assert figures[True][2][row.topic] >= RATE_FRACTION * wanted - slack, row.topic
     assert figures[True][2]['speed_estimate'] > 0.0
     # What crosses fits the bucket: the rates above hold, and the bucket's queue (400 ms)
     # absorbs the bursts (discovery, reliable resends) instead of dropping.
