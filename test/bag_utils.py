@@ -1,5 +1,6 @@
 """Checks of recorded bags for the cross-process tests (recorder kill, graph kill, e2e)."""
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 import subprocess
@@ -55,6 +56,33 @@ class SequenceGap:
         return self.after_s + (self.before_s - self.after_s) / (self.missing + 1)
 
 
+def _messages(path: Path, *, being_written: bool = False
+              ) -> Iterator[tuple[str, rec.MessageRecord]]:
+    """
+    Yield (topic, message) for each message of an MCAP file, in file order.
+
+    ``being_written``: the file's writer is still at work; its torn tail ends the messages.
+    """
+    topics: dict[int, str] = {}
+    try:
+        for opcode, _, content in rec.iter_records(Path(path).read_bytes(), len(rec.MAGIC)):
+            if opcode == rec.DATA_END:  # the summary and footer follow: no more messages
+                return
+            inner = [(opcode, content)]
+            if opcode == rec.CHUNK:
+                inner = [(op, c) for op, _, c in rec.iter_records(rec.decode_chunk(content))]
+            for op, body in inner:
+                if op == rec.CHANNEL:
+                    channel = rec.decode_channel(body)
+                    topics[channel.channel_id] = channel.topic
+                elif op == rec.MESSAGE:
+                    message = rec.decode_message(body)
+                    yield topics[message.channel_id], message
+    except rec.RecordError:
+        if not being_written:
+            raise
+
+
 def sequence_gaps(bag_path: Path) -> tuple[list[SequenceGap], dict[str, int]]:
     """
     Return the gaps in every topic's publisher sequence numbers, and each topic's writer runs.
@@ -68,46 +96,17 @@ def sequence_gaps(bag_path: Path) -> tuple[list[SequenceGap], dict[str, int]]:
     last: dict[str, tuple[int, int]] = {}
     gaps: list[SequenceGap] = []
     for path in storage_files(Path(bag_path)):
-        topics: dict[int, str] = {}
-        data = path.read_bytes()
-        for opcode, _, content in rec.iter_records(data, len(rec.MAGIC)):
-            if opcode == rec.DATA_END:  # the summary and footer follow: no more messages
-                break
-            inner = [(opcode, content)]
-            if opcode == rec.CHUNK:
-                inner = [(op, c) for op, _, c in rec.iter_records(rec.decode_chunk(content))]
-            for op, body in inner:
-                if op == rec.CHANNEL:
-                    channel = rec.decode_channel(body)
-                    topics[channel.channel_id] = channel.topic
-                elif op == rec.MESSAGE:
-                    message = rec.decode_message(body)
-                    topic = topics[message.channel_id]
-                    previous = last.get(topic)
-                    if previous is None or message.sequence <= previous[0]:
-                        runs[topic] = runs.get(topic, 0) + 1
-                    elif message.sequence > previous[0] + 1:
-                        gaps.append(SequenceGap(topic, message.sequence - previous[0] - 1,
-                                                previous[1] * 1e-9, message.log_time_ns * 1e-9))
-                    last[topic] = (message.sequence, message.log_time_ns)
+        for topic, message in _messages(path):
+            previous = last.get(topic)
+            if previous is None or message.sequence <= previous[0]:
+                runs[topic] = runs.get(topic, 0) + 1
+            elif message.sequence > previous[0] + 1:
+                gaps.append(SequenceGap(topic, message.sequence - previous[0] - 1,
+                                        previous[1] * 1e-9, message.log_time_ns * 1e-9))
+            last[topic] = (message.sequence, message.log_time_ns)
     return gaps, runs
 
 
 def flushed_topics(path: Path) -> set[str]:
     """Return the topics with a message in the flushed chunks of an MCAP file being written."""
-    found: set[str] = set()
-    topics: dict[int, str] = {}
-    try:
-        for opcode, _, content in rec.iter_records(Path(path).read_bytes(), len(rec.MAGIC)):
-            inner = [(opcode, content)]
-            if opcode == rec.CHUNK:
-                inner = [(op, c) for op, _, c in rec.iter_records(rec.decode_chunk(content))]
-            for op, body in inner:
-                if op == rec.CHANNEL:
-                    channel = rec.decode_channel(body)
-                    topics[channel.channel_id] = channel.topic
-                elif op == rec.MESSAGE:
-                    found.add(topics[rec.decode_message(body).channel_id])
-    except rec.RecordError:
-        pass  # the tail that is still being written
-    return found
+    return {topic for topic, _ in _messages(path, being_written=True)}

@@ -17,6 +17,7 @@ import time
 from bag_utils import assert_bag_readable, counters, reindex_bag
 from e2e_utils import descendants
 import numpy as np
+import psutil
 import pytest
 from ros_utils import spin_until, stop_process
 from wirefish_bringup import mcap_records as rec
@@ -159,16 +160,23 @@ def _read_until(proc: subprocess.Popen, prefix: str, timeout_s: float) -> list[s
     return lines
 
 
-def test_a_recorder_killed_under_wirefish_up_leaves_a_bag_that_reindex_repairs(
-        tmp_path, spawn, python, kill_seed):
-    namespace = '/wf_up_kill'
+def _up_recording(spawn, python, namespace: str, out: Path, duration_s: int
+                  ) -> tuple[subprocess.Popen, Path, psutil.Process]:
+    """Start `wirefish up --duration`; return it, its bag and its recorder, once it flushed."""
     launcher = spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
-                      '--namespace', namespace, '--out', str(tmp_path), '--duration', '12'])
+                      '--namespace', namespace, '--out', str(out), '--duration', str(duration_s)])
     lines = _read_until(launcher, 'recording to', 120.0)
     assert lines and lines[-1].startswith('recording to'), ''.join(lines)
     bag = Path(lines[-1].split()[2].rstrip(';'))
     (recorder,) = [p for p in descendants(launcher.pid) if 'record' in p.cmdline()]
     assert _wait_flushed(bag, 60.0), 'recorder never flushed'
+    return launcher, bag, recorder
+
+
+def test_a_recorder_killed_under_wirefish_up_leaves_a_bag_that_reindex_repairs(
+        tmp_path, spawn, python, kill_seed):
+    namespace = '/wf_up_kill'
+    launcher, bag, recorder = _up_recording(spawn, python, namespace, tmp_path, 12)
     time.sleep(float(np.random.default_rng(kill_seed).uniform(1.2, 5.0)))
     killed_at = time.time()  # the recorder stamps messages with the system clock
     recorder.kill()
@@ -191,13 +199,7 @@ def test_a_graph_stopped_right_after_its_recorder_was_killed_leaves_a_readable_b
     # The stop comes before the restarted recorder (--resume) could reindex: the launcher,
     # the last to see the run, finishes the bag itself.
     namespace = '/wf_up_kill_stop'
-    launcher = spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
-                      '--namespace', namespace, '--out', str(tmp_path), '--duration', '60'])
-    lines = _read_until(launcher, 'recording to', 120.0)
-    assert lines and lines[-1].startswith('recording to'), ''.join(lines)
-    bag = Path(lines[-1].split()[2].rstrip(';'))
-    (recorder,) = [p for p in descendants(launcher.pid) if 'record' in p.cmdline()]
-    assert _wait_flushed(bag, 60.0), 'recorder never flushed'
+    launcher, bag, recorder = _up_recording(spawn, python, namespace, tmp_path, 60)
     recorder.kill()
     recorder.wait(10.0)
     os.killpg(launcher.pid, signal.SIGINT)
