@@ -13,8 +13,13 @@ def test_the_row_is_met_when_every_discovery_fits_the_limit_unshaped():
     assert verdict == 'met' and 'multicast: 10000 / 2000 unshaped' in measured
 
 
-def test_the_row_is_missed_when_one_discovery_needs_more_than_the_limit():
-    assert row({'multicast': _mode(10000.0), 'static': _mode(42000.0)})[3] == 'missed'
+def test_each_discovery_gets_its_own_verdict_when_only_one_fits():
+    verdict = row({'multicast': _mode(10000.0), 'static': _mode(42000.0)})[3]
+    assert verdict == 'multicast: met; static: missed'
+
+
+def test_the_row_is_missed_when_no_discovery_fits():
+    assert row({'multicast': _mode(13000.0), 'static': _mode(42000.0)})[3] == 'missed'
 
 
 def test_a_machine_without_root_reports_why_nothing_was_measured():
