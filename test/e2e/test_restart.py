@@ -241,7 +241,8 @@ VICTIM_CHECKS: dict[str, Callable[[WatchedGraph, Kill], None]] = {
 # Seen once in 6 runs (2026-12-01): with the bridge killed, servo_cmd paused 1.01 s and the
 # markers downstream 2.06 s. Suspected, not verified: Fast DDS's shared-memory transport checks
 # a dead reader's port with a 1000 ms timeout (healthy_check_timeout_ms) and the CPG's publish
-# waits for it. One rerun keeps CI from failing on it; a node that stops fails both runs.
+# waits for it; a 200 Hz publisher whose subscriber was SIGKILLed paused at most 9 ms in 3
+# tries. One rerun keeps CI from failing on it; a node that stops fails both runs.
 @pytest.mark.flaky(reruns=1)
 @pytest.mark.parametrize('victim', VICTIMS)
 def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watched, victim):
