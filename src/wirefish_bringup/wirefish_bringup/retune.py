@@ -13,6 +13,7 @@ import math
 import sys
 import time
 
+from wirefish_bringup.goal_sender import GoalSender
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 
 BAR_WIDTH = 30
@@ -150,12 +151,18 @@ def run(args: argparse.Namespace) -> int:
                   '(wirefish up / make run)?', file=sys.stderr)
             return 1
         deadline = time.monotonic() + args.timeout
-        sent = client.send_goal_async(goal_of(args, RetuneGait.Goal),
-                                      feedback_callback=on_feedback)
-        if not spin_until(sent.done, deadline):
+        # A goal whose answer is lost (a client that has just started) is adopted from the
+        # server's status, or sent again: see goal_sender.
+        sender = GoalSender(node, client, lambda s: executor.spin_once(timeout_sec=s),
+                            'retune_gait/_action/status')
+        handle = sender.send(goal_of(args, RetuneGait.Goal), on_feedback, deadline)
+        sender.destroy()
+        if handle is None:
             print(f'wirefish retune: no answer within {args.timeout:g} s', file=sys.stderr)
             return 1
-        handle = sent.result()
+        if sender.resent:
+            print(f'wirefish retune: the tuner did not answer within {sender.answer_wait_s:g} '
+                  f's; the goal was sent {sender.resent + 1} times', file=sys.stderr)
         if not handle.accepted:
             print('wirefish retune: busy: the tuner rejected the goal because a fit is '
                   'running; retry when it finishes', file=sys.stderr)

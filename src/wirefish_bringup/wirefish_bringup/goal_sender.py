@@ -1,0 +1,136 @@
+"""
+Send an action goal and get its handle even when the server's answer to it is lost.
+
+rmw_fastrtps drops a service response ("failed to send response (timeout): client will not
+receive response") when the server has not yet matched the client's response reader within
+its writer's max_blocking_time (100 ms): a client that has just started, on a loaded machine,
+can wait forever for the answer to a goal the server accepted and is running. An action's
+goal is not a bare request, though: an accepted goal shows up in the server's status array and
+in its feedback, both under the goal id the client chose. ``GoalSender`` sends the goal with
+an id of its own, and when no answer comes within ``answer_wait_s`` it looks there: a goal of
+its ids that is active is adopted (its result is asked for as usual); otherwise it sends the
+goal again with a new id, up to ``max_sends`` times (a rejected goal never shows up, and the
+resend's answer finds the reader matched by then).
+
+``goal_outcome`` is the decision, pure: what the answers and the active ids say.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+import time
+from typing import Any
+import uuid
+
+ACCEPTED, REJECTED, WAITING = 'accepted', 'rejected', 'waiting'
+ANSWER_WAIT_S = 3.0
+MAX_SENDS = 3
+
+
+def goal_outcome(answers: dict[bytes, bool | None], active: set[bytes]
+                 ) -> tuple[str, bytes | None]:
+    """
+    Return (ACCEPTED, id), (REJECTED, None) or (WAITING, None) for the goals sent so far.
+
+    ``answers``: each sent goal id (in sending order) and its answer: True accepted, False
+    rejected, None none yet. ``active``: the ids the server reports running (status or
+    feedback). An accepted answer wins; else an active id without an answer (its answer was
+    lost); the goal is rejected only when every sent goal was answered so and none runs.
+    """
+    for goal_id, accepted in answers.items():
+        if accepted:
+            return ACCEPTED, goal_id
+    for goal_id in answers:
+        if goal_id in active:
+            return ACCEPTED, goal_id
+    if answers and all(accepted is False for accepted in answers.values()):
+        return REJECTED, None
+    return WAITING, None
+
+
+@dataclass
+class GoalSender:
+    """
+    One goal to an ActionClient, adopted when its answer is lost (see the module docstring).
+
+    ``client`` is the rclpy ActionClient, ``spin_once`` spins its node for at most the given
+    seconds; ``status_topic`` is the action's ``<name>/_action/status``.
+    """
+
+    node: Any  # rclpy Node
+    client: Any  # rclpy ActionClient
+    spin_once: Callable[[float], None]
+    status_topic: str
+    answer_wait_s: float = ANSWER_WAIT_S
+    max_sends: int = MAX_SENDS
+    active: set[bytes] = field(default_factory=set)
+    resent: int = 0
+
+    def __post_init__(self) -> None:
+        """Subscribe to the action's status (latched: the current array arrives at once)."""
+        from action_msgs.msg import GoalStatus, GoalStatusArray
+        from rclpy.qos import qos_profile_action_status_default
+
+        running = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING,
+                   GoalStatus.STATUS_CANCELING, GoalStatus.STATUS_SUCCEEDED,
+                   GoalStatus.STATUS_CANCELED, GoalStatus.STATUS_ABORTED)
+
+        def on_status(message: GoalStatusArray) -> None:
+            self.active.update(bytes(s.goal_info.goal_id.uuid) for s in message.status_list
+                               if s.status in running)
+        self._status = self.node.create_subscription(
+            GoalStatusArray, self.status_topic, on_status, qos_profile_action_status_default)
+
+    def send(self, goal, feedback_callback: Callable, deadline: float):
+        """
+        Return the goal's ClientGoalHandle (accepted or not), or None if none by ``deadline``.
+
+        ``feedback_callback`` gets the feedback of whichever sent goal runs.
+        """
+        from rclpy.action.client import ClientGoalHandle
+        from unique_identifier_msgs.msg import UUID
+
+        def on_feedback(message) -> None:
+            self.active.add(bytes(message.goal_id.uuid))
+            feedback_callback(message)
+
+        futures: dict[bytes, Any] = {}  # goal id -> the rclpy Future of its answer
+        sent_at = 0.0
+        while time.monotonic() < deadline:
+            answers = {goal_id: (future.result().accepted if future.done() else None)
+                       for goal_id, future in futures.items()}
+            outcome, adopted = goal_outcome(answers, self.active)
+            if outcome == ACCEPTED and adopted is not None:
+                future = futures[adopted]
+                if future.done():
+                    return future.result()
+                return ClientGoalHandle(self.client, UUID(uuid=list(adopted)),
+                                        _AcceptedAnswer())
+            if outcome == REJECTED:
+                return next(iter(futures.values())).result()
+            unanswered = not futures or answers[next(reversed(futures))] is None
+            if unanswered and len(futures) < self.max_sends and (
+                    not futures or time.monotonic() - sent_at >= self.answer_wait_s):
+                new_id = uuid.uuid4().bytes
+                self.resent += 1 if futures else 0
+                futures[new_id] = self.client.send_goal_async(
+                    goal, feedback_callback=on_feedback, goal_uuid=UUID(uuid=list(new_id)))
+                sent_at = time.monotonic()
+            self.spin_once(0.05)
+        return None
+
+    def destroy(self) -> None:
+        """Drop the status subscription."""
+        self.node.destroy_subscription(self._status)
+
+
+class _AcceptedAnswer:
+    """The goal answer a ClientGoalHandle holds for an adopted goal (its own was lost)."""
+
+    accepted = True
+
+    @property
+    def stamp(self):
+        from builtin_interfaces.msg import Time
+        return Time()
