@@ -30,7 +30,7 @@ def goal(**fields) -> RetuneGaitAction.Goal:
 
 def _sender(probe, client) -> GoalSender:
     return GoalSender(probe.node, client, lambda s: probe.executor.spin_once(timeout_sec=s),
-                      'retune_gait/_action/status')
+                      'retune_gait', RetuneGaitAction)
 
 
 def test_a_goal_whose_answer_is_lost_is_adopted_and_its_result_arrives(tuner, probe):

@@ -40,12 +40,12 @@ class GoalRun:
         self.probe, self.feedback = probe, []
         assert spin_until(probe.executor, client.server_is_ready, WAIT_S), 'no action server'
         # As `wirefish retune` sends it: a goal whose answer is lost is adopted (goal_sender).
-        sender = GoalSender(probe.node, client,
-                            lambda s: probe.executor.spin_once(timeout_sec=s),
-                            'retune_gait/_action/status')
-        self.handle = sender.send(message, lambda f: self.feedback.append(f.feedback),
-                                  time.monotonic() + WAIT_S)
-        sender.destroy()
+        # The sender stays: it delivers the goal's feedback (also after the result).
+        self.sender = GoalSender(probe.node, client,
+                                 lambda s: probe.executor.spin_once(timeout_sec=s),
+                                 'retune_gait', RetuneGaitAction)
+        self.handle = self.sender.send(message, lambda f: self.feedback.append(f.feedback),
+                                       time.monotonic() + WAIT_S)
         assert self.handle is not None, 'goal never answered'
         self._result = None
 

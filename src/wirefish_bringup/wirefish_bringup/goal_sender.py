@@ -12,6 +12,11 @@ its ids that is active is adopted (its result is asked for as usual); otherwise 
 goal again with a new id, up to ``max_sends`` times (a rejected goal never shows up, and the
 resend's answer finds the reader matched by then).
 
+The sender takes the goal's feedback from the action's feedback topic itself: rclpy forgets a
+goal's feedback callback when its result arrives, and the last feedback (another topic) can
+arrive after the result on a loaded machine (`wirefish retune` lost iterations 3-20 of 20
+once). Keep the sender until the feedback is no longer wanted, then ``destroy()`` it.
+
 ``goal_outcome`` is the decision, pure: what the answers and the active ids say.
 """
 
@@ -54,23 +59,27 @@ class GoalSender:
     """
     One goal to an ActionClient, adopted when its answer is lost (see the module docstring).
 
-    ``client`` is the rclpy ActionClient, ``spin_once`` spins its node for at most the given
-    seconds; ``status_topic`` is the action's ``<name>/_action/status``.
+    ``client`` is the rclpy ActionClient of ``action_type`` named ``action_name`` (relative to
+    ``node``), ``spin_once`` spins the node for at most the given seconds.
     """
 
     node: Any  # rclpy Node
     client: Any  # rclpy ActionClient
     spin_once: Callable[[float], None]
-    status_topic: str
+    action_name: str
+    action_type: Any
     answer_wait_s: float = ANSWER_WAIT_S
     max_sends: int = MAX_SENDS
     active: set[bytes] = field(default_factory=set)
     resent: int = 0
+    _sent: set[bytes] = field(default_factory=set)
+    _feedback_callback: Callable | None = None
 
     def __post_init__(self) -> None:
-        """Subscribe to the action's status (latched: the current array arrives at once)."""
+        """Subscribe to the action's status (latched: the array comes at once) and feedback."""
         from action_msgs.msg import GoalStatus, GoalStatusArray
         from rclpy.qos import qos_profile_action_status_default
+        from wirefish_common.qos import reliable
 
         running = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING,
                    GoalStatus.STATUS_CANCELING, GoalStatus.STATUS_SUCCEEDED,
@@ -80,7 +89,19 @@ class GoalSender:
             self.active.update(bytes(s.goal_info.goal_id.uuid) for s in message.status_list
                                if s.status in running)
         self._status = self.node.create_subscription(
-            GoalStatusArray, self.status_topic, on_status, qos_profile_action_status_default)
+            GoalStatusArray, f'{self.action_name}/_action/status', on_status,
+            qos_profile_action_status_default)
+
+        def on_feedback(message) -> None:
+            goal_id = bytes(message.goal_id.uuid)
+            if goal_id in self._sent:
+                self.active.add(goal_id)
+                if self._feedback_callback is not None:
+                    self._feedback_callback(message)
+        # Every iteration's feedback kept (rclpy's default depth of 10 drops a fast fit's).
+        self._feedback = self.node.create_subscription(
+            self.action_type.Impl.FeedbackMessage, f'{self.action_name}/_action/feedback',
+            on_feedback, reliable(1000))
 
     def send(self, goal, feedback_callback: Callable, deadline: float):
         """
@@ -91,10 +112,7 @@ class GoalSender:
         from rclpy.action.client import ClientGoalHandle
         from unique_identifier_msgs.msg import UUID
 
-        def on_feedback(message) -> None:
-            self.active.add(bytes(message.goal_id.uuid))
-            feedback_callback(message)
-
+        self._feedback_callback = feedback_callback
         futures: dict[bytes, Any] = {}  # goal id -> the rclpy Future of its answer
         sent_at = 0.0
         while time.monotonic() < deadline:
@@ -114,15 +132,17 @@ class GoalSender:
                     not futures or time.monotonic() - sent_at >= self.answer_wait_s):
                 new_id = uuid.uuid4().bytes
                 self.resent += 1 if futures else 0
+                self._sent.add(new_id)
                 futures[new_id] = self.client.send_goal_async(
-                    goal, feedback_callback=on_feedback, goal_uuid=UUID(uuid=list(new_id)))
+                    goal, goal_uuid=UUID(uuid=list(new_id)))
                 sent_at = time.monotonic()
             self.spin_once(0.05)
         return None
 
     def destroy(self) -> None:
-        """Drop the status subscription."""
+        """Drop the status and feedback subscriptions."""
         self.node.destroy_subscription(self._status)
+        self.node.destroy_subscription(self._feedback)
 
 
 class _AcceptedAnswer:

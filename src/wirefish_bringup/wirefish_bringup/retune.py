@@ -108,7 +108,6 @@ def run(args: argparse.Namespace) -> int:
     from rclpy.action import ActionClient
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
-    from wirefish_common.qos import reliable
     from wirefish_msgs.action import RetuneGait
 
     try:
@@ -121,9 +120,8 @@ def run(args: argparse.Namespace) -> int:
     node = rclpy.create_node('wirefish_retune', namespace=namespace)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
-    # Every iteration's feedback kept (the default depth of 10 drops most of a fast fit's).
-    client = ActionClient(node, RetuneGait, 'retune_gait',
-                          feedback_sub_qos_profile=reliable(1000))
+    # The goal's feedback is taken by the GoalSender (every iteration, also after the result).
+    client = ActionClient(node, RetuneGait, 'retune_gait')
     terminal = sys.stderr.isatty()
     drawn = [False]
     last_iteration = [-1]
@@ -154,9 +152,8 @@ def run(args: argparse.Namespace) -> int:
         # A goal whose answer is lost (a client that has just started) is adopted from the
         # server's status, or sent again: see goal_sender.
         sender = GoalSender(node, client, lambda s: executor.spin_once(timeout_sec=s),
-                            'retune_gait/_action/status')
+                            'retune_gait', RetuneGait)
         handle = sender.send(goal_of(args, RetuneGait.Goal), on_feedback, deadline)
-        sender.destroy()
         if handle is None:
             print(f'wirefish retune: no answer within {args.timeout:g} s', file=sys.stderr)
             return 1
