@@ -185,9 +185,8 @@ def _finish_bag(bag_path: Path) -> None:
         return True
 
     files = storage_files(bag_path)
-    if all(finished(path) for path in files) and (bag_path / 'metadata.yaml').exists():
-        return
-    if not files:
+    whole = all(finished(path) for path in files) and (bag_path / 'metadata.yaml').exists()
+    if not files or whole:
         return
     try:
         recoveries = reindex(bag_path)
