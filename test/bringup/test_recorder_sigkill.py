@@ -14,7 +14,7 @@ import subprocess
 import sys
 import time
 
-from bag_utils import assert_bag_readable, counters, reindex_bag
+from bag_utils import assert_bag_readable, counters, flushed_topics, reindex_bag
 from e2e_utils import descendants
 import numpy as np
 import psutil
@@ -200,6 +200,13 @@ def test_a_graph_stopped_right_after_its_recorder_was_killed_leaves_a_readable_b
     # the last to see the run, finishes the bag itself.
     namespace = '/wf_up_kill_stop'
     launcher, bag, recorder = _up_recording(spawn, python, namespace, tmp_path, 60)
+    # The first flushed chunk can precede servo_cmd's discovery (seen once in a full run: the
+    # bag then held attitude and battery but no servo_cmd): kill once servo_cmd is on disk.
+    servo_cmd = f'{namespace}/servo_cmd'
+    deadline = time.monotonic() + 30.0
+    while servo_cmd not in flushed_topics(bag / 'bag_0.mcap'):
+        assert time.monotonic() < deadline, 'servo_cmd never reached a flushed chunk'
+        time.sleep(0.1)
     recorder.kill()
     recorder.wait(10.0)
     os.killpg(launcher.pid, signal.SIGINT)
