@@ -63,6 +63,10 @@ from wirefish_common.qos import RELIABLE, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_angles
 
 
+# Rate of the command tick (Hz): the failsafe and held commands (see _make_timers).
+COMMAND_TICK_HZ = 20.0
+
+
 class BridgeNode(Node):
     """Wires servo_cmd to the serial link and the fish's telemetry to ROS topics."""
 
@@ -112,7 +116,7 @@ class BridgeNode(Node):
         self._gate.timeout_s = self._values['command_timeout_s']
         self._gate.limit_rad = self._values['servo_limit_rad']
         self._health.heartbeat_timeout_s = self._values['heartbeat_timeout_s']
-        if names & {'max_command_rate_hz', 'heartbeat_rate_hz', 'diagnostics_rate_hz'}:
+        if names & {'heartbeat_rate_hz', 'diagnostics_rate_hz'}:
             self._make_timers()
         if names & LINK_PARAMETERS:
             self._link.stop()
@@ -122,11 +126,11 @@ class BridgeNode(Node):
     def _make_timers(self) -> None:
         for timer in self._bridge_timers.values():
             self.destroy_timer(timer)
-        # The command tick releases held commands and checks the failsafe; >= 20 Hz so the
-        # failsafe reacts within 50 ms of command_timeout_s whatever the rate limit.
-        tick_hz = max(20.0, self._values['max_command_rate_hz'])
+        # The command tick runs the failsafe (neutral within 50 ms of command_timeout_s) and
+        # sends a held command that no newer one superseded. It no longer runs at the rate
+        # limit (100 wake-ups a second, issue 15): a held command leaves with the next one.
         self._bridge_timers = {
-            'command': self.create_timer(1.0 / tick_hz, self._on_command_tick),
+            'command': self.create_timer(1.0 / COMMAND_TICK_HZ, self._on_command_tick),
             'heartbeat': self.create_timer(1.0 / self._values['heartbeat_rate_hz'],
                                            self._send_heartbeat),
             'diagnostics': self.create_timer(1.0 / self._values['diagnostics_rate_hz'],

@@ -10,14 +10,23 @@ from __future__ import annotations
 NEUTRAL = (0.0, 0.0)
 
 
+# Frames of credit the rate limit can save up. More than one, so that a command arriving a
+# little early (executor jitter) after one a little late is not held: with exactly one, the
+# CPG's 200 Hz stream through a 100 Hz gate lost a slot at every early arrival (the next frame
+# then went 15 ms after the last). At most this many frames ever go out back to back.
+BURST_FRAMES = 1.5
+
+
 class CommandGate:
     """
     Forward at most ``max_rate_hz`` commands per second and command neutral on silence.
 
-    A command arriving sooner than 1/``max_rate_hz`` after the last one sent is held; the next
-    tick sends the newest held one (older ones are superseded, never queued). When no command
-    arrived for ``timeout_s`` (or none ever did) the gate is in failsafe: it returns
-    ``NEUTRAL`` at most every ``neutral_period_s`` so a lost frame is repeated.
+    The rate limit is a token bucket: credit grows at ``max_rate_hz`` frames a second up to
+    ``BURST_FRAMES``, and a frame costs one. A command that finds less than one frame of credit
+    is held; the next command (which supersedes it: held commands are never queued) or the
+    next tick sends the newest held one once the credit is there. When no command arrived for
+    ``timeout_s`` (or none ever did) the gate is in failsafe: it returns ``NEUTRAL`` at most
+    every ``neutral_period_s`` so a lost frame is repeated.
     """
 
     def __init__(self, max_rate_hz: float, timeout_s: float, limit_rad: float,
@@ -32,6 +41,8 @@ class CommandGate:
         self.clamped = 0
         self._last_command_time: float | None = None
         self._last_sent_time = -float('inf')
+        self._credit = 1.0  # frames; the first command goes out at once
+        self._credit_time: float | None = None
         self._pending: tuple[float, float] | None = None
 
     def _clamp(self, angles: tuple[float, float]) -> tuple[float, float]:
@@ -52,12 +63,23 @@ class CommandGate:
         self._last_command_time = now
         self.failsafe = False
         angles = self._clamp(angles)
-        if now - self._last_sent_time >= 1.0 / self.max_rate_hz:
+        if self._take_credit(now):
             self._pending = None
-            self._last_sent_time = now
             return angles
         self._pending = angles
         return None
+
+    def _take_credit(self, now: float) -> bool:
+        """Spend one frame of credit if there is one (the rate limit); say whether it was."""
+        if self._credit_time is not None:
+            earned = max(0.0, now - self._credit_time) * self.max_rate_hz
+            self._credit = min(BURST_FRAMES, self._credit + earned)
+        self._credit_time = now
+        if self._credit < 1.0 - 1e-9:  # sums of float steps: 0.3 + 0.3 + 0.2 + 0.2 < 1.0
+            return False
+        self._credit -= 1.0
+        self._last_sent_time = now
+        return True
 
     def on_tick(self, now: float) -> tuple[float, float] | None:
         """Return a held command that may now go out, or NEUTRAL in failsafe, or None."""
@@ -73,8 +95,7 @@ class CommandGate:
                 self._last_sent_time = now
                 return NEUTRAL
             return None
-        if self._pending is not None and now - self._last_sent_time >= 1.0 / self.max_rate_hz:
+        if self._pending is not None and self._take_credit(now):
             angles, self._pending = self._pending, None
-            self._last_sent_time = now
             return angles
         return None

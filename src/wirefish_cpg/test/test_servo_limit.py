@@ -7,7 +7,7 @@ from wirefish_cpg.servo_limit import clamp_to_limit
 
 def test_angles_within_the_limit_pass_unchanged():
     angles, rates, clipped = clamp_to_limit([0.3, -0.5], [1.0, -2.0], 0.5)
-    assert (angles.tolist(), rates.tolist(), clipped) == ([0.3, -0.5], [1.0, -2.0], False)
+    assert (angles, rates, clipped) == ((0.3, -0.5), (1.0, -2.0), False)
 
 
 @pytest.mark.parametrize('angles, expected_angles, expected_rates', [

@@ -290,14 +290,18 @@ class CpgIntegrator:
             self._s = _pair_rk4(self._s, self.step_s, self._c)
         self.time_s += steps * self.step_s
 
-    def output(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
-        """Return (angles (2,) rad, rates (2,) rad/s) at ``time_s`` (within a step of now)."""
+    def output(self, time_s: float) -> tuple[tuple[float, float], tuple[float, float]]:
+        """
+        Return (angles rad, rates rad/s) of the two servos at ``time_s`` (within a step of now).
+
+        Plain floats, not arrays: the node calls this at every tick (up to 1 kHz).
+        """
         _finite('time_s', time_s)
         lead = min(max(time_s - self.time_s, 0.0), self.step_s)
         s = self._s if lead == 0.0 else _pair_rk4(self._s, lead, self._c)
         d = _pair_derivative(s, self._c)
         xi1, xi2, r1, r2, dr1, dr2, b1, b2, db1, db2 = s
-        angles = np.array([r1 * math.cos(xi1) + b1, r2 * math.cos(xi2) + b2])
-        rates = np.array([dr1 * math.cos(xi1) - r1 * d[0] * math.sin(xi1) + db1,
-                          dr2 * math.cos(xi2) - r2 * d[1] * math.sin(xi2) + db2])
+        angles = (r1 * math.cos(xi1) + b1, r2 * math.cos(xi2) + b2)
+        rates = (dr1 * math.cos(xi1) - r1 * d[0] * math.sin(xi1) + db1,
+                 dr2 * math.cos(xi2) - r2 * d[1] * math.sin(xi2) + db2)
         return angles, rates

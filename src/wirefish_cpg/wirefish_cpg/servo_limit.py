@@ -2,21 +2,22 @@
 
 from __future__ import annotations
 
-import numpy as np
-from numpy.typing import ArrayLike
+from collections.abc import Sequence
+
+ServoPair = tuple[float, float]
 
 
-def clamp_to_limit(angles: ArrayLike, rates: ArrayLike, limit_rad: float
-                   ) -> tuple[np.ndarray, np.ndarray, bool]:
+def clamp_to_limit(angles: Sequence[float], rates: Sequence[float], limit_rad: float
+                   ) -> tuple[ServoPair, ServoPair, bool]:
     """
     Return (angles clipped to [-limit, limit] rad, rates, whether any angle was clipped).
 
     A clipped servo holds still at the limit, so its rate is 0 (rad/s): a consumer integrating
-    the rate must not run past the angle.
+    the rate must not run past the angle. Two servos, plain floats (called at every CPG tick).
     """
-    angles = np.asarray(angles, dtype=float)
-    rates = np.asarray(rates, dtype=float)
-    clipped = np.abs(angles) > limit_rad
-    if not clipped.any():
-        return angles, rates, False
-    return angles.clip(-limit_rad, limit_rad), np.where(clipped, 0.0, rates), True
+    (a1, a2), (r1, r2) = angles, rates
+    if abs(a1) <= limit_rad and abs(a2) <= limit_rad:
+        return (float(a1), float(a2)), (float(r1), float(r2)), False
+    clipped = [(min(limit_rad, max(-limit_rad, a)), r if abs(a) <= limit_rad else 0.0)
+               for a, r in ((a1, r1), (a2, r2))]
+    return ((clipped[0][0], clipped[1][0]), (clipped[0][1], clipped[1][1]), True)

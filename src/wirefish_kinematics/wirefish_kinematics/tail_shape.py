@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wirefish_kinematics.body_wave import body_positions, swing_angles
+from wirefish_kinematics.body_wave import body_positions
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.wire_coupling import bend_angles
 
@@ -41,8 +41,12 @@ def tail_shape(servo_angles: tuple[float, float], geometry: FishGeometry, statio
     """Return the tail's shape at ``servo_angles`` (rad) on ``station_count`` (>= 2) stations."""
     beta1, beta2 = (float(b) for b in bend_angles(servo_angles[0], servo_angles[1], geometry))
     stations = np.linspace(0.0, geometry.tail_length, station_count)
-    x, y = body_positions(stations, beta1, beta2, geometry)
-    theta1, theta2 = swing_angles(beta1, beta2, geometry)
-    ends_x, ends_y = body_positions(np.array(geometry.link_end_stations), beta1, beta2,
-                                    geometry)
-    return TailShape(stations, x, y, beta1, beta2, float(theta1), float(theta2), ends_x, ends_y)
+    # The stations and the link ends in one evaluation of eqs 7-15 (three, with the swing
+    # angles' own, were two thirds of the node's 50 Hz tick): the swing angles of section 5.2
+    # are the directions of the link ends, as in ``swing_angles``.
+    x, y = body_positions(np.concatenate([stations, geometry.link_end_stations]), beta1, beta2,
+                          geometry)
+    ends_x, ends_y = x[station_count:], y[station_count:]
+    theta1, theta2 = np.arctan2(ends_y, ends_x)
+    return TailShape(stations, x[:station_count], y[:station_count], beta1, beta2,
+                     float(theta1), float(theta2), ends_x, ends_y)
