@@ -8,7 +8,8 @@ Subscribes
 Publishes (sensor-data QoS, stamped on receipt with the node clock)
     ``imu/data`` (sensor_msgs/Imu, frame ``imu_frame_id``), ``attitude``
     (geometry_msgs/Vector3Stamped: roll, pitch, yaw rad), ``servo_state`` (sensor_msgs/JointState,
-    measured angles), ``battery`` (sensor_msgs/BatteryState); and ``/diagnostics``
+    measured angles), ``battery`` (sensor_msgs/BatteryState, at ``battery_rate_hz`` and at once
+    when the low-battery flag changes); and ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, reliable) at ``diagnostics_rate_hz``: one status named
     ``<namespace>/bridge_node: serial link <port>``, hardware_id ``<node> on <port> (<device>)``.
 Only the fish it was started for: a virtual fish's link whose owner record says it is stale,
@@ -47,6 +48,7 @@ from wirefish_bridge.bridge_parameters import (check_combination, LINK_PARAMETER
                                                PARAMETERS, SPECS)
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
+from wirefish_bridge.decimator import Decimator
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
 from wirefish_bridge.link_owner import open_refusal
 from wirefish_bridge.protocol import (ErrorReport, Heartbeat,
@@ -86,6 +88,7 @@ class BridgeNode(Node):
         self._inbox_lock = threading.Lock()
         self._drain_scheduled = False  # a drain task is pending on the executor (inbox lock)
         self._health = LinkHealth(self._values['heartbeat_timeout_s'], time.monotonic())
+        self._battery_rate = Decimator(self._values['battery_rate_hz'])
 
         self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
         self._attitude_pub = self.create_publisher(Vector3Stamped, 'attitude',
@@ -116,6 +119,7 @@ class BridgeNode(Node):
         self._gate.timeout_s = self._values['command_timeout_s']
         self._gate.limit_rad = self._values['servo_limit_rad']
         self._health.heartbeat_timeout_s = self._values['heartbeat_timeout_s']
+        self._battery_rate.rate_hz = self._values['battery_rate_hz']
         if names & {'heartbeat_rate_hz', 'diagnostics_rate_hz'}:
             self._make_timers()
         if names & LINK_PARAMETERS:
@@ -229,9 +233,10 @@ class BridgeNode(Node):
             self._values['linear_acceleration_stddev_m_s2']))
         self._attitude_pub.publish(attitude_message(telemetry, stamp, frame_id))
         self._servo_pub.publish(servo_state_message(telemetry, stamp))
-        self._battery_pub.publish(battery_message(
-            telemetry, stamp, bool(telemetry.status & Status.LOW_BATTERY),
-            prefixed(self._frame_prefix, 'base_link')))
+        low_battery = bool(telemetry.status & Status.LOW_BATTERY)
+        if self._battery_rate.due(time.monotonic(), low_battery):
+            self._battery_pub.publish(battery_message(
+                telemetry, stamp, low_battery, prefixed(self._frame_prefix, 'base_link')))
 
     def _on_servo_cmd(self, msg: JointState) -> None:
         angles = servo_angles(msg)

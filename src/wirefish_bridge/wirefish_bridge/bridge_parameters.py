@@ -36,6 +36,9 @@ PARAMETERS = (
     ParameterSpec('reconnect_backoff_max_s', 1.0, 'Longest retry delay (s); doubles up to it',
                   0.01, 30.0),
     ParameterSpec('diagnostics_rate_hz', 1.0, 'Rate of /diagnostics (Hz)', 0.1, 10.0),
+    ParameterSpec('battery_rate_hz', 10.0,
+                  'Rate of battery (Hz), at most the telemetry rate; a change of the low-battery '
+                  'flag is published at once', 0.1, 1000.0),
     ParameterSpec('imu_frame_id', 'imu_link', 'frame_id of imu/data and attitude'),
     ParameterSpec('orientation_stddev_rad', 0.0175,
                   'Roll and pitch standard deviation (rad) for the covariance; 0 = unknown',

@@ -1,0 +1,42 @@
+"""
+Publish a stream slower than its source, but a change of state at once (pure, no rclpy).
+
+The fish sends one TELEMETRY frame 100 times a second; its battery voltage changes over
+minutes, so ``battery`` at 100 Hz was 90 publishes a second that told nothing (issue 15: the
+serial thread's CPU is the publishes). A change of the low-battery flag still goes out with the
+frame that carried it.
+"""
+
+from __future__ import annotations
+
+
+class Decimator:
+    """Says which samples of a stream to publish: one per ``1 / rate_hz`` s, and any change."""
+
+    def __init__(self, rate_hz: float) -> None:
+        """Publish at most ``rate_hz`` (> 0) samples a second, plus every change."""
+        self.rate_hz = rate_hz
+        self._last_time: float | None = None
+        self._last_state: object = None
+
+    @property
+    def rate_hz(self) -> float:
+        """Return the rate (Hz); a new one applies from the next sample."""
+        return self._rate_hz
+
+    @rate_hz.setter
+    def rate_hz(self, value: float) -> None:
+        if not value > 0.0:
+            raise ValueError(f'rate must be > 0 Hz, got {value}')
+        self._rate_hz = float(value)
+
+    def due(self, now: float, state: object = None) -> bool:
+        """Return whether the sample at ``now`` (s, monotonic) with ``state`` is published."""
+        changed = self._last_time is not None and state != self._last_state
+        # Within a hundredth of a period counts as on time: 100 Hz frames against 10 Hz must
+        # give every tenth frame, not every eleventh when a frame comes a little early.
+        if (self._last_time is None or changed
+                or now - self._last_time >= 0.99 / self._rate_hz):
+            self._last_time, self._last_state = now, state
+            return True
+        return False
