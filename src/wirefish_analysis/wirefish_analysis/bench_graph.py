@@ -19,7 +19,7 @@ import psutil
 
 from wirefish_bringup.graph import fish_graph, NodeSpec
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
-from wirefish_common.executors import EXECUTOR_VARIABLE
+from wirefish_common.executors import EVENTS, EXECUTOR_VARIABLE, make_executor
 
 READY_TIMEOUT_S = 60.0
 
@@ -34,22 +34,30 @@ def percentiles_ms(values_s: np.ndarray) -> dict[str, float]:
 
 
 @contextmanager
-def ros_session(domain_id: int):
-    """Yield (node, executor) of a benchmark-side rclpy context on ``domain_id``."""
+def ros_session(domain_id: int, executor_kind: str | None = None):
+    """
+    Yield (node, executor) of a benchmark-side rclpy context on ``domain_id``.
+
+    The benchmark's own receiver spins on the executor of the graph it measures (``events``
+    unless ``executor_kind`` says ``classic``), as a node of that graph would: a Python
+    executor's wake-up on the receiving side (a few hundred us) is part of what a classic
+    graph costs, not of what an events graph costs. Until 2026-12-01 (third session) it was
+    always the classic executor, which put its own wake-ups into both rows' receiver figures.
+    """
     import rclpy
     from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
 
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
     node = rclpy.create_node('wirefish_bench', context=context)
-    executor = SingleThreadedExecutor(context=context)
+    executor = make_executor(executor_kind or EVENTS, context=context)
     executor.add_node(node)
     try:
         yield node, executor
     finally:
-        executor.shutdown()
+        executor.remove_node(node)
         node.destroy_node()
+        executor.shutdown()
         rclpy.try_shutdown(context=context)
 
 
@@ -108,7 +116,7 @@ def cpg_rate(rate_hz: float, duration_s: float, domain_id: int,
         stamps.append(msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec)
 
     with processes([spec], domain_id, executor=executor) as supervisor, \
-            ros_session(domain_id) as (node, spinner):
+            ros_session(domain_id, executor) as (node, spinner):
         node.create_subscription(JointState, 'servo_cmd', on_servo, qos_profile_sensor_data)
         spin_for(spinner, 2.0)  # discovery and warm-up
         arrivals.clear()
@@ -161,7 +169,7 @@ def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = F
     counts = {('servo_cmd', i): 0 for i in range(1, fish + 1)}
     counts.update({('imu/data', i): 0 for i in range(1, fish + 1)})
     with processes(specs, domain_id, executor=executor) as supervisor, \
-            ros_session(domain_id) as (node, spinner):
+            ros_session(domain_id, executor) as (node, spinner):
         for i in range(1, fish + 1):
             for topic, msg_type in (('servo_cmd', JointState), ('imu/data', Imu)):
                 def count(_m, key=(topic, i)) -> None:

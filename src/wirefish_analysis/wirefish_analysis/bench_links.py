@@ -21,6 +21,8 @@ import tty
 
 import numpy as np
 
+from wirefish_analysis.bench_graph import ros_session
+
 
 def _percentiles(samples_s: list[float]) -> dict:
     if not samples_s:
@@ -30,6 +32,56 @@ def _percentiles(samples_s: list[float]) -> dict:
             'p99_ms': float(np.percentile(ms, 99)), 'max_ms': float(ms.max())}
 
 
+def _measure(node, spinner, master: int, samples: int, period_s: float
+             ) -> tuple[list[float], list[float]]:
+    """Play the fish on ``master``: return the command and telemetry latencies (s)."""
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import Imu, JointState
+    from wirefish_bridge.codec import FrameEncoder, StreamDecoder
+    from wirefish_bridge.protocol import Heartbeat, Role, ServoCommand, Telemetry
+
+    received: list[float] = []
+    node.create_subscription(Imu, 'imu/data', lambda _m: received.append(time.perf_counter()),
+                             qos_profile_sensor_data)
+    publisher = node.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)
+    encoder, decoder = FrameEncoder(), StreamDecoder()
+    command_latency: list[float] = []
+    telemetry_latency: list[float] = []
+    deadline = time.monotonic() + 20.0   # discovery: until a telemetry comes back
+    while time.monotonic() < deadline and not received:
+        os.write(master, encoder.encode(Heartbeat(role=Role.FISH)))
+        os.write(master, encoder.encode(Telemetry(0, 0.0, 0.0, 0.0, (0.0,) * 3,
+                                                  (0.0, 0.0, 9.8), 0.0, 0.0, 8.0)))
+        spinner.spin_once(timeout_sec=0.1)
+    for i in range(samples):
+        # (a) command path
+        angle = 0.001 * (i % 100 + 1)
+        sent = time.perf_counter()
+        publisher.publish(JointState(name=['servo_1', 'servo_2'], position=[angle, 0.0]))
+        stop = sent + 0.5
+        while time.perf_counter() < stop:
+            ready, _, _ = select.select([master], [], [], 0.0005)
+            if not ready:
+                continue
+            frames = decoder.feed(os.read(master, 4096))
+            if any(isinstance(f.message, ServoCommand)
+                   and abs(f.message.servo_1 - angle) < 1e-6 for f in frames):
+                command_latency.append(time.perf_counter() - sent)
+                break
+        # (b) telemetry path
+        count = len(received)
+        written = time.perf_counter()
+        os.write(master, encoder.encode(Telemetry(i, 0.0, 0.0, 0.0, (0.0,) * 3,
+                                                  (0.0, 0.0, 9.8), 0.0, 0.0, 8.0)))
+        stop = written + 0.5
+        while len(received) == count and time.perf_counter() < stop:
+            spinner.spin_once(timeout_sec=0.0005)
+        if len(received) > count:
+            telemetry_latency.append(received[count] - written)
+        time.sleep(period_s)
+    return command_latency, telemetry_latency
+
+
 def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02,
         executor: str | None = None) -> dict:
     """
@@ -37,13 +89,7 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02,
 
     ``executor`` ('events' or 'classic'; None: its default) is the bridge's WIREFISH_EXECUTOR.
     """
-    import rclpy
     from ament_index_python.packages import get_package_prefix
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.qos import qos_profile_sensor_data
-    from sensor_msgs.msg import Imu, JointState
-    from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-    from wirefish_bridge.protocol import Heartbeat, Role, ServoCommand, Telemetry
 
     master, slave = os.openpty()
     tty.setraw(slave)
@@ -57,55 +103,12 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02,
                                '-p', 'max_command_rate_hz:=1000.0'],
                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                               start_new_session=True)
-    context = rclpy.context.Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    node = rclpy.create_node('bench_links', context=context)
-    spinner = SingleThreadedExecutor(context=context)
-    spinner.add_node(node)
-    received: list[float] = []
-    node.create_subscription(Imu, 'imu/data', lambda _m: received.append(time.perf_counter()),
-                             qos_profile_sensor_data)
-    publisher = node.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)
-    encoder, decoder = FrameEncoder(), StreamDecoder()
-    command_latency: list[float] = []
-    telemetry_latency: list[float] = []
     try:
-        deadline = time.monotonic() + 20.0   # discovery: until a telemetry comes back
-        while time.monotonic() < deadline and not received:
-            os.write(master, encoder.encode(Heartbeat(role=Role.FISH)))
-            os.write(master, encoder.encode(Telemetry(0, 0.0, 0.0, 0.0, (0.0,) * 3,
-                                                      (0.0, 0.0, 9.8), 0.0, 0.0, 8.0)))
-            spinner.spin_once(timeout_sec=0.1)
-        for i in range(samples):
-            # (a) command path
-            angle = 0.001 * (i % 100 + 1)
-            sent = time.perf_counter()
-            publisher.publish(JointState(name=['servo_1', 'servo_2'], position=[angle, 0.0]))
-            stop = sent + 0.5
-            while time.perf_counter() < stop:
-                ready, _, _ = select.select([master], [], [], 0.0005)
-                if not ready:
-                    continue
-                frames = decoder.feed(os.read(master, 4096))
-                if any(isinstance(f.message, ServoCommand)
-                       and abs(f.message.servo_1 - angle) < 1e-6 for f in frames):
-                    command_latency.append(time.perf_counter() - sent)
-                    break
-            # (b) telemetry path
-            count = len(received)
-            written = time.perf_counter()
-            os.write(master, encoder.encode(Telemetry(i, 0.0, 0.0, 0.0, (0.0,) * 3,
-                                                      (0.0, 0.0, 9.8), 0.0, 0.0, 8.0)))
-            stop = written + 0.5
-            while len(received) == count and time.perf_counter() < stop:
-                spinner.spin_once(timeout_sec=0.0005)
-            if len(received) > count:
-                telemetry_latency.append(received[count] - written)
-            time.sleep(period_s)
+        # The receiver spins on the bridge's executor kind (see bench_graph.ros_session).
+        with ros_session(domain_id, executor) as (node, spinner):
+            command_latency, telemetry_latency = _measure(node, spinner, master, samples,
+                                                          period_s)
     finally:
-        spinner.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
         if bridge.poll() is None:
             os.killpg(bridge.pid, signal.SIGINT)
             try:
@@ -120,7 +123,7 @@ def run(samples: int = 300, domain_id: int = 99, period_s: float = 0.02,
             'how': f'{samples} samples each, {period_s * 1000:.0f} ms apart; bridge_node as a '
                    'separate process on a pty held by the benchmark (which plays the fish); '
                    'perf_counter from publish to bytes readable (command), and from write to '
-                   'the imu/data callback (telemetry)'}
+                   "the imu/data callback (telemetry), received on the bridge's executor kind"}
 
 
 if __name__ == '__main__':

@@ -79,7 +79,8 @@ def _cpg_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                      else '—', _side_by_side(pair, describe),
                      _verdicts(pair, ok) if kilohertz else '—',
                      '10 s; source: header stamps of servo_cmd (the node clock when the loop '
-                     'published); receiver: arrival times in a separate process; psutil CPU'))
+                     'published); receiver: arrival times in a separate process, spun on the '
+                     "row's executor; psutil CPU"))
     return rows
 
 
@@ -94,7 +95,8 @@ def _link_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                      _side_by_side(pair, lambda r: f'{_fmt(r.get("p50_ms"))} / '
                                    f'{_fmt(r.get("p99_ms"))} ms ({r.get("count")} samples)'),
                      _verdicts(pair, lambda r: r.get('p99_ms', float('inf')) <= 1.0),
-                     f'{how}; the benchmark side runs the classic executor in both'))
+                     f'{how} (the classic row receives on the classic executor, the events '
+                     'row on the events executor)'))
     return rows
 
 

@@ -66,7 +66,6 @@ class CpgNode(Node):
         # One message, refilled at every tick (only the loop's thread touches it): building a
         # JointState with its names and stamp was a fifth of a tick's CPU.
         self._command = servo_joint_state((0.0, 0.0), (0.0, 0.0))
-        self._clock = self.get_clock()
         self._params_pub = self.create_publisher(CpgParams, 'cpg_params', LATCHED)
         self.create_service(Trigger, 'start', self._on_start)
         self.create_service(Trigger, 'stop', self._on_stop)
@@ -135,7 +134,7 @@ class CpgNode(Node):
                                     throttle_duration_sec=2.0)
 
     def _publish_command(self) -> None:
-        now_ns = self._clock.now().nanoseconds
+        now_ns = self.get_clock().now().nanoseconds
         if now_ns <= self._last_tick_ns:  # simulated time stands still
             return
         self._last_tick_ns = now_ns
