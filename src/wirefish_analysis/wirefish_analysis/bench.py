@@ -38,7 +38,9 @@ def machine() -> dict:
         pass
     return {'cpu': cpu, 'cores': os.cpu_count(), 'python': platform.python_version(),
             'numpy': np.__version__, 'kernel': platform.release(),
-            'date': datetime.now(timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}
+            'date': datetime.now(timezone.utc).strftime('%Y-%m-%d %H:%M UTC'),
+            # Other users' load moves every figure on a shared machine: say how busy it was.
+            'load_average_1min': os.getloadavg()[0]}
 
 
 def recording(duration_s: float, domain_id: int) -> dict:

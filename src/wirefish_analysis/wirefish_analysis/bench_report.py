@@ -262,8 +262,10 @@ def render_markdown(results: dict) -> str:
              'Written by `make bench` (`python -m wirefish_analysis.bench`); figures from one '
              'run.',
              f'Machine: {m["cpu"]}, {m["cores"]} cores, Python {m["python"]}, numpy '
-             f'{m["numpy"]}, kernel {m["kernel"]}; {m["date"]}. Shared and noisy: medians and '
-             'p99 from one run, ratios within that run.', '',
+             f'{m["numpy"]}, kernel {m["kernel"]}; {m["date"]}'
+             + (f', load average {m["load_average_1min"]:.1f} at the start'
+                if 'load_average_1min' in m else '')
+             + '. Shared and noisy: medians and p99 from one run, ratios within that run.', '',
              '| figure | goal | measured | verdict | how |', '|---|---|---|---|---|']
     for figure, goal, measured, verdict, how in rows(results):
         lines.append(f'| {figure} | {goal} | {measured} | {verdict} | {how} |')

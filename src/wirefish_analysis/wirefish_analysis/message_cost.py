@@ -1,0 +1,133 @@
+"""
+What one ROS message, timer tick or publish costs a Python process here (issue 15; not a test).
+
+docs/PROFILING.md builds its cost model of a fish's graph from these figures: each probe is a
+process of its own on the events executor (the graph's default), measured with psutil over a
+window after a warm-up. ``python -m wirefish_analysis.message_cost`` prints the JSON: CPU in %
+of one core per process of each probe, and the same per event in microseconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import psutil
+
+RATE_HZ = 200.0  # servo_cmd's rate: the graph's busiest stream
+WARM_UP_S = 4.0
+MODULE = 'wirefish_analysis.message_cost'  # each probe runs as its own process
+
+
+def _spin(node) -> None:
+    from rclpy.experimental import EventsExecutor
+
+    executor = EventsExecutor()
+    executor.add_node(node)
+    while True:
+        executor.spin_once(timeout_sec=0.1)
+
+
+def _publisher(rate_hz: float) -> None:
+    """Publish a servo JointState at ``rate_hz`` from a thread loop, as cpg_node does."""
+    import rclpy
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+
+    rclpy.init()
+    node = rclpy.create_node('cost_publisher')
+    publisher = node.create_publisher(JointState, 'cost_probe', qos_profile_sensor_data)
+    msg = JointState(name=['servo_1', 'servo_2'], position=[0.1, 0.2], velocity=[0.0, 0.0])
+    deadline = time.monotonic()
+    while True:
+        deadline += 1.0 / rate_hz
+        delay = deadline - time.monotonic()
+        if delay > 0.0:
+            time.sleep(delay)
+        publisher.publish(msg)
+
+
+def _subscriber(kind: str) -> None:
+    """Take the probe's messages on the events executor: ``msg``, ``raw`` bytes, or ``none``."""
+    import rclpy
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+
+    rclpy.init()
+    node = rclpy.create_node('cost_subscriber')
+    if kind != 'none':
+        node.create_subscription(JointState, 'cost_probe', lambda _m: None,
+                                 qos_profile_sensor_data, raw=kind == 'raw')
+    _spin(node)
+
+
+def _timer(rate_hz: float) -> None:
+    """Run an empty timer callback at ``rate_hz`` on the events executor."""
+    import rclpy
+
+    rclpy.init()
+    node = rclpy.create_node('cost_timer')
+    node.create_timer(1.0 / rate_hz, lambda: None)
+    _spin(node)
+
+
+ROLES = {'publisher': lambda arg: _publisher(float(arg)), 'subscriber': _subscriber,
+         'timer': lambda arg: _timer(float(arg))}
+
+
+def _measure(roles: list[tuple[str, str]], window_s: float, domain_id: int) -> list[float]:
+    """Run one process per role; return each one's CPU (% of a core) over ``window_s``."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    procs = [subprocess.Popen([sys.executable, '-m', MODULE, '--role', role, arg], env=env)
+             for role, arg in roles]
+    try:
+        time.sleep(WARM_UP_S)
+        handles = [psutil.Process(p.pid) for p in procs]
+        start = [sum(h.cpu_times()[:2]) for h in handles]
+        time.sleep(window_s)
+        return [100.0 * (sum(h.cpu_times()[:2]) - s) / window_s for h, s in zip(handles, start)]
+    finally:
+        for p in procs:
+            p.kill()
+            p.wait()
+
+
+def run(window_s: float = 8.0, domain_id: int = 93) -> dict:
+    """Measure every probe; return CPU per process and per event (us)."""
+    rate = str(RATE_HZ)
+    probes = {
+        'idle node': [('subscriber', 'none')],
+        'timer at 200 Hz': [('timer', rate)],
+        'publisher at 200 Hz, no reader': [('publisher', rate)],
+        'publisher at 200 Hz, one reader': [('publisher', rate), ('subscriber', 'msg')],
+        'publisher at 200 Hz, one raw reader': [('publisher', rate), ('subscriber', 'raw')],
+        'publisher at 200 Hz, two readers': [('publisher', rate), ('subscriber', 'msg'),
+                                             ('subscriber', 'msg')],
+    }
+    results = {}
+    for name, roles in probes.items():
+        cpu = _measure(roles, window_s, domain_id)
+        results[name] = {'cpu_percent': [round(c, 2) for c in cpu],
+                         'us_per_event': [round(c / 100.0 / RATE_HZ * 1e6) for c in cpu]}
+    return {'window_s': window_s, 'rate_hz': RATE_HZ, 'probes': results}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print the probes' JSON, or run one probe process (``--role``)."""
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument('--role', nargs=2, metavar=('ROLE', 'ARG'), help=argparse.SUPPRESS)
+    parser.add_argument('--window', type=float, default=8.0, help='seconds measured per probe')
+    args = parser.parse_args(argv)
+    if args.role:
+        ROLES[args.role[0]](args.role[1])
+        return 0
+    print(json.dumps(run(args.window), indent=1))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
