@@ -20,11 +20,13 @@ twohost: setup  ## fish and shore roles on two network namespaces over DDS (root
 # The whole suite in two runs on both cores: every package's pure tests (src/*/test: no ROS
 # process), then the workspace tests that start nodes and graphs (test/). There a file's tests
 # stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
-# owns its own window of ROS domain ids (test/conftest.py); every test its own namespace.
+# owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
+# files are dealt in collection order, which puts the longest first (test/module_order.py).
 # Most of test/ waits on real-time graphs: two workers took 8.4 min where one took 14.
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
-	@$(WFENV) python -m pytest -n $(FAST_JOBS) --dist loadfile test $(PYTEST_ARGS)
+	@$(WFENV) python -m pytest -n $(FAST_JOBS) --dist loadfile --no-loadscope-reorder test \
+		$(PYTEST_ARGS)
 
 # The quick loop: every package's pure tests and every linter (flake8, pep257, mypy, the
 # package.xml check); no ROS process is started and the paper's experiments (wirefish_analysis:

@@ -13,6 +13,7 @@ from pathlib import Path
 import subprocess
 import sys
 
+from module_order import module_rank
 import pytest
 from ros_utils import stop_process
 
@@ -109,21 +110,6 @@ def python() -> str:
     return sys.executable
 
 
-# The modules that swim longest (a minute or more each, `--durations` of a full run), in that
-# order. `make test` runs test/ as `-n 2 --dist loadfile`, and xdist hands files out in
-# collection order: left in their alphabetical place (planner, twohost), they started last and
-# one worker swam them alone while the other had finished. Longest first balances the workers.
-LONGEST_MODULES = (
-    'planner/test_planner_graph.py',
-    'planner/test_planner_mission.py',
-    'twohost/test_two_hosts.py',
-    'fleet/test_fleet.py',
-    'bringup/test_recorder_sigkill.py',
-    'e2e/test_restart.py',
-)
-
-
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Put the longest modules first, in the order above; every other test keeps its place."""
-    rank = {WORKSPACE / 'test' / name: i for i, name in enumerate(LONGEST_MODULES)}
-    items.sort(key=lambda item: rank.get(Path(item.fspath), len(rank)))
+    """Collect the longest modules first (module_order.py); every other test keeps its place."""
+    items.sort(key=lambda item: module_rank(Path(item.fspath)))

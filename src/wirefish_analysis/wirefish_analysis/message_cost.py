@@ -21,6 +21,8 @@ import psutil
 RATE_HZ = 200.0  # servo_cmd's rate: the graph's busiest stream
 WARM_UP_S = 4.0
 MODULE = 'wirefish_analysis.message_cost'  # each probe runs as its own process
+# The probes' own topic: not one of the graph's (CONTRACTS.md lists those).
+PROBE_TOPIC = 'cost_probe'
 
 
 def _spin(node) -> None:
@@ -40,7 +42,7 @@ def _publisher(rate_hz: float) -> None:
 
     rclpy.init()
     node = rclpy.create_node('cost_publisher')
-    publisher = node.create_publisher(JointState, 'cost_probe', qos_profile_sensor_data)
+    publisher = node.create_publisher(JointState, PROBE_TOPIC, qos_profile_sensor_data)
     msg = JointState(name=['servo_1', 'servo_2'], position=[0.1, 0.2], velocity=[0.0, 0.0])
     deadline = time.monotonic()
     while True:
@@ -60,7 +62,7 @@ def _subscriber(kind: str) -> None:
     rclpy.init()
     node = rclpy.create_node('cost_subscriber')
     if kind != 'none':
-        node.create_subscription(JointState, 'cost_probe', lambda _m: None,
+        node.create_subscription(JointState, PROBE_TOPIC, lambda _m: None,
                                  qos_profile_sensor_data, raw=kind == 'raw')
     _spin(node)
 

@@ -1,0 +1,28 @@
+"""
+The order `make test` deals test/'s modules to its two workers in: the longest first.
+
+The modules below swim longest (a minute or more each, `--durations` of a full run). `make
+test` runs test/ as `-n 2 --dist loadfile --no-loadscope-reorder`, so xdist deals the files in
+collection order, and conftest.py collects these first. By default xdist deals the files with
+most tests first, so these one-test files came last (2026-12-01: the drive, the mission, the
+two hosts and the fleet ran after everything else and test/ took 9.6 min); dealt first, they
+swim side by side while the short files fill the gaps.
+"""
+
+from pathlib import Path
+
+WORKSPACE = Path(__file__).resolve().parents[1]
+LONGEST_MODULES = (
+    'test/planner/test_planner_graph.py',
+    'test/planner/test_planner_mission.py',
+    'test/twohost/test_two_hosts.py',
+    'test/fleet/test_fleet.py',
+    'test/bringup/test_recorder_sigkill.py',
+    'test/e2e/test_restart.py',
+)
+
+
+def module_rank(path: Path) -> int:
+    """Return where a test module is dealt: its place in ``LONGEST_MODULES``, else after them."""
+    ranks = {WORKSPACE / name: i for i, name in enumerate(LONGEST_MODULES)}
+    return ranks.get(Path(path), len(ranks))
