@@ -138,9 +138,16 @@ def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         old = onboard(False, 'classic')
         new = [v for v in (onboard(False, 'events'), onboard(True, 'events')) if v is not None]
         best = min(new) if new else None
+
+        def runs(single: bool, executor: str) -> str:
+            values = one_fish[single].get(executor, {}).get('onboard_cpu_percent_runs')
+            return (f' (median of {" / ".join(f"{v:.1f}" for v in values)})'
+                    if values and len(values) > 1 else '')
+
         measured = '<br>'.join(
             f'**{e}**, {"one process per fish" if single else "one process per node"}: '
-            f'{_fmt(onboard(single, e), ".1f")} %' for single in (False, True) for e in EXECUTORS)
+            f'{_fmt(onboard(single, e), ".1f")} %{runs(single, e)}'
+            for single in (False, True) for e in EXECUTORS)
         verdict = 'not measured'
         if old is not None and best is not None:
             measured += f'<br>best events / classic per node: {best / old:.2f}'
