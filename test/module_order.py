@@ -22,7 +22,9 @@ LONGEST_MODULES = (
 )
 
 
+_RANKS = {WORKSPACE / name: i for i, name in enumerate(LONGEST_MODULES)}
+
+
 def module_rank(path: Path) -> int:
     """Return where a test module is dealt: its place in ``LONGEST_MODULES``, else after them."""
-    ranks = {WORKSPACE / name: i for i, name in enumerate(LONGEST_MODULES)}
-    return ranks.get(Path(path), len(ranks))
+    return _RANKS.get(Path(path), len(_RANKS))

@@ -40,7 +40,7 @@ class CommandGate:
         self.failsafe_entries = 0
         self.clamped = 0
         self._last_command_time: float | None = None
-        self._last_sent_time = -float('inf')
+        self._last_neutral_time = -float('inf')
         self._credit = 1.0  # frames; the first command goes out at once
         self._credit_time: float | None = None
         self._pending: tuple[float, float] | None = None
@@ -78,7 +78,6 @@ class CommandGate:
         if self._credit < 1.0 - 1e-9:  # sums of float steps: 0.3 + 0.3 + 0.2 + 0.2 < 1.0
             return False
         self._credit -= 1.0
-        self._last_sent_time = now
         return True
 
     def on_tick(self, now: float) -> tuple[float, float] | None:
@@ -89,10 +88,10 @@ class CommandGate:
             if not self.failsafe:
                 self.failsafe = True
                 self.failsafe_entries += 1
-                self._last_sent_time = -float('inf')  # send neutral at once
+                self._last_neutral_time = -float('inf')  # send neutral at once
             self._pending = None
-            if now - self._last_sent_time >= self.neutral_period_s:
-                self._last_sent_time = now
+            if now - self._last_neutral_time >= self.neutral_period_s:
+                self._last_neutral_time = now
                 return NEUTRAL
             return None
         if self._pending is not None and self._take_credit(now):

@@ -15,9 +15,9 @@ def clamp_to_limit(angles: Sequence[float], rates: Sequence[float], limit_rad: f
     A clipped servo holds still at the limit, so its rate is 0 (rad/s): a consumer integrating
     the rate must not run past the angle. Two servos, plain floats (called at every CPG tick).
     """
-    (a1, a2), (r1, r2) = angles, rates
-    if abs(a1) <= limit_rad and abs(a2) <= limit_rad:
-        return (float(a1), float(a2)), (float(r1), float(r2)), False
-    clipped = [(min(limit_rad, max(-limit_rad, a)), r if abs(a) <= limit_rad else 0.0)
-               for a, r in ((a1, r1), (a2, r2))]
-    return ((clipped[0][0], clipped[1][0]), (clipped[0][1], clipped[1][1]), True)
+    (a1, a2), (r1, r2) = (float(a) for a in angles), (float(r) for r in rates)
+    within1, within2 = abs(a1) <= limit_rad, abs(a2) <= limit_rad
+    if within1 and within2:
+        return (a1, a2), (r1, r2), False
+    return ((min(limit_rad, max(-limit_rad, a1)), min(limit_rad, max(-limit_rad, a2))),
+            (r1 if within1 else 0.0, r2 if within2 else 0.0), True)
