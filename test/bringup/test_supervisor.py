@@ -5,6 +5,8 @@ Even several of the same name are stopped; an exiting one is restarted by its po
 a budget, then given up or, if required, an error that stops the graph.
 """
 
+import signal
+import sys
 import time
 
 import psutil
@@ -38,6 +40,7 @@ def test_same_named_processes_are_all_stopped_with_exit_code_0(tmp_path, ros_env
         node.destroy_node()
     codes = supervisor.stop()
     assert codes == {'cpg_node_2': 0, 'cpg_node': 0}
+    assert supervisor.overran == []
     assert sorted(p.name for p in tmp_path.glob('*.log')) == ['cpg_node.log', 'cpg_node_2.log']
 
 
@@ -92,3 +95,28 @@ def test_a_process_whose_policy_does_not_respawn_is_given_up_at_once(tmp_path, r
     finally:
         supervisor.stop()
     assert len(lines) == 1 and 'is not restarted (its policy)' in lines[0], lines
+
+
+# Processes that ignore SIGINT, as one whose stop hangs does; the first one exits at SIGTERM.
+_SLOW = 'signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))\n'
+_DEAF = 'signal.signal(signal.SIGTERM, signal.SIG_IGN)\n'
+
+
+@pytest.mark.parametrize('on_sigterm, code', [(_SLOW, 0), (_DEAF, None)])
+def test_a_process_still_running_at_the_deadline_is_named_and_escalated(
+        tmp_path, monkeypatch, on_sigterm, code):
+    script = tmp_path / 'late_node'
+    script.write_text(f'#!{sys.executable}\nimport signal, sys, time\n'
+                      'signal.signal(signal.SIGINT, signal.SIG_IGN)\n' + on_sigterm
+                      + "print('ready', flush=True)\ntime.sleep(60)\n")
+    script.chmod(0o755)
+    monkeypatch.setattr(NodeSpec, 'executable_path', lambda _spec: script)
+    supervisor = Supervisor(tmp_path / 'logs')
+    proc = supervisor.start(NodeSpec('wirefish_cpg', 'late_node', 'late_node', ()))
+    log = tmp_path / 'logs' / 'late_node.log'
+    deadline = time.monotonic() + 30.0
+    while 'ready' not in log.read_text() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert supervisor.stop(timeout_s=0.5) == {'late_node': code}
+    assert supervisor.overran == ['late_node']
+    assert proc.returncode == (0 if code == 0 else -signal.SIGKILL)

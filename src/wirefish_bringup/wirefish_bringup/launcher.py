@@ -30,6 +30,7 @@ DEVICE_TIMEOUT_S = 15.0
 # still stopping after 5 s), since each process needs CPU time to finish.
 STOP_TIMEOUT_S = 5.0
 STOP_S_PER_PROCESS = 1.0
+STOP_LOG_LINES = 60  # of a process that had to be killed: enough for its threads' stacks
 # Start-up may include restarts with back-off (1 + 2 + 4 s) of a node that fails at once.
 READY_TIMEOUT_S = 60.0
 # How long a new `wirefish up` listens for the registry's nodes already in its namespace (it
@@ -283,11 +284,18 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish up: {error}', file=sys.stderr)
         code = 1
     finally:
-        codes = supervisor.stop(timeout_s=max(STOP_TIMEOUT_S,
-                                              STOP_S_PER_PROCESS * len(supervisor.processes)))
+        stop_timeout_s = max(STOP_TIMEOUT_S, STOP_S_PER_PROCESS * len(supervisor.processes))
+        codes = supervisor.stop(timeout_s=stop_timeout_s)
     summary = supervisor.summary()
     if summary:
         print(f'wirefish up: {summary}', file=sys.stderr)
+    for name in supervisor.overran:  # its log ends with its threads' stacks (SignalShutdown)
+        end = ('was killed' if codes[name] is None
+               else f'exited with code {codes[name]} after a SIGTERM')
+        print(f'wirefish up: {name} still ran {stop_timeout_s:g} s after the SIGINT and {end}; '
+              f'the end of its log:\n'
+              f'{supervisor.log_tail(name, lines=STOP_LOG_LINES) or "(empty)"}',
+              file=sys.stderr)
     unclean = {name: rc for name, rc in codes.items() if rc != 0}
     if unclean:
         print(f'wirefish up: processes that did not exit cleanly: {unclean}', file=sys.stderr)

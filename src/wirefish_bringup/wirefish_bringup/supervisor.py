@@ -20,6 +20,7 @@ from typing import TextIO
 from wirefish_bringup.graph import NodeSpec, RestartBudget
 
 _PR_SET_PDEATHSIG = 1
+TERM_GRACE_S = 2.0  # after the SIGTERM to a process still running at the stop's deadline
 
 
 def _die_with_parent() -> None:  # runs in the child between fork and exec
@@ -51,6 +52,7 @@ class Supervisor:
         self.given_up: dict[str, int] = {}  # key -> its last exit code
         self._pending: dict[str, float] = {}  # key -> when (monotonic) it is restarted
         self._logs: dict[str, TextIO] = {}
+        self.overran: list[str] = []  # the processes stop() had to kill
 
     def start(self, spec: NodeSpec) -> subprocess.Popen:
         """
@@ -159,7 +161,10 @@ class Supervisor:
         """
         SIGINT every process (reverse start order), escalate after ``timeout_s``.
 
-        Returns each process's exit code; None for one that had to be killed.
+        A process still running then is named in ``overran`` and gets SIGTERM, then after
+        ``TERM_GRACE_S`` SIGKILL. Returns each process's exit code: its own if it exited by
+        itself (a wirefish process takes SIGTERM as one more stop request: exit 0 then means its
+        stop was slow, not unclean), None if it had to be killed.
         """
         procs = list(self.processes.items())[::-1]
         for _, proc in procs:
@@ -169,15 +174,16 @@ class Supervisor:
         for name, proc in procs:
             try:
                 codes[name] = proc.wait(timeout=max(0.0, deadline - time.monotonic()))
+                continue
             except subprocess.TimeoutExpired:
+                self.overran.append(name)
                 self._signal(proc, signal.SIGTERM)
-                try:
-                    proc.wait(timeout=2.0)
-                    codes[name] = None
-                except subprocess.TimeoutExpired:
-                    self._signal(proc, signal.SIGKILL)
-                    proc.wait()
-                    codes[name] = None
+            try:
+                codes[name] = proc.wait(timeout=TERM_GRACE_S)
+            except subprocess.TimeoutExpired:
+                self._signal(proc, signal.SIGKILL)
+                proc.wait()
+                codes[name] = None
         self._pending.clear()  # stopping: a restart that was due never happens
         for log in self._logs.values():
             log.close()

@@ -26,17 +26,27 @@ executor). ``attach(node)`` (a guard condition that shuts rclpy down) is for pro
 call ``spin()`` on a classic executor. Processes without a node to attach (a loop of their own)
 poll ``requested``. A signal that arrives before ``attach``/``attach_executor`` is kept and
 acted on as soon as one is called.
+
+A process still running ``STOP_STACKS_AFTER_S`` after the first signal writes the stacks of all
+its threads to stderr (its log under `wirefish up`), before the launcher's deadline
+(``wirefish_bringup.launcher``) escalates to SIGTERM and SIGKILL: a stop that hangs then says
+where it hangs. A process that stops in time writes nothing (the interpreter cancels the dump at
+exit).
 """
 
 from __future__ import annotations
 
 import atexit
+import faulthandler
 import signal
 import socket
 import threading
 from typing import Any
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+# Under the 6 s `wirefish up` gives a graph of 6 processes to stop; a stop takes < 2 s on the
+# loaded 2-core reference machine (load average 10).
+STOP_STACKS_AFTER_S = 4.0
 
 
 def ignore_stop_signals() -> None:
@@ -48,9 +58,10 @@ def ignore_stop_signals() -> None:
 class SignalShutdown:
     """Turns SIGINT/SIGTERM into an rclpy shutdown run by the executor's own loop."""
 
-    def __init__(self) -> None:
+    def __init__(self, stacks_after_s: float = STOP_STACKS_AFTER_S) -> None:
         """Route both signals to a watcher thread (call from the main thread)."""
         self.requested = False
+        self._stacks_after_s = stacks_after_s
         self._guard: Any = None
         self._executor: Any = None
         self._executor_lock = threading.Lock()  # a wake never meets an executor shut down
@@ -87,6 +98,10 @@ class SignalShutdown:
 
     def _watch(self) -> None:
         while self._receiver.recv(64):
+            if not self.requested:
+                # The dump goes to fd 2 from faulthandler's own C thread: it works while the
+                # main thread hangs in C code too.
+                faulthandler.dump_traceback_later(self._stacks_after_s, exit=False)
             self.requested = True
             self._trigger()
 
