@@ -5,7 +5,10 @@ fish_sim: the virtual fish on a pseudo-terminal, playing the board's firmware in
 line, flushed), points the link at it and runs until SIGINT/SIGTERM (exit code 0). The core
 (``VirtualFish``) needs no ROS; with ``--ros`` the process also publishes ``sim/ground_truth``
 (nav_msgs/Odometry, frame ``odom``, child ``base_link``, both under the ROS parameter
-``frame_prefix`` when set). Fault flags: ``--corrupt-fraction``,
+``frame_prefix`` when set) and swims with the fish's geometry from its ROS parameters (l1 ...
+drag_coefficient: the graph's one ``/**`` block of the params file, which kinematics_node,
+tuner_node and planner_node read too; read at start). Without ``--ros`` it swims with
+``FishGeometry``'s defaults. Fault flags: ``--corrupt-fraction``,
 ``--drop-fraction``, ``--stall-every/--stall-for`` (firmware freezes: no output, input lost),
 ``--reopen-every/--reopen-count/--reopen-delay`` (close the device, wait, open a new one).
 Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns the fish) and
@@ -15,6 +18,7 @@ Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns th
 from __future__ import annotations
 
 import argparse
+from dataclasses import fields
 import math
 from pathlib import Path
 import select
@@ -23,6 +27,7 @@ import time
 
 import numpy as np
 
+from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.pty_device import PtyDevice
@@ -91,9 +96,20 @@ class GroundTruthPublisher:
         from nav_msgs.msg import Odometry
         from wirefish_common.frames import declare_frame_prefix, prefixed
 
+        from wirefish_common.parameter_table import declare
+        from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
+
         self._rclpy = rclpy
         rclpy.init(args=ros_args, signal_handler_options=SignalHandlerOptions.NO)
         self.node = rclpy.create_node('fish_sim')
+        specs = geometry_parameters()
+        try:  # the values the other nodes of the graph judge the same way
+            declare(self.node, specs, geometry_from)
+        except InvalidParameters:
+            self.close()
+            raise
+        self.geometry = geometry_from({spec.name: self.node.get_parameter(spec.name).value
+                                       for spec in specs})
         prefix = declare_frame_prefix(self.node)  # fish_1: fish_1/odom, fish_1/base_link
         self._frames = prefixed(prefix, 'odom'), prefixed(prefix, 'base_link')
         self._odometry = Odometry
@@ -140,14 +156,22 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     # However many SIGINT/SIGTERM arrive: one stop, exit 0 (see wirefish_common.shutdown).
     signals = SignalShutdown()
     rng = np.random.default_rng(args.seed)
-    fish = VirtualFish(config_from(args), rng=rng)
+    try:
+        ground_truth = GroundTruthPublisher(ros_args) if args.ros else None
+    except InvalidParameters as error:  # one line, as a node's FATAL at start-up
+        print(error, file=sys.stderr, flush=True)  # it names fish_sim
+        return 1
+    fish = VirtualFish(config_from(args), rng=rng,
+                       geometry=ground_truth.geometry if ground_truth is not None else None)
+    print(f'fish_sim: geometry ({"ROS parameters" if ground_truth else "defaults"}) '
+          + ', '.join(f'{f.name} {getattr(fish.geometry, f.name):g}'
+                      for f in fields(fish.geometry)), file=sys.stderr, flush=True)
     faults = FaultInjector(np.random.default_rng(args.seed + 1), args.corrupt_fraction,
                            args.drop_fraction)
     disturbance = Disturbance(args.yaw_disturbance, args.surge_disturbance)
     stalls = Schedule(args.stall_every, args.stall_for)
     reopens = Schedule(args.reopen_every, args.reopen_delay, args.reopen_count)
     device = PtyDevice(args.link)
-    ground_truth = GroundTruthPublisher(ros_args) if args.ros else None
     try:
         print(device.open_pair(), flush=True)
         start = last = time.monotonic()
