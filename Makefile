@@ -22,10 +22,11 @@ twohost: setup  ## fish and shore roles on two network namespaces over DDS (root
 # stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
 # owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
 # files are dealt in collection order, which puts the longest first (test/module_order.py).
+# -rR: the summary names each test that passed only on its rerun (CI's output shows it too).
 # Most of test/ waits on real-time graphs: two workers took 8.4 min where one took 14.
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
-	@$(WFENV) python -m pytest -n $(FAST_JOBS) --dist loadfile --no-loadscope-reorder test \
+	@$(WFENV) python -m pytest -n $(FAST_JOBS) --dist loadfile --no-loadscope-reorder -rR test \
 		$(PYTEST_ARGS)
 
 # The quick loop: every package's pure tests and every linter (flake8, pep257, mypy, the
