@@ -97,6 +97,7 @@ class GroundTruthPublisher:
         from wirefish_common.frames import declare_frame_prefix, prefixed
 
         from wirefish_common.parameter_table import declare
+        from wirefish_common.qos import RELIABLE
         from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
 
         self._rclpy = rclpy
@@ -113,7 +114,7 @@ class GroundTruthPublisher:
         prefix = declare_frame_prefix(self.node)  # fish_1: fish_1/odom, fish_1/base_link
         self._frames = prefixed(prefix, 'odom'), prefixed(prefix, 'base_link')
         self._odometry = Odometry
-        self.publisher = self.node.create_publisher(Odometry, 'sim/ground_truth', 10)
+        self.publisher = self.node.create_publisher(Odometry, 'sim/ground_truth', RELIABLE)
 
     def publish(self, fish: VirtualFish) -> None:
         """Publish the fish's ground truth now."""
