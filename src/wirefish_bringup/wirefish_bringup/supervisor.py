@@ -52,7 +52,7 @@ class Supervisor:
         self.given_up: dict[str, int] = {}  # key -> its last exit code
         self._pending: dict[str, float] = {}  # key -> when (monotonic) it is restarted
         self._logs: dict[str, TextIO] = {}
-        self.overran: list[str] = []  # the processes stop() had to kill
+        self.overran: list[str] = []  # the processes still running at stop()'s deadline
 
     def start(self, spec: NodeSpec) -> subprocess.Popen:
         """

@@ -87,7 +87,13 @@ def config_from(args: argparse.Namespace) -> SimConfig:
 
 
 class GroundTruthPublisher:
-    """sim/ground_truth (nav_msgs/Odometry) from the fish state; only with --ros."""
+    """
+    fish_sim's ROS side, only with --ros: the geometry it swims with, and sim/ground_truth.
+
+    The geometry (``geometry``) comes from the node's parameters, judged as kinematics_node
+    judges them (``InvalidParameters`` names the first bad one); sim/ground_truth is
+    nav_msgs/Odometry of the fish state.
+    """
 
     def __init__(self, ros_args: list[str]) -> None:
         """Initialise rclpy without its signal handlers (ours stop the loop cleanly)."""
@@ -95,7 +101,6 @@ class GroundTruthPublisher:
         from rclpy.signals import SignalHandlerOptions
         from nav_msgs.msg import Odometry
         from wirefish_common.frames import declare_frame_prefix, prefixed
-
         from wirefish_common.parameter_table import declare
         from wirefish_common.qos import RELIABLE
         from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
