@@ -47,7 +47,9 @@ def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, 
 
 
 # Seen failing once under a loaded full run (2026-12-01 closing note), passing alone: one rerun
-# so a shared machine does not sink CI; a real regression fails both runs.
+# so a shared machine does not sink CI; a real regression fails both runs. (A later full run
+# failed both on the servo check, 0.5-0.8 mrad over the bound: a real CPG step at frequency
+# changes, fixed in CpgIntegrator.set_parameters.)
 @pytest.mark.flaky(reruns=1)
 @pytest.mark.ros
 def test_drive_the_virtual_fish(driver):
