@@ -174,21 +174,24 @@ class Supervisor:
         for name, proc in procs:
             try:
                 codes[name] = proc.wait(timeout=max(0.0, deadline - time.monotonic()))
-                continue
             except subprocess.TimeoutExpired:
                 self.overran.append(name)
-                self._signal(proc, signal.SIGTERM)
-            try:
-                codes[name] = proc.wait(timeout=TERM_GRACE_S)
-            except subprocess.TimeoutExpired:
-                self._signal(proc, signal.SIGKILL)
-                proc.wait()
-                codes[name] = None
+                codes[name] = self._escalate(proc)
         self._pending.clear()  # stopping: a restart that was due never happens
         for log in self._logs.values():
             log.close()
         self._logs.clear()
         return codes
+
+    def _escalate(self, proc: subprocess.Popen) -> int | None:
+        """SIGTERM, then SIGKILL after ``TERM_GRACE_S``; return its own exit code, or None."""
+        self._signal(proc, signal.SIGTERM)
+        try:
+            return proc.wait(timeout=TERM_GRACE_S)
+        except subprocess.TimeoutExpired:
+            self._signal(proc, signal.SIGKILL)
+            proc.wait()
+            return None
 
     @staticmethod
     def _signal(proc: subprocess.Popen, signum: int) -> None:
