@@ -1,0 +1,33 @@
+/*
+ * The firmware application: the one entry point a port's main loop (or an RTOS task) calls.
+ *
+ *   static wf_app_t app;              -- all state, no heap
+ *   wf_app_init(&app, &config);       -- once, after the port's clocks, UART, PWM, I2C, ADC
+ *   for (;;) wf_app_poll(&app);       -- as often as possible (at least once a millisecond)
+ *
+ * wf_app_poll reads the UART, decodes and acts on frames, runs the failsafe, updates the
+ * servos, samples the IMU and sends telemetry (100 Hz) and heartbeats (2 Hz) when they are due.
+ * The full definition of wf_app_t and wf_config_t lives in wf/app_state.h (owned by the core).
+ */
+#ifndef WF_APP_H
+#define WF_APP_H
+
+#include "wf/app_state.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The defaults of PROTOCOL.md: 0.5 s command timeout, 1.5 s heartbeat timeout, 100 Hz
+ * telemetry, 2 Hz heartbeat, 50 Hz servo frames, the virtual fish's servo limit. */
+void wf_config_defaults(wf_config_t *config);
+
+void wf_app_init(wf_app_t *app, const wf_config_t *config);
+
+void wf_app_poll(wf_app_t *app);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* WF_APP_H */

@@ -1,0 +1,59 @@
+/*
+ * The hardware interface: everything the portable core asks of a board.
+ *
+ * Two ports implement it: port/host (POSIX: a pty or stdin/stdout, a simulated clock for
+ * tests) and port/stm32f4 (registers of RM0090, interrupt-driven USART, TIM PWM, I2C1, ADC,
+ * SysTick). The core never touches a register and never allocates: every buffer it uses is
+ * a fixed array inside its own state structures.
+ *
+ * Calls come from one context (the main loop, or one RTOS task); the ports make the UART
+ * queues safe against their own interrupt handlers.
+ */
+#ifndef WF_HAL_H
+#define WF_HAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum { WF_SERVO_COUNT = 2 };
+
+/* Milliseconds since power-up; wraps at 2^32 (every comparison in the core is modular). */
+uint32_t wf_hal_millis(void);
+
+/* Moves up to max received bytes into buf without blocking; returns how many. */
+size_t wf_hal_uart_read(uint8_t *buf, size_t max);
+
+/* Queues len bytes for transmission without blocking; returns how many were accepted (a full
+ * transmit queue accepts fewer: the caller counts the rest as not sent). */
+size_t wf_hal_uart_write(const uint8_t *buf, size_t len);
+
+/* Timer ticks per microsecond of the servo PWM timer, and the compare register's full period
+ * in ticks (set by wf_hal_pwm_init). */
+uint32_t wf_hal_pwm_ticks_per_us(void);
+
+/* Starts PWM on both servo channels at frame_hz (50..333 Hz); returns false if the rate is out
+ * of range, and then changes nothing. */
+bool wf_hal_pwm_init(uint32_t frame_hz);
+
+/* Writes a compare value (pulse width in timer ticks) to servo channel 0 or 1. */
+void wf_hal_pwm_set_compare(unsigned servo, uint32_t compare_ticks);
+
+/* One I2C transaction with the 7-bit address: writes tx_len bytes, then (repeated start) reads
+ * rx_len bytes. Returns false on NACK, bus error or timeout; rx is then unspecified. */
+bool wf_hal_i2c_transfer(uint8_t address7, const uint8_t *tx, size_t tx_len, uint8_t *rx,
+                         size_t rx_len);
+
+/* The battery voltage divider's ADC reading, 12-bit (0..4095), or a negative value when no
+ * conversion is available. */
+int32_t wf_hal_adc_battery_raw(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* WF_HAL_H */
