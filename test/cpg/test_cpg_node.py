@@ -13,7 +13,7 @@ pytestmark = pytest.mark.ros
 
 def test_servo_cmd_streams_both_servos_and_converges_to_the_table1_amplitudes(spawn, probe):
     spawn([CPG_NODE])
-    probe.wait_samples(600)  # 3 s at 200 Hz
+    probe.wait_samples(300)  # 3 s at the default 100 Hz
     t, positions, velocities = probe.trace()
     assert probe.servo[-1].name == ['servo_1', 'servo_2']
     assert np.all(np.diff(t) > 0)

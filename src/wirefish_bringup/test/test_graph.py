@@ -4,9 +4,11 @@ import ast
 from pathlib import Path
 
 import pytest
+from wirefish_bridge.bridge_parameters import SPECS as BRIDGE_SPECS
 from wirefish_bringup.graph import (combined_policy, composable_entries, entries, expected_rates,
                                     fish_graph, NODES, NodeSpec, RestartBudget, RestartPolicy,
                                     sim_tty_link, validate_namespace)
+from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
 
 LAUNCH_FILE = Path(__file__).resolve().parents[1] / 'launch' / 'wirefish.launch.py'
 
@@ -64,9 +66,15 @@ def test_every_node_class_names_a_module_and_a_class():
         assert module.startswith(e.package + '.') and cls.isidentifier(), e.name
 
 
+def test_servo_cmd_is_expected_at_the_rate_the_bridge_forwards_to_the_board():
+    nominal, _ = expected_rates(sim=True)
+    assert nominal['servo_cmd'] == CPG_SPECS['publish_rate_hz'].default
+    assert nominal['servo_cmd'] == BRIDGE_SPECS['max_command_rate_hz'].default
+
+
 def test_the_expected_rates_are_the_registry_streams():
     nominal, minimum = expected_rates(sim=True)
-    assert nominal['servo_cmd'] == 200.0 and nominal['sim/ground_truth'] == 50.0
+    assert nominal['sim/ground_truth'] == 50.0
     assert minimum['/diagnostics'] > 0.0
     assert 'sim/ground_truth' not in expected_rates(sim=False)[0]
 

@@ -156,7 +156,7 @@ NODES: tuple[NodeEntry, ...] = (
                         'battery': 10.0},
               min_rates_hz={'/diagnostics': 0.5}, fed_by=('fish_sim',)),
     NodeEntry('wirefish_cpg', 'cpg_node', 'cpg_node', start_order=20,
-              node_class='wirefish_cpg.cpg_node:CpgNode', rates_hz={'servo_cmd': 200.0}),
+              node_class='wirefish_cpg.cpg_node:CpgNode', rates_hz={'servo_cmd': 100.0}),
     NodeEntry('wirefish_kinematics', 'kinematics_node', 'kinematics_node', start_order=30,
               node_class='wirefish_kinematics.kinematics_node:KinematicsNode', frames=True,
               rates_hz={'body_wave': 50.0, 'body_wave_markers': 10.0},
