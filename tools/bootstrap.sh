@@ -86,8 +86,28 @@ fi
 # --- colcon build --------------------------------------------------------------------------
 # With --symlink-install, edits to Python modules are live: only the file list, setup.py and the
 # non-Python files (package.xml, CMakeLists.txt, msg/srv, launch, config) need a new build.
-src_files="$(git ls-files -co --exclude-standard -- src | LC_ALL=C sort)"
-src_key="$( { echo "$src_files"; echo "$src_files" | grep -v -E '\.py$' | xargs -d '\n' -r sha256sum;
+# tf2_msgs (/tf, /tf_static): an installed one if there is any (a full Jazzy install), else the
+# workspace's copy in interfaces/ (the wheels lack it; same definition, same type hash).
+base_paths=(src)
+tf2_prefix=""
+IFS=: read -ra ament_prefixes <<<"${AMENT_PREFIX_PATH:-}"
+[ "$MODE" = wheels ] && ament_prefixes=("$VENV")
+for prefix in "${ament_prefixes[@]}"; do
+  [[ "$prefix" = "$ROOT/install"* ]] && continue
+  if [ -e "$prefix/share/ament_index/resource_index/packages/tf2_msgs" ]; then
+    tf2_prefix="$prefix"
+    break
+  fi
+done
+if [ -n "$tf2_prefix" ]; then
+  log "tf2_msgs: the installed one ($tf2_prefix)"
+else
+  log "tf2_msgs: none installed, building the workspace's copy (interfaces/tf2_msgs)"
+  base_paths+=(interfaces)
+fi
+src_files="$(git ls-files -co --exclude-standard -- "${base_paths[@]}" | LC_ALL=C sort)"
+src_key="$( { echo "${base_paths[*]}"; echo "$src_files";
+  echo "$src_files" | grep -v -E '\.py$' | xargs -d '\n' -r sha256sum;
   echo "$src_files" | grep -E '(^|/)setup\.py$' | xargs -d '\n' -r sha256sum; } | sha256sum)"
 if [ "$(cat install/.wirefish-stamp 2>/dev/null)" != "$src_key" ]; then
   log "colcon build"
@@ -97,7 +117,7 @@ if [ "$(cat install/.wirefish-stamp 2>/dev/null)" != "$src_key" ]; then
     if [ "$MODE" = wheels ]; then
       export AMENT_PREFIX_PATH="$VENV" CMAKE_PREFIX_PATH="$VENV"
     fi
-    colcon --log-base log build --symlink-install --base-paths src \
+    colcon --log-base log build --symlink-install --base-paths "${base_paths[@]}" \
       --build-base build --install-base install \
       --event-handlers console_cohesion- console_direct- summary+ status- \
       --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE="$VENV/bin/python" 2>&1 \
