@@ -1,5 +1,5 @@
 """
-docs/ARCHITECTURE.md and docs/CONTRACTS.md say what the code is (pure: reads files and tables).
+docs/ and README.md say what the code is (pure: reads files and tables).
 
 Each test names what the docs miss or cite wrongly, so a renamed module, a new topic, node,
 parameter, package or message type fails here until the docs follow.
@@ -18,9 +18,11 @@ SRC = ROOT / 'src'
 README = ROOT / 'README.md'
 ARCHITECTURE = ROOT / 'docs' / 'ARCHITECTURE.md'
 CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
+REFERENCE = ROOT / 'docs' / 'REFERENCE.md'
+FAULTS = ROOT / 'docs' / 'FAULTS.md'
 DOCS = (ARCHITECTURE, CONTRACTS)
-# README.md's topic table disagrees with the code here today (reported to the README's owner):
-# it lists a topic that is gone and lacks two. Remove each name once the README is fixed.
+# Every document a user reads: its cited files and its relative links must exist.
+USER_DOCS = (README, ARCHITECTURE, CONTRACTS, REFERENCE, FAULTS)
 # A topic, service or action name given as a literal where a node or tool creates it.
 _CREATED = re.compile(
     r'(?:create_(?:publisher|subscription|service)|ActionServer|ActionClient)'
@@ -29,6 +31,8 @@ _CREATED = re.compile(
 _DOTTED = re.compile(r'`(wirefish_[a-z]+(?:\.[A-Za-z_][A-Za-z0-9_]*)+)')
 # A repository path in backticks ending in .py or .md.
 _PATH = re.compile(r'`((?:src|test|docs)/[\w./-]+\.(?:py|md))`')
+# A relative markdown link's target, without its #anchor.
+_LINK = re.compile(r'\]\((?!https?://|#)([^)#\s]+)(?:#[^)]*)?\)')
 
 
 def _text(path: Path) -> str:
@@ -71,11 +75,11 @@ def parameter_tables() -> list[tuple[str, str]]:
     return tables
 
 
-def readme_table_names() -> set[str]:
-    """Return the names in the first column of README.md's table of topics and services."""
+def reference_table_names() -> set[str]:
+    """Return the names in the first column of REFERENCE.md's table of topics and services."""
     names: set[str] = set()
     in_table = False
-    for line in _text(README).splitlines():
+    for line in _text(REFERENCE).splitlines():
         if line.startswith('| name | kind |'):
             in_table = True
         elif in_table and not line.startswith('|'):
@@ -150,11 +154,11 @@ def test_every_node_class_of_the_registry_declares_a_table_found_here():
     assert found == {e.package for e in NODES if e.node_class is not None}
 
 
-def test_the_readme_topic_table_lists_what_the_code_creates():
-    listed, created = readme_table_names(), _created_names()
+def test_the_reference_topic_table_lists_what_the_code_creates():
+    listed, created = reference_table_names(), _created_names()
     stale, missing = listed - created, created - listed
     assert listed and not stale and not missing, (
-        f'README.md topic table: {sorted(stale)} created nowhere, {sorted(missing)} not listed')
+        f'REFERENCE.md topic table: {sorted(stale)} created nowhere, {sorted(missing)} not listed')
 
 
 @pytest.mark.parametrize('module, table', parameter_tables())
@@ -178,11 +182,18 @@ def test_every_cited_module_and_name_exists(doc):
     assert cited and not problems, f'{doc.name}: {problems}'
 
 
-@pytest.mark.parametrize('doc', DOCS, ids=[d.name for d in DOCS])
+@pytest.mark.parametrize('doc', USER_DOCS, ids=[d.name for d in USER_DOCS])
 def test_every_cited_file_exists(doc):
     missing = [p for p in _PATH.findall(_text(doc)) if not (ROOT / p).exists()
                and 'foo_node' not in p]
     assert not missing, f'{doc.name} cites files that do not exist: {missing}'
+
+
+@pytest.mark.parametrize('doc', USER_DOCS, ids=[d.name for d in USER_DOCS])
+def test_every_relative_link_leads_to_a_file(doc):
+    missing = [target for target in _LINK.findall(_text(doc))
+               if not (doc.parent / target).exists()]
+    assert not missing, f'{doc.name} links to files that do not exist: {missing}'
 
 
 @pytest.mark.parametrize('dotted, problem', [
