@@ -62,13 +62,13 @@ def test_invalid_updates_are_rejected_with_a_reason_and_change_nothing(spawn, pr
 
 def test_valid_update_applies_smoothly_and_is_announced(spawn, probe):
     spawn([CPG_NODE])
-    probe.wait_samples(300)
+    probe.wait_samples(150)
     start = len(probe.servo)
     result = probe.set_parameters({'amplitude_1': 0.2, 'amplitude_2': -0.3,
                                    'frequency_hz': 1.5, 'offset_1': 0.1})
     assert result.successful, result.reason
-    probe.wait_samples(500)
-    t, positions, velocities = probe.trace(start - 100)
+    probe.wait_samples(250)
+    t, positions, velocities = probe.trace(start - 50)
     assert max_step_ratio(t, positions, velocities) <= 1.0
     last_period = positions[t > t[-1] - 1.0 / 1.5]
     np.testing.assert_allclose(last_period.max(axis=0) - last_period.min(axis=0),
@@ -80,25 +80,25 @@ def test_valid_update_applies_smoothly_and_is_announced(spawn, probe):
 
 def test_stop_brings_the_tail_to_rest_without_a_step_and_start_resumes(spawn, probe):
     spawn([CPG_NODE])
-    probe.wait_samples(300)
+    probe.wait_samples(150)
     start = len(probe.servo)
     stop = probe.node.create_client(Trigger, 'stop')
     assert probe.call(stop, Trigger.Request()).success
-    probe.wait_samples(300)
-    t, positions, velocities = probe.trace(start - 50)
+    probe.wait_samples(150)
+    t, positions, velocities = probe.trace(start - 25)
     assert max_step_ratio(t, positions, velocities) <= 1.0
-    assert np.abs(positions[-20:]).max() < 1e-3
+    assert np.abs(positions[-10:]).max() < 1e-3
     begin = probe.node.create_client(Trigger, 'start')
     assert probe.call(begin, Trigger.Request()).success
-    probe.wait_samples(400)
-    t, positions, velocities = probe.trace(start + 200)
+    probe.wait_samples(200)
+    t, positions, velocities = probe.trace(start + 100)
     assert max_step_ratio(t, positions, velocities) <= 1.0
-    assert np.abs(positions[-200:, 1]).max() == pytest.approx(0.47, rel=0.03)
+    assert np.abs(positions[-100:, 1]).max() == pytest.approx(0.47, rel=0.03)
 
 
 def test_outputs_beyond_the_servo_limit_are_clamped_with_a_warning(spawn, probe):
     proc = spawn([CPG_NODE, '--ros-args', '-p', 'servo_limit_rad:=0.3'])
-    probe.wait_samples(400)
+    probe.wait_samples(200)
     _, positions, _ = probe.trace()
     assert np.abs(positions).max() <= 0.3
     assert np.isclose(np.abs(positions[:, 1]).max(), 0.3)
@@ -108,13 +108,13 @@ def test_outputs_beyond_the_servo_limit_are_clamped_with_a_warning(spawn, probe)
 
 def test_autostart_false_holds_still_until_start(spawn, probe):
     spawn([CPG_NODE, '--ros-args', '-p', 'autostart:=false'])
-    probe.wait_samples(100)
+    probe.wait_samples(50)
     _, positions, _ = probe.trace()
     assert np.abs(positions).max() == 0.0
     begin = probe.node.create_client(Trigger, 'start')
     assert probe.call(begin, Trigger.Request()).success
-    probe.wait_samples(400)
-    assert np.abs(probe.trace()[1][-100:]).max() > 0.3
+    probe.wait_samples(200)
+    assert np.abs(probe.trace()[1][-50:]).max() > 0.3
 
 
 def test_servo_cmd_is_stamped_with_simulated_time_when_use_sim_time(spawn, probe):
@@ -129,7 +129,7 @@ def test_servo_cmd_is_stamped_with_simulated_time_when_use_sim_time(spawn, probe
         clock_pub.publish(Clock(clock=Time(sec=sim_ns[0] // 10**9,
                                            nanosec=sim_ns[0] % 10**9)))
     probe.node.create_timer(0.005, tick)
-    probe.wait_samples(200)
+    probe.wait_samples(100)
     t, positions, _ = probe.trace()
     assert t.min() >= 1000.0 and t.max() <= sim_ns[0] * 1e-9
     assert np.abs(positions).max() > 0.1  # it oscillates on simulated time

@@ -5,13 +5,13 @@ The fish role runs in one network namespace, the shore role in another, DDS over
 between them (multicast discovery, UDPv4 only: see netns.py).
 
 One run, in phases (each needs the graph up, which takes most of the time): the fish swims
-(servo_cmd >= 190 Hz measured inside the fish's namespace) and the shore gets its copies of
-imu/data and speed_estimate; a retune called on the shore applies on the fish; the link is cut
-for 10 s while the shore drives: servo_cmd never pauses, the planner's cmd_vel timeout rests the
-fish, nothing reaches the shore; the link returns: the shore sees the streams again within
-RECOVERY_BOUND_S and a second retune applies; under a 100 kbit/s token bucket every relayed
-topic arrives at its configured rate, with the bytes per second crossing each way printed
-(the BENCHMARKS.md row). Wall time ~2.5 min.
+(servo_cmd >= 95 % of its default rate measured inside the fish's namespace) and the shore gets its
+copies of imu/data and speed_estimate; a retune called on the shore applies on the fish; the link
+is cut for 10 s while the shore drives: servo_cmd never pauses, the planner's cmd_vel timeout rests
+the fish, nothing reaches the shore; the link returns: the shore sees the streams again within
+RECOVERY_BOUND_S and a second retune applies; under a 100 kbit/s token bucket every relayed topic
+arrives at its configured rate, with the bytes per second crossing each way printed (the
+BENCHMARKS.md row). Wall time ~2.5 min.
 """
 
 import re
@@ -22,6 +22,7 @@ import pytest
 from twohost.link_hosts import wait_for
 from wirefish_bringup.crossing import default_crossing_file, load_crossing
 from wirefish_bringup.netns import FISH, SHORE
+from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
 
 pytestmark = pytest.mark.ros
 
@@ -37,7 +38,8 @@ CUT_S = 10.0
 # The link returns: Fast DDS's participant lease (20 s) outlasts a 10 s cut, so nothing has to
 # be discovered again; data resumes with the next sample or resend.
 RECOVERY_BOUND_S = 15.0
-SERVO_GAP_BOUND_S = 0.25  # 50 periods at 200 Hz: a pause, not a scheduling hiccup
+SERVO_GAP_BOUND_S = 0.25  # 25 periods at 100 Hz: a pause, not a scheduling hiccup
+SERVO_MIN_HZ = 0.95 * CPG_SPECS['publish_rate_hz'].default
 REST_WITHIN_S = 3.0  # cmd_vel_timeout_s 0.5 + a control period + the CPG's parameter call
 RATE_WINDOW_S = 10.0
 SERVO_WINDOW_S = 5.0  # of driving before the cut
@@ -140,8 +142,8 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
           f'shore got {imu_cut - imu_cut_start} imu/data copies in its last {CUT_S - 1:g} s')
     swim_hz = _rate(fish, 'servo_cmd', drive_at, restored_at)
     print(f'servo_cmd on the fish over the drive and the cut: {swim_hz:.1f} Hz')
-    assert swim_hz >= 190.0
-    assert servo_gap < SERVO_GAP_BOUND_S and cut_hz >= 190.0
+    assert swim_hz >= SERVO_MIN_HZ
+    assert servo_gap < SERVO_GAP_BOUND_S and cut_hz >= SERVO_MIN_HZ
     assert rested and rested[0]['t'] - cut_at < REST_WITHIN_S
     assert imu_cut == imu_cut_start  # the cut cuts (no shared-memory path past the veth)
 
