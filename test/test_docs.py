@@ -10,6 +10,7 @@ import importlib
 from pathlib import Path
 import re
 
+from declared_parameters import tables_declared_in
 import pytest
 from wirefish_bringup.graph import NODES
 
@@ -57,22 +58,8 @@ def parameter_tables() -> list[tuple[str, str]]:
 
     Read from each node class's module, so a node added to the registry is checked too.
     """
-    tables = []
-    for entry in NODES:
-        if entry.node_class is None:
-            continue
-        module = entry.node_class.split(':')[0]
-        package, name = module.split('.')
-        tree = ast.parse(_text(SRC / package / package / f'{name}.py'))
-        imported = {a.asname or a.name: n.module for n in ast.walk(tree)
-                    if isinstance(n, ast.ImportFrom) for a in n.names}
-        for call in ast.walk(tree):
-            if (isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
-                    and call.func.id == 'declare' and len(call.args) >= 2
-                    and isinstance(call.args[1], ast.Name)):
-                table = call.args[1].id
-                tables.append((imported.get(table, module), table))
-    return tables
+    return [table for entry in NODES if entry.node_class is not None
+            for table in tables_declared_in(entry.node_class.split(':')[0])]
 
 
 def reference_table_names() -> set[str]:

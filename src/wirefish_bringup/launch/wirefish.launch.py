@@ -46,7 +46,7 @@ def _nodes(context):
         actions.append(Node(
             package=spec.package, executable=spec.executable, name=spec.name,
             namespace=spec.namespace, arguments=list(spec.arguments),
-            parameters=[spec.params_file, dict(spec.parameters)],
+            parameters=[spec.params_file, spec.typed_parameters()],
             respawn=spec.restart.respawn, respawn_delay=spec.restart.delay_s,
             respawn_max_retries=spec.restart.max_restarts,
             on_exit=_shutdown_after_last_retry(spec) if spec.restart.required else None,

@@ -27,6 +27,7 @@ import re
 
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 from wirefish_common.frames import frame_prefix_problem
+import yaml
 
 DEFAULT_NAMESPACE = '/wirefish'
 PARAMS_FILE_NAME = 'wirefish.yaml'
@@ -212,6 +213,21 @@ class NodeSpec:
             return self.arguments
         return (*self.arguments, *ros_arguments(self.name, self.namespace, self.params_file,
                                                 self.parameters))
+
+    def typed_parameters(self) -> dict[str, bool | int | float | str]:
+        """Return ``parameters`` typed as ``-p key:=value`` reads them: for launch_ros's dict."""
+        return {key: parameter_value(text) for key, text in self.parameters.items()}
+
+
+def parameter_value(text: str) -> bool | int | float | str:
+    """
+    Return a registry value as rcl reads ``-p key:=text``: YAML (``false``: a bool).
+
+    launch_ros writes a ``parameters`` dict into YAML as it is, so the launch file must pass
+    these typed values: the string ``'false'`` would reach the node as a string.
+    """
+    value = yaml.safe_load(text) if text else text
+    return value if isinstance(value, (bool, int, float, str)) else text
 
 
 def ros_arguments(name: str, namespace: str, params_file: str | None,

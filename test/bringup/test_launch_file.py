@@ -1,0 +1,157 @@
+"""
+launch/wirefish.launch.py, checked without the launch packages (pure: stand-ins, no ROS).
+
+`launch` and `launch_ros` are not on PyPI, so stand-ins installed into ``sys.modules`` record
+what the launch file builds: every ``Node(...)`` and its parameters. Each value is checked
+against the type the node declares for it, since launch_ros writes a ``parameters`` dict into
+YAML as it is and a node refuses a string where it declares a bool (rclpy does not convert).
+"""
+
+from dataclasses import dataclass, field
+import importlib
+import importlib.util
+from pathlib import Path
+import sys
+import types
+
+from declared_parameters import declared_specs
+import pytest
+from wirefish_bringup.graph import entry
+from wirefish_common.frames import FRAME_PREFIX
+from wirefish_common.parameter_table import ParameterSpec
+
+LAUNCH_FILE = (Path(__file__).resolve().parents[2] / 'src' / 'wirefish_bringup' / 'launch'
+               / 'wirefish.launch.py')
+
+
+@dataclass
+class Recorded:
+    """What the stand-ins saw: every Node(...)'s keyword arguments, every declared argument."""
+
+    nodes: list[dict] = field(default_factory=list)
+    arguments: dict[str, str] = field(default_factory=dict)
+
+
+class _Context:
+    def __init__(self, values: dict[str, str]) -> None:
+        self.launch_configurations = values
+
+
+def _stand_ins(recorded: Recorded) -> dict[str, types.ModuleType]:
+    launch = types.ModuleType('launch')
+    actions = types.ModuleType('launch.actions')
+    substitutions = types.ModuleType('launch.substitutions')
+    launch_ros = types.ModuleType('launch_ros')
+    ros_actions = types.ModuleType('launch_ros.actions')
+
+    class LaunchDescription:
+        def __init__(self, entities):
+            self.entities = list(entities)
+
+    class DeclareLaunchArgument:
+        def __init__(self, name, default_value='', description='', choices=None):
+            assert description, f'launch argument {name} has no description'
+            recorded.arguments[name] = default_value
+            self.name, self.choices = name, choices
+
+    class OpaqueFunction:
+        def __init__(self, function):
+            self.function = function
+
+    class Shutdown:
+        def __init__(self, reason=''):
+            self.reason = reason
+
+    class LaunchConfiguration:
+        def __init__(self, name):
+            self.name = name
+
+        def perform(self, context):
+            return context.launch_configurations[self.name]
+
+    def node(**kwargs):
+        recorded.nodes.append(kwargs)
+        return kwargs
+
+    launch.LaunchDescription = LaunchDescription
+    actions.DeclareLaunchArgument = DeclareLaunchArgument
+    actions.OpaqueFunction = OpaqueFunction
+    actions.Shutdown = Shutdown
+    substitutions.LaunchConfiguration = LaunchConfiguration
+    ros_actions.Node = node
+    launch.actions, launch.substitutions, launch_ros.actions = actions, substitutions, ros_actions
+    return {'launch': launch, 'launch.actions': actions, 'launch.substitutions': substitutions,
+            'launch_ros': launch_ros, 'launch_ros.actions': ros_actions}
+
+
+def launched_nodes(monkeypatch, **overrides: str) -> list[dict]:
+    """Return the Node(...) keyword arguments of `ros2 launch ... key:=value ...`."""
+    recorded = Recorded()
+    for name, module in _stand_ins(recorded).items():
+        monkeypatch.setitem(sys.modules, name, module)
+    spec = importlib.util.spec_from_file_location('wirefish_launch_under_test', LAUNCH_FILE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    description = module.generate_launch_description()
+    unknown = set(overrides) - set(recorded.arguments)
+    assert not unknown, f'the launch file declares no {sorted(unknown)}'
+    context = _Context({**recorded.arguments, **overrides})
+    for entity in description.entities:
+        if hasattr(entity, 'function'):
+            entity.function(context)
+    return recorded.nodes
+
+
+def declared(node_name: str) -> dict[str, ParameterSpec]:
+    """Return every parameter node ``node_name`` declares, by name."""
+    specs = {s.name: s for s in declared_specs(entry(node_name))}
+    if entry(node_name).frames:
+        specs[FRAME_PREFIX] = ParameterSpec(FRAME_PREFIX, '', 'frame id prefix')
+    return specs
+
+
+def type_problems(node: dict) -> list[str]:
+    """Return each parameter of one Node(...) whose value is not of the declared type."""
+    problems = []
+    for values in node['parameters']:
+        if not isinstance(values, dict):
+            continue  # the parameter file: its values are typed by YAML itself
+        specs = declared(node['name'])
+        for key, value in values.items():
+            if key not in specs:
+                problems.append(f'{node["name"]}: {key} is not declared')
+            elif type(value) is not type(specs[key].default):
+                problems.append(f'{node["name"]}: {key} = {value!r} is a {type(value).__name__},'
+                                f' declared {type(specs[key].default).__name__}')
+    return problems
+
+
+LAUNCHES = {
+    'sim': {'sim': 'true', 'namespace': '/rt'},
+    'real fish': {'sim': 'false', 'port': '/dev/ttyUSB0'},
+    'fish role, prefixed': {'role': 'fish', 'frame_prefix': 'fish_1'},
+    'shore role': {'role': 'shore'},
+}
+
+
+def test_the_stand_ins_record_the_graph(monkeypatch):
+    names = [n['name'] for n in launched_nodes(monkeypatch, **LAUNCHES['sim'])]
+    assert {'fish_sim', 'bridge_node', 'cpg_node', 'planner_node', 'tuner_node'} <= set(names)
+
+
+@pytest.mark.parametrize('overrides', LAUNCHES.values(), ids=LAUNCHES.keys())
+def test_every_parameter_the_launch_file_passes_has_its_declared_type(monkeypatch, overrides):
+    nodes = launched_nodes(monkeypatch, **overrides)
+    problems = [p for node in nodes for p in type_problems(node)]
+    assert nodes and not problems, problems
+
+
+def test_a_string_where_a_bool_is_declared_is_found():
+    node = {'name': 'planner_node', 'parameters': ['wirefish.yaml', {'rest_at_start': 'false'}]}
+    assert type_problems(node) == [
+        "planner_node: rest_at_start = 'false' is a str, declared bool"]
+
+
+def test_a_parameter_no_node_declares_is_found():
+    node = {'name': 'cpg_node', 'parameters': [{'no_such_parameter': 1.0}]}
+    assert type_problems(node) == ['cpg_node: no_such_parameter is not declared']
