@@ -1,5 +1,5 @@
 """
-Recover the fish's unpublished geometry from the paper's indirect evidence (issue 16 item 3).
+Recover the fish's unpublished geometry from the paper's indirect evidence.
 
 ``python -m wirefish_analysis.identify_geometry --out config.yaml`` fits l1, l2, l3, r1, r2,
 R_D (= R_D1 = R_D2) and C_D, within physical bounds, to what the paper does state:
@@ -319,8 +319,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--template', type=Path, default=None,
                         help='parameter file to copy (default: the installed wirefish.yaml)')
     parser.add_argument('--seed', type=int, default=0, help='PSO seed')
-    parser.add_argument('--swarm', type=int, default=40)
-    parser.add_argument('--iterations', type=int, default=100)
+    parser.add_argument('--swarm', type=int, default=40, help='PSO particles per search')
+    parser.add_argument('--iterations', type=int, default=100,
+                        help='PSO iterations per search')
     parser.add_argument('--polish-iterations', type=int, default=2000,
                         help='Nelder-Mead iterations after the swarm')
     parser.add_argument('--starts', type=int, default=4, help='independent searches')

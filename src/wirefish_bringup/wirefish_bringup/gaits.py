@@ -38,9 +38,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from wirefish_cpg.gait_library import default_library_path
 
     actions = parser.add_subparsers(dest='gaits_command', required=True, metavar='ACTION')
-    build = actions.add_parser('build', help='fit a frequency x amplitude-scale grid')
-    listing = actions.add_parser('list', help='the library as a table with eq 18 speeds')
-    plot = actions.add_parser('plot', help='predicted speed over the family grid (PNG)')
+    helps = {'build': 'fit a frequency x amplitude-scale grid of gaits into the library',
+             'list': 'the library as a table with eq 18 speeds',
+             'plot': 'predicted speed over the family grid (PNG)'}
+    build, listing, plot = (actions.add_parser(name, help=text, description=text)
+                            for name, text in helps.items())
     for sub in (build, listing, plot):
         sub.add_argument('--library', type=Path, default=default_library_path(),
                          help='gait library file (default: %(default)s)')

@@ -25,7 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish mission`."""
     from wirefish_bringup.graph import DEFAULT_NAMESPACE
 
-    parser.add_argument('mission', help=f'mission YAML file, or a shipped one: {SHIPPED}')
+    parser.add_argument('mission',
+                        help=f'mission YAML file, or a shipped one: {", ".join(SHIPPED)}')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
     parser.add_argument('-o', '--output', type=Path, default=None,
                         help='directory for the bag and the PNG '
