@@ -1,4 +1,4 @@
-"""Geometry identification from the paper's indirect evidence (issue 16 item 3)."""
+"""Geometry identification from the paper's indirect evidence."""
 
 from pathlib import Path
 import subprocess

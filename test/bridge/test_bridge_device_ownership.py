@@ -1,5 +1,5 @@
 """
-A bridge writes only into the fish it was started for, and alone (issue 12, items 6 and 8).
+A bridge writes only into the fish it was started for, and alone.
 
 Across processes: bridge_node and fish_sim as their own processes on a real pty; the test
 plays an unrelated terminal (a pty pair it holds, that never sends a frame) where needed.

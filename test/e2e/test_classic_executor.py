@@ -1,5 +1,5 @@
 """
-One fish on the classic executor (WIREFISH_EXECUTOR=classic), the fallback of issue 15.
+One fish on the classic executor (WIREFISH_EXECUTOR=classic), the fallback executor.
 
 Every other test runs the graph on the default, the events executor; this one runs it the old
 way, one process per node and in one process, and checks that it still streams and stops

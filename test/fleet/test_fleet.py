@@ -1,5 +1,5 @@
 """
-Issue 17's fleet acceptance: `wirefish up --fleet 3` on one machine, recorded in one bag.
+The fleet's acceptance: `wirefish up --fleet 3` on one machine, recorded in one bag.
 
 Three virtual fish, each its whole graph in <base>/fish_<i>, one recorder of the base
 namespace. While they swim, one fish is retuned (`wirefish retune --apply --namespace

@@ -1,4 +1,4 @@
-"""kinematics_node publishes body_wave_markers with every n-th body_wave (issue 15)."""
+"""kinematics_node publishes body_wave_markers with every n-th body_wave."""
 
 import pytest
 

@@ -1,5 +1,5 @@
 """
-Issue 14's acceptance on the virtual fish, across processes, measured on sim/ground_truth.
+The planner's acceptance on the virtual fish, across processes, measured on sim/ground_truth.
 
 One graph (fish_sim with a constant yaw disturbance, bridge, CPG, planner) and one drive in
 phases, because each phase needs many seconds of swimming: rest before any cmd_vel; speed

@@ -1,5 +1,5 @@
 """
-Issue 17's acceptance across two hosts, a fish and a shore, over a radio that fails.
+Acceptance across two hosts, a fish and a shore, over a radio that fails.
 
 The fish role runs in one network namespace, the shore role in another, DDS over a veth pair
 between them (multicast discovery, UDPv4 only: see netns.py).

@@ -1,4 +1,4 @@
-"""BENCHMARKS.md rows of issue 13: the library's answer and `wirefish gaits build`."""
+"""BENCHMARKS.md rows of the gait library: its answer and `wirefish gaits build`."""
 
 import pytest
 from wirefish_analysis.bench_report import rows

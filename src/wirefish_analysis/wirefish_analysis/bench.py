@@ -22,7 +22,7 @@ import numpy as np
 WORKSPACE = Path(__file__).resolve().parents[3] if (
     Path(__file__).resolve().parents[3] / 'Makefile').is_file() else Path.cwd()
 DOMAIN = int(os.environ.get('WIREFISH_BENCH_DOMAIN', '101'))
-# Issue 15: every node benchmark runs on the old executor and the new one, side by side.
+# Every node benchmark runs on the old executor and the new one, side by side.
 EXECUTORS = ('classic', 'events')
 # The 1-fish rows (the onboard-CPU verdict) are the median of this many alternated runs.
 ONE_FISH_REPEATS = 3
@@ -124,14 +124,14 @@ def run_all(quick: bool = False) -> dict:
     try:
         from wirefish_analysis import bench_retune
         results['retune'] = _run('retune', bench_retune.run)
-        # Issue 13: the same wave again comes from the gait library; the default gait family.
+        # The same wave again comes from the gait library; the default gait family.
         results['retune_library'] = _run('retune answered from the library',
                                          bench_retune.library_answer, domain_id=DOMAIN)
         results['gaits_build'] = _run('wirefish gaits build', bench_retune.gaits_build)
     except ImportError as error:
         results['retune'] = {'error': f'not available: {error}'}
     from wirefish_analysis import bench_radio_link
-    # Issue 17: what crosses fish -> shore, two network namespaces (root only; else the reason).
+    # What crosses fish -> shore, two network namespaces (root only; else the reason).
     results['radio_link'] = _run('radio link', bench_radio_link.run, domain_id=DOMAIN)
     results['kinematics_cpu'] = [
         _run(f'kinematics {s} x {r} ({e})', bench_graph.kinematics_cpu, s, r, 10.0 * scale,

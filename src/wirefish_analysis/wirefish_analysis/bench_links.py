@@ -1,5 +1,5 @@
 """
-Latency of the bridge's two paths, over a real pty and real DDS (issue 7 benchmark; not a test).
+Latency of the bridge's two paths, over a real pty and real DDS (a benchmark, not a test).
 
 (a) command: ``servo_cmd`` published here -> the SERVO_CMD frame's bytes readable on the fish's
     side of the pty (this process plays the fish: it holds the pty master);

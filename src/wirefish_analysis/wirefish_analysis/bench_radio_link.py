@@ -1,5 +1,5 @@
 """
-Benchmark: bytes per second crossing the fish-shore radio link (issue 17), per discovery mode.
+Benchmark: bytes per second crossing the fish-shore radio link, per discovery mode.
 
 A fish host and a shore host in two network namespaces (``wirefish_bringup.netns``, root
 only), ``wirefish up --role fish`` on one and ``wirefish up --role shore --duration`` on the

@@ -23,7 +23,7 @@ def _verdict(measured, goal_ok) -> str:
     return 'met' if goal_ok else 'missed'
 
 
-# Issue 15: each node figure on the classic executor and the events executor, from one run.
+# Each node figure on the classic executor and the events executor, from one run.
 EXECUTORS = ('classic', 'events')
 FLEET_HOW = 'all streaming after {ready} s; then 3 s warm-up, 10 s window; psutil CPU'
 
@@ -192,7 +192,7 @@ def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
-LIBRARY_GOAL_S = 0.020  # issue 13: the same wave twice, the second from the library
+LIBRARY_GOAL_S = 0.020  # the same wave twice, the second from the library
 
 
 def _library_rows(results: dict) -> list[tuple[str, str, str, str, str]]:

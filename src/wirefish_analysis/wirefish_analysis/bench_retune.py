@@ -12,7 +12,7 @@ judged on one ruler. pyswarms draws from NumPy's global RNG, so the baseline see
 
 ``python -m wirefish_analysis.bench_retune`` prints the figures as JSON.
 
-Gait library rows (issue 13): ``library_answer`` times the same goal twice through a real
+Gait library rows: ``library_answer`` times the same goal twice through a real
 tuner_node process and its retune_gait action (the first fits, the rest come from the
 library), client round trip and the tuner's own figure; ``gaits_build`` times
 ``wirefish gaits build`` on its default grid.

@@ -1,5 +1,5 @@
 """
-What one ROS message, timer tick or publish costs a Python process here (issue 15; not a test).
+What one ROS message, timer tick or publish costs a Python process here (not a test).
 
 docs/PROFILING.md builds its cost model of a fish's graph from these figures: each probe is a
 process of its own on the events executor (the graph's default), measured with psutil over a

@@ -132,7 +132,7 @@ class BridgeNode(Node):
             self.destroy_timer(timer)
         # The command tick runs the failsafe (neutral within 50 ms of command_timeout_s) and
         # sends a held command that no newer one superseded. It no longer runs at the rate
-        # limit (100 wake-ups a second, issue 15): a held command leaves with the next one.
+        # limit (100 wake-ups a second): a held command leaves with the next one.
         self._bridge_timers = {
             'command': self.create_timer(1.0 / COMMAND_TICK_HZ, self._on_command_tick),
             'heartbeat': self.create_timer(1.0 / self._values['heartbeat_rate_hz'],

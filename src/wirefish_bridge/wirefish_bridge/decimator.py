@@ -2,7 +2,7 @@
 Publish a stream slower than its source, but a change of state at once (pure, no rclpy).
 
 The fish sends one TELEMETRY frame 100 times a second; its battery voltage changes over
-minutes, so ``battery`` at 100 Hz was 90 publishes a second that told nothing (issue 15: the
+minutes, so ``battery`` at 100 Hz was 90 publishes a second that told nothing (the
 serial thread's CPU is the publishes). A change of the low-battery flag still goes out with the
 frame that carried it.
 """

@@ -1,4 +1,4 @@
-"""Roles (fish / shore), the crossing table, frame prefixes and fleets (issue 17), pure."""
+"""Roles (fish / shore), the crossing table, frame prefixes and fleets, pure."""
 
 from pathlib import Path
 

@@ -1,5 +1,5 @@
 """
-A fleet: several fish on one machine, each in a namespace of its own (issue 17 item 4).
+A fleet: several fish on one machine, each in a namespace of its own.
 
 Fish ``i`` (1-based) of a fleet in ``base`` runs its whole graph (its own virtual fish, bridge,
 CPG, kinematics, planner and tuner) in ``<base>/fish_<i>`` with frame ids under ``fish_<i>``

@@ -1,5 +1,5 @@
 """
-`wirefish gaits`: build, list and plot the gait library (the tuner's YAML file, issue 13).
+`wirefish gaits`: build, list and plot the gait library (the tuner's YAML file).
 
 ``build`` fits a grid of waves, tail-beat frequency x amplitude scale of a reference wave (the
 paper's section 5.2 wave by default), on all cores (a process pool) with the tuner's default

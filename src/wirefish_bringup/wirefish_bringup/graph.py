@@ -6,7 +6,7 @@ single-process mode (`wirefish compose`), `launch/wirefish.launch.py`, the signa
 end-to-end tests (the streams and rates below). Adding a node is one ``NodeEntry`` here plus its
 package (its setup.py entry point and its YAML section).
 
-Restart policy (issue 12 item 10). A process of the graph that exits while the graph runs is
+Restart policy. A process of the graph that exits while the graph runs is
 restarted after ``delay_s``; each further restart within ``window_s`` waits ``backoff`` times
 longer (capped at ``max_delay_s``), so a crash loop slows down instead of spinning. The exit
 after ``max_restarts`` restarts within ``window_s`` spends the budget: the launcher reports the
@@ -36,7 +36,7 @@ _NAMESPACE_PATTERN = re.compile(r'^(/[A-Za-z][A-Za-z0-9_]*)+$|^/$')
 # When an entry is part of the graph: always, only with the virtual fish, only when recording,
 # only when the fish runs apart from its shore (role fish: the link relay, see crossing.py).
 ALWAYS, SIM, RECORD, APART = 'always', 'sim', 'record', 'apart'
-# Which side of the radio link an entry runs on (issue 17). The fish side is everything that
+# Which side of the radio link an entry runs on. The fish side is everything that
 # keeps the fish safe and swimming without shore; the shore side only tunes, records, drives.
 FISH, SHORE, ALL = 'fish', 'shore', 'all'
 ROLES = (FISH, SHORE, ALL)

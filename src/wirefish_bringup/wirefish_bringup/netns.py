@@ -1,5 +1,5 @@
 """
-Two hosts on one machine: two network namespaces joined by a veth pair (issue 17 item 2).
+Two hosts on one machine: two network namespaces joined by a veth pair.
 
 ``TwoHosts(token, subnet)`` names everything it creates with ``wf`` + ``token`` (the namespaces
 ``wf<token>f`` for the fish and ``wf<token>s`` for the shore, the veth ends ``wf<token>a`` and

@@ -1,5 +1,5 @@
 """
-Which rclpy executor spins a wirefish process, and the one loop that spins it (issue 15).
+Which rclpy executor spins a wirefish process, and the one loop that spins it.
 
 ``events`` (the default): ``rclpy.experimental.EventsExecutor``, the C++ events-based executor
 the pinned Jazzy wheel (rclpy 7.1.6) ships. A wake-up of rclpy's Python executors costs a few

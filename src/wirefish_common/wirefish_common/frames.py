@@ -1,5 +1,5 @@
 """
-Frame ids that carry the fish's name: the ``frame_prefix`` parameter (issue 17 item 4).
+Frame ids that carry the fish's name: the ``frame_prefix`` parameter.
 
 Several fish in one TF tree (a fleet, one RViz) need distinct frames: with ``frame_prefix``
 ``fish_1`` a node writes ``fish_1/base_link`` where a lone fish writes ``base_link`` (the

@@ -121,7 +121,7 @@ def test_invalid_waves_are_rejected(kwargs):
         WaveSpec(**kwargs)
 
 
-# --- the paper-literal mode (issue 16): v = the wave's frequency, eq 1 from rest, [t_s, t_o] ---
+# --- the paper-literal mode: v = the wave's frequency, eq 1 from rest, [t_s, t_o] ---
 
 def _eq1_from_rest_by_dop853(position, times, frequency_hz, alpha=20.0):
     """Integrate the six states of eq 1 from rest with scipy; return Theta (T, 2) at times."""
