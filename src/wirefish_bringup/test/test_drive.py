@@ -4,7 +4,7 @@ import math
 from types import SimpleNamespace
 
 import pytest
-from wirefish_bringup.drive import DriveLimits, key_action, split_keys, state_line
+from wirefish_bringup.drive import DriveLimits, key_action, KeyDecoder, state_line
 
 LIMITS = DriveLimits(speed_step=0.05, max_speed=0.1, turn_step=0.1, max_turn=0.2)
 
@@ -12,7 +12,7 @@ LIMITS = DriveLimits(speed_step=0.05, max_speed=0.1, turn_step=0.1, max_turn=0.2
 @pytest.mark.parametrize('key, expected', [
     ('w', (0.1, 0.0)), ('\x1b[A', (0.1, 0.0)), ('s', (0.0, 0.0)), ('\x1b[B', (0.0, 0.0)),
     ('a', (0.05, 0.1)), ('\x1b[D', (0.05, 0.1)), ('d', (0.05, -0.1)), ('\x1b[C', (0.05, -0.1)),
-    (' ', (0.0, 0.0)), ('x', (0.05, 0.0)),
+    ('\x1bOA', (0.1, 0.0)), ('\x1bOD', (0.05, 0.1)), (' ', (0.0, 0.0)), ('x', (0.05, 0.0)),
 ])
 def test_keys_change_speed_and_turn(key, expected):
     assert key_action(key, 0.05, 0.0, LIMITS) == pytest.approx(expected)
@@ -30,7 +30,30 @@ def test_quit(key):
 
 
 def test_an_arrow_sequence_is_one_key():
-    assert split_keys('w\x1b[Aa ') == ['w', '\x1b[A', 'a', ' ']
+    assert KeyDecoder().feed(b'w\x1b[Aa ') == ['w', '\x1b[A', 'a', ' ']
+
+
+# Arrow keys, each cut between two reads at every place it can be cut.
+SPLITS = [(b'\x1b', b'[A'), (b'\x1b[', b'A'), (b'w\x1b', b'[D'), (b'\x1bO', b'C'),
+          (b'\x1b[1;', b'5B')]
+
+
+@pytest.mark.parametrize('first, second', SPLITS)
+def test_a_sequence_cut_between_reads_is_one_key_when_whole(first, second):
+    decoder = KeyDecoder()
+    before = decoder.feed(first)
+    assert [k for k in before if k.startswith('\x1b')] == []
+    assert before + decoder.feed(second) == [*(['w'] if first.startswith(b'w') else []),
+                                             (first + second).decode().lstrip('w')]
+
+
+def test_a_lone_escape_does_not_swallow_the_next_key():
+    assert KeyDecoder().feed(b'\x1bw') == ['\x1b', 'w']
+
+
+def test_a_multibyte_character_cut_between_reads_is_one_key():
+    decoder = KeyDecoder()
+    assert decoder.feed('é'.encode()[:1]) == [] and decoder.feed('é'.encode()[1:]) == ['é']
 
 
 def test_status_line_shows_the_planner_state_and_why_it_clamps():

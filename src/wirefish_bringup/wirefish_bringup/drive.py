@@ -12,12 +12,16 @@ same job.
 from __future__ import annotations
 
 import argparse
+import codecs
 from dataclasses import dataclass
 import math
+import os
 import sys
 
 PUBLISH_HZ = 10.0
-ARROWS = {'\x1b[A': 'w', '\x1b[B': 's', '\x1b[D': 'a', '\x1b[C': 'd'}
+ESC = '\x1b'
+ARROWS = {f'{prefix}{final}': key for prefix in ('\x1b[', '\x1bO')
+          for final, key in (('A', 'w'), ('B', 's'), ('D', 'a'), ('C', 'd'))}
 
 
 @dataclass(frozen=True)
@@ -49,17 +53,52 @@ def key_action(key: str, speed: float, turn: float, limits: DriveLimits
     return round(speed, 6), round(turn, 6)
 
 
-def split_keys(data: str) -> list[str]:
-    """Return the keys in ``data``: an arrow's escape sequence counts as one key."""
-    keys, i = [], 0
-    while i < len(data):
-        if data.startswith('\x1b[', i) and i + 2 < len(data):
-            keys.append(data[i:i + 3])
-            i += 3
-        else:
-            keys.append(data[i])
-            i += 1
-    return keys
+class KeyDecoder:
+    """
+    Keys from the terminal's bytes as they arrive: an arrow's escape sequence counts as one key.
+
+    ``feed`` takes whatever one read returned and gives back the keys it completes; a sequence
+    cut between two reads (``ESC`` now, ``[A`` next) is kept until its last byte comes, so
+    it acts once, whole, and never as its tail's letters (``A`` would be a turn).
+    """
+
+    def __init__(self) -> None:
+        """Start with nothing pending."""
+        self._text = codecs.getincrementaldecoder('utf-8')(errors='replace')
+        self._pending = ''
+
+    def feed(self, data: bytes) -> list[str]:
+        """Return the keys ``data`` completes (CSI ``ESC [ ... final``, SS3 ``ESC O x``)."""
+        text = self._pending + self._text.decode(data)
+        keys, i = [], 0
+        while i < len(text):
+            if text[i] != ESC:
+                keys.append(text[i])
+                i += 1
+                continue
+            end = _sequence_end(text, i)
+            if end is None:  # cut by the read: the rest comes with the next one
+                break
+            keys.append(text[i:end])
+            i = end
+        self._pending = text[i:]
+        return keys
+
+
+
+def _sequence_end(text: str, start: int) -> int | None:
+    """Return the end of the escape sequence at ``start``, or None if ``text`` cuts it."""
+    if start + 1 >= len(text):
+        return None
+    introducer = text[start + 1]
+    if introducer == 'O':  # SS3: ESC O A (arrows in the terminal's application mode)
+        return start + 3 if start + 2 < len(text) else None
+    if introducer != '[':
+        return start + 1  # a lone ESC key, then an ordinary one
+    for end in range(start + 2, len(text)):
+        if '\x40' <= text[end] <= '\x7e':  # CSI's final byte (parameters come before it)
+            return end + 1
+    return None
 
 
 def state_line(speed: float, turn: float, state) -> str:
@@ -113,15 +152,19 @@ def run(args: argparse.Namespace) -> int:
         return 2
     limits = DriveLimits(*values)
     link = _Link(namespace)
-    saved = termios.tcgetattr(sys.stdin)
+    fd = sys.stdin.fileno()
+    decoder = KeyDecoder()
+    saved = termios.tcgetattr(fd)
     speed, turn = 0.0, 0.0
     print(__doc__.strip().split('\n\n')[1].replace('\n', ' '))
     try:
-        tty.setcbreak(sys.stdin.fileno())
+        tty.setcbreak(fd)
         while link.ok():
-            ready, _, _ = select.select([sys.stdin], [], [], 1.0 / PUBLISH_HZ)
+            ready, _, _ = select.select([fd], [], [], 1.0 / PUBLISH_HZ)
             if ready:
-                for key in split_keys(sys.stdin.read(1) + _pending(sys.stdin)):
+                # The fd, not sys.stdin: the text stream would buffer an arrow's tail where
+                # select no longer sees it.
+                for key in decoder.feed(os.read(fd, 1024)):
                     result = key_action(key, speed, turn, limits)
                     if result is None:
                         return 0
@@ -132,20 +175,10 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        termios.tcsetattr(sys.stdin, termios.TCSADRAIN, saved)
+        termios.tcsetattr(fd, termios.TCSADRAIN, saved)
         link.close()
         print()
     return 0
-
-
-def _pending(stream) -> str:
-    """Return what else is waiting on ``stream`` (the rest of an arrow's escape sequence)."""
-    import select
-
-    data = ''
-    while select.select([stream], [], [], 0.0)[0]:
-        data += stream.read(1)
-    return data
 
 
 class _Link:
