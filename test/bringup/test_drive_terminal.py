@@ -57,8 +57,8 @@ def terminal():
 
 
 @pytest.mark.ros
-def test_arrow_keys_cut_across_reads_act_at_once_on_their_axis(cmd_vel, terminal, spawn,
-                                                                tmp_path):
+def test_arrow_keys_cut_across_reads_act_at_once_on_their_axis(
+        cmd_vel, terminal, spawn, tmp_path):
     executor, received = cmd_vel
     master, slave = terminal
     log = (tmp_path / 'drive.log').open('w')

@@ -85,7 +85,6 @@ class KeyDecoder:
         return keys
 
 
-
 def _sequence_end(text: str, start: int) -> int | None:
     """Return the end of the escape sequence at ``start``, or None if ``text`` cuts it."""
     if start + 1 >= len(text):
