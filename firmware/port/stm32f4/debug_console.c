@@ -1,0 +1,77 @@
+/* The QEMU build's debug console on USART2 (see debug_console.h). */
+#include "debug_console.h"
+
+#if WF_PORT_QEMU
+#include "board.h"
+#include "pwm.h"
+#include "regs.h"
+#include "ring.h"
+#include "wf/hal.h"
+
+RING_DEFINE(debug_ring, 2048);
+static uint32_t last_config_ms;
+
+void debug_console_init(void)
+{
+    RCC_APB1ENR |= RCC_APB1ENR_USART2;
+    USART_BRR(USART2_BASE) = (BOARD_APB1_HZ + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
+    USART_CR1(USART2_BASE) = USART_CR1_UE | USART_CR1_TE;
+}
+
+static void put_number(int32_t value)
+{
+    char digits[11];
+    unsigned count = 0u;
+    uint32_t magnitude = value < 0 ? 0u - (uint32_t)value : (uint32_t)value;
+    if (value < 0) {
+        (void)ring_put(&debug_ring, '-');
+    }
+    do {
+        digits[count++] = (char)('0' + magnitude % 10u);
+        magnitude /= 10u;
+    } while (magnitude != 0u);
+    while (count > 0u) {
+        (void)ring_put(&debug_ring, (uint8_t)digits[--count]);
+    }
+}
+
+/* Called from the main loop and from the USART1 interrupt: the line is written with
+ * interrupts masked, so the ring keeps a single producer at a time. A full ring drops whole
+ * lines only (the tests count what they read, a cut line would be misread). */
+void debug_console_event(char tag, uint32_t a, int32_t b, int32_t c, int fields)
+{
+    uint32_t primask = board_irq_save();
+    if (debug_ring.mask + 1u - ring_used(&debug_ring) >= 40u) {
+        (void)ring_put(&debug_ring, (uint8_t)tag);
+        (void)ring_put(&debug_ring, ' ');
+        put_number((int32_t)a);
+        if (fields > 1) {
+            (void)ring_put(&debug_ring, ' ');
+            put_number(b);
+        }
+        if (fields > 2) {
+            (void)ring_put(&debug_ring, ' ');
+            put_number(c);
+        }
+        (void)ring_put(&debug_ring, '\n');
+    }
+    board_irq_restore(primask);
+}
+
+/* QEMU 7.2's USART has no TXE interrupt (see uart.c): the main loop sends the lines. */
+void debug_console_poll(void)
+{
+    uint32_t now = wf_hal_millis();
+    if (now - last_config_ms >= 1000u) {
+        last_config_ms = now;
+        debug_console_event('C', wf_hal_pwm_ticks_per_us(), (int32_t)board_pwm_period(), 0, 2);
+    }
+    uint8_t byte;
+    while (ring_get(&debug_ring, &byte)) {
+        while (!(USART_SR(USART2_BASE) & USART_SR_TXE)) {
+        }
+        USART_DR(USART2_BASE) = byte;
+    }
+}
+
+#endif /* WF_PORT_QEMU */

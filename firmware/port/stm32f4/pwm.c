@@ -1,0 +1,64 @@
+/*
+ * Servo PWM on TIM3 (RM0090 18): channel 1 = servo 0 on PC6, channel 2 = servo 1 on PC7
+ * (AF2). The timer counts at 1 MHz (PSC 83 from the 84 MHz APB1 timer clock), so a compare
+ * value is a pulse width in microseconds and the period is 1e6 / frame_hz ticks: 20000 at
+ * 50 Hz, 3003 at 333 Hz (a 16-bit ARR holds both). PWM mode 1 with preload: a new compare
+ * takes effect at the next period, so a pulse is never cut short.
+ */
+#include "debug_console.h"
+#include "gpio.h"
+#include "board.h"
+#include "pwm.h"
+#include "regs.h"
+#include "wf/hal.h"
+
+enum { PWM_TICK_HZ = 1000000, PWM_MIN_HZ = 50, PWM_MAX_HZ = 333 };
+
+static uint32_t period_ticks;
+
+uint32_t board_pwm_period(void)
+{
+    return period_ticks;
+}
+
+uint32_t wf_hal_pwm_ticks_per_us(void)
+{
+    return PWM_TICK_HZ / 1000000u;
+}
+
+bool wf_hal_pwm_init(uint32_t frame_hz)
+{
+    if (frame_hz < PWM_MIN_HZ || frame_hz > PWM_MAX_HZ) {
+        return false;
+    }
+    RCC_APB1ENR |= RCC_APB1ENR_TIM3;
+    gpio_alternate(GPIOC_BASE, 6u, 2u, 0);
+    gpio_alternate(GPIOC_BASE, 7u, 2u, 0);
+    period_ticks = PWM_TICK_HZ / frame_hz;
+    TIM_CR1(TIM3_BASE) = 0u;
+    TIM_PSC(TIM3_BASE) = BOARD_APB1_TIMER_HZ / PWM_TICK_HZ - 1u;
+    TIM_ARR(TIM3_BASE) = period_ticks - 1u;
+    TIM_CCMR1(TIM3_BASE) = TIM_CCMR1_OC1M_PWM1 | TIM_CCMR1_OC1PE | TIM_CCMR1_OC2M_PWM1
+                           | TIM_CCMR1_OC2PE;
+    TIM_CCER(TIM3_BASE) = TIM_CCER_CC1E | TIM_CCER_CC2E;
+    TIM_EGR(TIM3_BASE) = TIM_EGR_UG;   /* load PSC and ARR now */
+    TIM_CR1(TIM3_BASE) = TIM_CR1_ARPE | TIM_CR1_CEN;
+    return true;
+}
+
+void wf_hal_pwm_set_compare(unsigned servo, uint32_t compare_ticks)
+{
+    volatile uint32_t *ccr = servo == 0u ? &TIM_CCR1(TIM3_BASE) : &TIM_CCR2(TIM3_BASE);
+    if (servo >= WF_SERVO_COUNT) {
+        return;
+    }
+    if (compare_ticks > period_ticks) {
+        compare_ticks = period_ticks;   /* a compare beyond the period is a constant high */
+    }
+    uint32_t before = *ccr;
+    *ccr = compare_ticks;
+    uint32_t now = *ccr;   /* what the timer holds: the test reads this value back */
+    if (now != before) {
+        debug_console_event('P', wf_hal_millis(), (int32_t)servo, (int32_t)now, 3);
+    }
+}

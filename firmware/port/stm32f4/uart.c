@@ -1,0 +1,86 @@
+/*
+ * USART1, the link to the host (115200 8N1, RM0090 30.6), interrupt driven: the RX interrupt
+ * fills rx_ring, the main loop empties it (wf_hal_uart_read); the main loop fills tx_ring
+ * (wf_hal_uart_write) and the TXE interrupt empties it. Each ring has one producer and one
+ * consumer (ring.h). Pins on the real board: PA9 TX, PA10 RX (AF7), the pins of the system
+ * bootloader's USART1, so the radio that carries the link can also reflash the board.
+ */
+#include "board.h"
+#include "debug_console.h"
+#include "gpio.h"
+#include "regs.h"
+#include "ring.h"
+#include "wf/hal.h"
+
+RING_DEFINE(rx_ring, 256);
+RING_DEFINE(tx_ring, 512);
+static volatile uint32_t rx_overflows;   /* bytes lost: rx_ring full (the core was late) */
+
+void board_uart_init(void)
+{
+    RCC_APB2ENR |= RCC_APB2ENR_USART1;
+    gpio_alternate(GPIOA_BASE, 9u, 7u, 0);
+    gpio_alternate(GPIOA_BASE, 10u, 7u, 0);
+    USART_BRR(USART1_BASE) = (BOARD_APB2_HZ + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
+    USART_CR2(USART1_BASE) = 0u;
+    USART_CR3(USART1_BASE) = 0u;
+    USART_CR1(USART1_BASE) = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE;
+    NVIC_ISER(USART1_IRQN / 32u) = 1u << (USART1_IRQN % 32u);
+}
+
+void wf_usart1_handler(void)
+{
+    uint32_t status = USART_SR(USART1_BASE);
+    if (status & (USART_SR_RXNE | USART_SR_ORE)) {
+        uint8_t byte = (uint8_t)USART_DR(USART1_BASE);   /* the read clears RXNE and ORE */
+        if (!ring_put(&rx_ring, byte)) {
+            rx_overflows = rx_overflows + 1u;
+        }
+        if (byte == 0u) {
+            debug_console_event('Z', wf_hal_millis(), 0, 0, 1);
+        }
+    }
+    if ((USART_CR1(USART1_BASE) & USART_CR1_TXEIE) && (status & USART_SR_TXE)) {
+        uint8_t byte;
+        if (ring_get(&tx_ring, &byte)) {
+            USART_DR(USART1_BASE) = byte;
+        } else {
+            USART_CR1(USART1_BASE) &= ~USART_CR1_TXEIE;   /* nothing left: stop asking */
+        }
+    }
+}
+
+size_t wf_hal_uart_read(uint8_t *buf, size_t max)
+{
+    size_t count = 0u;
+    while (count < max && ring_get(&rx_ring, &buf[count])) {
+        count++;
+    }
+    return count;
+}
+
+size_t wf_hal_uart_write(const uint8_t *buf, size_t len)
+{
+    size_t count = 0u;
+    while (count < len && ring_put(&tx_ring, buf[count])) {
+        count++;
+    }
+#if WF_PORT_QEMU
+    /* QEMU 7.2's USART raises its interrupt for RXNE only, never for TXE, and sends each DR
+     * write at once: the main loop is the ring's consumer here. */
+    uint8_t byte;
+    while (ring_get(&tx_ring, &byte)) {
+        while (!(USART_SR(USART1_BASE) & USART_SR_TXE)) {
+        }
+        USART_DR(USART1_BASE) = byte;
+    }
+#else
+    if (count > 0u) {
+        /* CR1 is also written by the interrupt handler: change it with interrupts masked. */
+        uint32_t primask = board_irq_save();
+        USART_CR1(USART1_BASE) |= USART_CR1_TXEIE;
+        board_irq_restore(primask);
+    }
+#endif
+    return count;
+}
