@@ -16,7 +16,8 @@ LAUNCH_FILE = Path(__file__).resolve().parents[1] / 'launch' / 'wirefish.launch.
 def test_the_virtual_fish_starts_first_and_the_bridge_opens_its_link():
     specs = fish_graph('/tank/fish_1', sim=True, params_file='p.yaml')
     assert [s.executable for s in specs] == [
-        'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'planner_node', 'tuner_node']
+        'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'tf_node', 'planner_node',
+        'tuner_node']
     link = str(sim_tty_link('/tank/fish_1'))
     assert specs[0].command_arguments()[:3] == ('--link', link, '--ros')
     assert specs[0].link == Path(link)

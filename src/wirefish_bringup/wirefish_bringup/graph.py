@@ -162,6 +162,9 @@ NODES: tuple[NodeEntry, ...] = (
               node_class='wirefish_kinematics.kinematics_node:KinematicsNode', frames=True,
               rates_hz={'body_wave': 50.0, 'body_wave_markers': 10.0},
               min_rates_hz={'speed_estimate': 0.5}, fed_by=('cpg_node',)),
+    # The TF tree (/tf, /tf_static): odom -> base_link, the mounts and the tail's frames.
+    NodeEntry('wirefish_tf', 'tf_node', 'tf_node', start_order=32,
+              node_class='wirefish_tf.tf_node:TfNode', frames=True),
     # rest_at_start false: cpg_node keeps the default gait until the first cmd_vel (the graph's
     # other users expect it); the cmd_vel timeout still rests the fish when commands stop.
     NodeEntry('wirefish_planner', 'planner_node', 'planner_node', start_order=35,

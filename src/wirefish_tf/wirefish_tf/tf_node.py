@@ -1,0 +1,188 @@
+"""
+tf_node: the fish's TF tree (REP-105) on ``/tf`` and ``/tf_static``; frames in ``frames``.
+
+Subscribes
+    ``body_wave`` (wirefish_msgs/BodyWave, sensor data): its bend angles place the moving tail
+    frames (``tail_plate_ii``, ``tail_plate_iii``, ``caudal_fin`` in ``tail_base``), stamped
+    as the body wave, at its rate.
+    ``sim/ground_truth`` (nav_msgs/Odometry, reliable): the virtual fish's pose, published as
+    ``odom`` -> ``base_link`` unchanged (same stamp).
+    ``imu/data`` (sensor_msgs/Imu, sensor data) and ``speed_estimate``
+    (wirefish_msgs/SpeedEstimate, reliable): the real fish's odometry, dead-reckoned
+    (``frames.dead_reckoned``: the speed estimate along the IMU yaw, drifting as dead reckoning
+    does), at most ``odom_rate_hz``.
+Publishes
+    ``/tf`` (tf2_msgs/TFMessage, reliable depth 100, as tf2's broadcaster) and ``/tf_static``
+    (reliable, transient local: ``base_link`` -> ``imu_link``, ``base_link`` -> ``tail_base``,
+    again whenever the geometry changes).
+Parameters: ``odom_source`` (``auto``: ground truth once sim/ground_truth is heard, dead
+reckoning until then; ``ground_truth``; ``dead_reckoning``), ``odom_rate_hz``, ``imu_x``,
+``imu_y``, ``imu_z`` (the IMU in base_link, m), the geometry (l1, l2, l3, body_length: the
+graph's ``/**`` block) and ``frame_prefix``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from builtin_interfaces.msg import Time
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import Imu
+from tf2_msgs.msg import TFMessage
+from wirefish_common.frames import declare_frame_prefix, prefixed
+from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_kinematics.geometry import FishGeometry
+from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
+from wirefish_msgs.msg import BodyWave, SpeedEstimate
+from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, quaternion_yaw,
+                                tail_base_in_base_link, tail_frames)
+from wirefish_tf.tf_messages import tf_message, transform
+
+# tf2_ros's TransformBroadcaster and StaticTransformBroadcaster profiles.
+TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+TF_STATIC_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
+GEOMETRY_NAMES = ('l1', 'l2', 'l3', 'body_length')
+TF_PARAMETERS = geometry_parameters(GEOMETRY_NAMES) + (
+    ParameterSpec('odom_source', OdomSource.AUTO.value,
+                  'Source of odom -> base_link: auto (ground truth once sim/ground_truth is '
+                  'heard, else dead reckoning), ground_truth, dead_reckoning'),
+    ParameterSpec('odom_rate_hz', 50.0, 'Most dead-reckoned odom -> base_link a second (Hz)',
+                  0.0, 1000.0, low_exclusive=True),
+    ParameterSpec('imu_x', -0.12, 'IMU position in base_link, x (m); estimate', -2.0, 2.0),
+    ParameterSpec('imu_y', 0.0, 'IMU position in base_link, y (m); estimate', -1.0, 1.0),
+    ParameterSpec('imu_z', 0.0, 'IMU position in base_link, z (m); estimate', -1.0, 1.0),
+)
+SPECS = {spec.name: spec for spec in TF_PARAMETERS}
+
+
+def _consistent(values: dict[str, object]) -> FishGeometry:
+    """Return the geometry of ``values``; raise ValueError for an unknown ``odom_source``."""
+    source = values.get('odom_source', OdomSource.AUTO.value)
+    if source not in {s.value for s in OdomSource}:
+        raise ValueError(f'odom_source must be one of {", ".join(s.value for s in OdomSource)},'
+                         f' got {source!r}')
+    return geometry_from(values, GEOMETRY_NAMES)
+
+
+def _seconds(stamp: Time) -> float:
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+class TfNode(Node):
+    """Publishes the fish's frames: odometry, the static mounts and the moving tail."""
+
+    def __init__(self, **kwargs) -> None:
+        """Declare the parameters; wire /tf, /tf_static and the subscriptions."""
+        super().__init__('tf_node', **kwargs)
+        declare(self, TF_PARAMETERS, _consistent)
+        prefix = declare_frame_prefix(self)
+        self._frame = {frame: prefixed(prefix, frame.value) for frame in Frame}
+        self._values = {s.name: self.get_parameter(s.name).value for s in TF_PARAMETERS}
+        self._geometry = geometry_from(self._values, GEOMETRY_NAMES)
+        self._source = OdomSource(self._values['odom_source'])
+        self._heard_ground_truth = False
+        self._pose = PlanarPose(0.0, 0.0, 0.0)
+        self._yaw: float | None = None
+        self._speed = 0.0
+        self._last_imu_s: float | None = None
+        self._last_odom_s = -math.inf
+        self._tf_pub = self.create_publisher(TFMessage, '/tf', TF_QOS)
+        self._static_pub = self.create_publisher(TFMessage, '/tf_static', TF_STATIC_QOS)
+        self.create_subscription(BodyWave, 'body_wave', self._on_body_wave, SENSOR_DATA)
+        self.create_subscription(Odometry, 'sim/ground_truth', self._on_ground_truth, RELIABLE)
+        self.create_subscription(Imu, 'imu/data', self._on_imu, SENSOR_DATA)
+        self.create_subscription(SpeedEstimate, 'speed_estimate', self._on_speed, RELIABLE)
+        self.add_on_set_parameters_callback(self._validate)
+        self.add_post_set_parameters_callback(self._apply)
+        self._publish_static()
+
+    # --- parameters -----------------------------------------------------------------------
+    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
+        return validate_update(SPECS, self._values, parameters, _consistent)
+
+    def _apply(self, parameters: list[Parameter]) -> None:
+        names = {p.name for p in parameters if p.name in SPECS}
+        for name in names:
+            self._values[name] = self.get_parameter(name).value
+        self._geometry = geometry_from(self._values, GEOMETRY_NAMES)
+        self._source = OdomSource(self._values['odom_source'])
+        if names & {*GEOMETRY_NAMES, 'imu_x', 'imu_y', 'imu_z'}:
+            self._publish_static()
+
+    # --- static mounts --------------------------------------------------------------------
+    def _publish_static(self) -> None:
+        stamp = self.get_clock().now().to_msg()
+        base = self._frame[Frame.BASE_LINK]
+        imu = PlanarPose(self._values['imu_x'], self._values['imu_y'], 0.0,
+                         self._values['imu_z'])
+        self._static_pub.publish(tf_message([
+            transform(base, self._frame[Frame.IMU_LINK], imu, stamp),
+            transform(base, self._frame[Frame.TAIL_BASE],
+                      tail_base_in_base_link(self._geometry), stamp)]))
+
+    # --- the moving tail ------------------------------------------------------------------
+    def _on_body_wave(self, msg: BodyWave) -> None:
+        if not (math.isfinite(msg.beta1) and math.isfinite(msg.beta2)):
+            return  # the kinematics never sends these; nothing to place
+        parent = self._frame[Frame.TAIL_BASE]
+        poses = tail_frames(msg.beta1, msg.beta2, self._geometry)
+        self._tf_pub.publish(tf_message([
+            transform(parent, self._frame[frame], pose, msg.header.stamp)
+            for frame, pose in poses.items()]))
+
+    # --- odometry -------------------------------------------------------------------------
+    def _on_ground_truth(self, msg: Odometry) -> None:
+        if self._source is OdomSource.DEAD_RECKONING:
+            return
+        if not self._heard_ground_truth:
+            self._heard_ground_truth = True
+            if self._source is OdomSource.AUTO:
+                self.get_logger().info('odom -> base_link from sim/ground_truth (virtual fish)')
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        values = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
+        if not all(math.isfinite(v) for v in values):
+            return
+        out = transform(self._frame[Frame.ODOM], self._frame[Frame.BASE_LINK],
+                        PlanarPose(p.x, p.y, 0.0, p.z), msg.header.stamp)
+        out.transform.rotation = q  # the simulated attitude as published
+        self._tf_pub.publish(tf_message([out]))
+
+    def _dead_reckoning(self) -> bool:
+        return (self._source is OdomSource.DEAD_RECKONING
+                or (self._source is OdomSource.AUTO and not self._heard_ground_truth))
+
+    def _on_speed(self, msg: SpeedEstimate) -> None:
+        if math.isfinite(msg.speed) and msg.speed >= 0.0:
+            self._speed = msg.speed
+
+    def _on_imu(self, msg: Imu) -> None:
+        if not self._dead_reckoning():
+            return
+        q = msg.orientation
+        if not all(math.isfinite(v) for v in (q.x, q.y, q.z, q.w)) or (
+                q.x == q.y == q.z == q.w == 0.0):
+            return
+        now_s = _seconds(msg.header.stamp)
+        yaw = quaternion_yaw(q.x, q.y, q.z, q.w)  # imu_link is aligned with base_link
+        if self._last_imu_s is not None and self._yaw is not None and now_s > self._last_imu_s:
+            self._pose = dead_reckoned(self._pose, self._yaw, self._speed,
+                                       now_s - self._last_imu_s)
+        self._pose = PlanarPose(self._pose.x, self._pose.y, yaw)
+        self._last_imu_s, self._yaw = now_s, yaw
+        if now_s - self._last_odom_s >= 1.0 / self._values['odom_rate_hz']:
+            self._last_odom_s = now_s
+            self._tf_pub.publish(tf_message([transform(
+                self._frame[Frame.ODOM], self._frame[Frame.BASE_LINK], self._pose,
+                msg.header.stamp)]))
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the TF node until shutdown."""
+    run_node(TfNode, args)
