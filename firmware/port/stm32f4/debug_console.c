@@ -10,9 +10,11 @@
 
 RING_DEFINE(debug_ring, 2048);
 static uint32_t last_config_ms;
+static const wf_config_t *config;
 
-void debug_console_init(void)
+void debug_console_init(const wf_config_t *board_config)
 {
+    config = board_config;
     RCC_APB1ENR |= RCC_APB1ENR_USART2;
     USART_BRR(USART2_BASE) = (BOARD_APB1_HZ + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
     USART_CR1(USART2_BASE) = USART_CR1_UE | USART_CR1_TE;
@@ -38,20 +40,14 @@ static void put_number(int32_t value)
 /* Called from the main loop and from the USART1 interrupt: the line is written with
  * interrupts masked, so the ring keeps a single producer at a time. A full ring drops whole
  * lines only (the tests count what they read, a cut line would be misread). */
-void debug_console_event(char tag, uint32_t a, int32_t b, int32_t c, int fields)
+void debug_console_line(char tag, const int32_t *values, unsigned count)
 {
     uint32_t primask = board_irq_save();
-    if (debug_ring.mask + 1u - ring_used(&debug_ring) >= 40u) {
+    if (debug_ring.mask + 1u - ring_used(&debug_ring) >= 2u + 12u * count) {
         (void)ring_put(&debug_ring, (uint8_t)tag);
-        (void)ring_put(&debug_ring, ' ');
-        put_number((int32_t)a);
-        if (fields > 1) {
+        for (unsigned i = 0u; i < count; i++) {
             (void)ring_put(&debug_ring, ' ');
-            put_number(b);
-        }
-        if (fields > 2) {
-            (void)ring_put(&debug_ring, ' ');
-            put_number(c);
+            put_number(values[i]);
         }
         (void)ring_put(&debug_ring, '\n');
     }
@@ -64,7 +60,17 @@ void debug_console_poll(void)
     uint32_t now = wf_hal_millis();
     if (now - last_config_ms >= 1000u) {
         last_config_ms = now;
-        debug_console_event('C', wf_hal_pwm_ticks_per_us(), (int32_t)board_pwm_period(), 0, 2);
+        const int32_t timer[2] = {(int32_t)wf_hal_pwm_ticks_per_us(),
+                                  (int32_t)board_pwm_period()};
+        debug_console_line('C', timer, 2u);
+        for (unsigned i = 0u; i < WF_SERVO_COUNT; i++) {
+            const wf_servo_cal_t *cal = &config->servo_cal[i];
+            const int32_t servo[5] = {(int32_t)i, (int32_t)(cal->neutral_us * 1000.0f + 0.5f),
+                                      (int32_t)(cal->us_per_rad * 1000.0f + 0.5f),
+                                      cal->direction,
+                                      (int32_t)(config->servo_limit_rad * 1e6f + 0.5f)};
+            debug_console_line('K', servo, 5u);
+        }
     }
     uint8_t byte;
     while (ring_get(&debug_ring, &byte)) {

@@ -4,6 +4,8 @@
  *   "Z <ms>"              a 0x00 byte (frame delimiter) arrived on USART1, board time
  *   "P <ms> <ch> <ticks>" servo channel ch's compare register changed; the value read back
  *   "C <ticks_per_us> <period_ticks>" the PWM timer's set-up, once a second
+ *   "K <servo> <neutral_ns> <ns_per_rad> <direction> <limit_urad>" the servo calibration
+ *                         (pulse widths in ns, the limit in microradians), once a second
  * Every build but the QEMU one compiles the calls away.
  */
 #ifndef WF_STM32F4_DEBUG_CONSOLE_H
@@ -11,15 +13,20 @@
 
 #include <stdint.h>
 
+#include "wf/app_state.h"
+
 #if WF_PORT_QEMU
-void debug_console_init(void);
-void debug_console_event(char tag, uint32_t a, int32_t b, int32_t c, int fields);
+void debug_console_init(const wf_config_t *config);
+void debug_console_line(char tag, const int32_t *values, unsigned count);
 void debug_console_poll(void);
 #else
-static inline void debug_console_init(void) {}
-static inline void debug_console_event(char tag, uint32_t a, int32_t b, int32_t c, int fields)
+static inline void debug_console_init(const wf_config_t *config)
 {
-    (void)tag, (void)a, (void)b, (void)c, (void)fields;
+    (void)config;
+}
+static inline void debug_console_line(char tag, const int32_t *values, unsigned count)
+{
+    (void)tag, (void)values, (void)count;
 }
 static inline void debug_console_poll(void) {}
 #endif

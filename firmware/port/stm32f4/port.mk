@@ -2,9 +2,9 @@
 #   make -C firmware arm    real STM32F407 board image: build/arm/wirefish.{elf,bin}
 #   make -C firmware qemu   emulator image (-M netduinoplus2): build/qemu/wirefish.elf
 # Inputs from the including Makefile (set before the include): CORE_SRCS, the core's C files
-# (relative to firmware/), and CORE_INCLUDES (default -Iinclude). Without CORE_SRCS the port
-# links its own heartbeat-only bring-up app. Each link prints flash and RAM use and fails
-# beyond the budget: 32 KB flash, 8 KB RAM (the stack's 2 KB included).
+# (relative to firmware/), CORE_INCLUDES (default -Iinclude) and WARNINGS (the core's warning
+# flags, errors included; default -Wall -Wextra -Werror). Each link prints flash and RAM use
+# and fails beyond the budget: 32 KB flash, 8 KB RAM (the stack's 2 KB included).
 
 STM32F4_DIR := port/stm32f4
 ARM_PREFIX ?= arm-none-eabi-
@@ -16,18 +16,12 @@ ARM_FLASH_BUDGET := 32768
 ARM_RAM_BUDGET := 8192
 ARM_ARCH := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 CORE_INCLUDES ?= -Iinclude
-ARM_CFLAGS := $(ARM_ARCH) -std=c11 -Os -g -Wall -Wextra -Werror -ffunction-sections \
+WARNINGS ?= -Wall -Wextra -Werror
+ARM_CFLAGS := $(ARM_ARCH) -std=c11 -Os -g $(WARNINGS) -ffunction-sections \
 	-fdata-sections $(CORE_INCLUDES) -I$(STM32F4_DIR)
 ARM_LDFLAGS := $(ARM_ARCH) --specs=nano.specs --specs=nosys.specs -nostartfiles \
 	-T$(STM32F4_DIR)/stm32f4.ld -Wl,--gc-sections
-ARM_PORT_SRCS := $(filter-out $(STM32F4_DIR)/bringup_app.c,$(wildcard $(STM32F4_DIR)/*.c))
-ifeq ($(strip $(CORE_SRCS)),)
-ARM_APP_SRCS := $(STM32F4_DIR)/bringup_app.c
-ARM_APP_DEFS := -DWF_PORT_BRINGUP=1
-else
-ARM_APP_SRCS := $(CORE_SRCS)
-ARM_APP_DEFS :=
-endif
+ARM_PORT_SRCS := $(wildcard $(STM32F4_DIR)/*.c)
 
 .PHONY: arm qemu arm-toolchain
 arm: $(ARM_BUILD)/arm/wirefish.elf $(ARM_BUILD)/arm/wirefish.bin
@@ -40,10 +34,10 @@ arm-toolchain:
 
 # One variant: $(1) its name (the build directory), $(2) its defines.
 define ARM_VARIANT
-$(1)_OBJS := $$(patsubst %.c,$(ARM_BUILD)/$(1)/obj/%.o,$(ARM_PORT_SRCS) $(ARM_APP_SRCS))
+$(1)_OBJS := $$(patsubst %.c,$(ARM_BUILD)/$(1)/obj/%.o,$(ARM_PORT_SRCS) $(CORE_SRCS))
 $(ARM_BUILD)/$(1)/obj/%.o: %.c | arm-toolchain
 	@mkdir -p $$(@D)
-	$(ARM_CC) $(ARM_CFLAGS) $(ARM_APP_DEFS) $(2) -MMD -MP -c $$< -o $$@
+	$(ARM_CC) $(ARM_CFLAGS) $(2) -MMD -MP -c $$< -o $$@
 $(ARM_BUILD)/$(1)/wirefish.elf: $$($(1)_OBJS) $(STM32F4_DIR)/stm32f4.ld
 	$(ARM_CC) $(ARM_LDFLAGS) -Wl,-Map=$(ARM_BUILD)/$(1)/wirefish.map -o $$@ $$($(1)_OBJS) -lm
 	@set -- $$$$($(ARM_SIZE) -B $$@ | awk 'NR == 2 {print $$$$1 + $$$$2, $$$$2 + $$$$3}'); \

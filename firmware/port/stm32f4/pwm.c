@@ -59,6 +59,7 @@ void wf_hal_pwm_set_compare(unsigned servo, uint32_t compare_ticks)
     *ccr = compare_ticks;
     uint32_t now = *ccr;   /* what the timer holds: the test reads this value back */
     if (now != before) {
-        debug_console_event('P', wf_hal_millis(), (int32_t)servo, (int32_t)now, 3);
+        const int32_t event[3] = {(int32_t)wf_hal_millis(), (int32_t)servo, (int32_t)now};
+        debug_console_line('P', event, 3u);
     }
 }

@@ -42,7 +42,8 @@ void wf_reset_handler(void)
 enum { CORE_VECTORS = 16, IRQ_VECTORS = 82 };
 typedef void (*vector_t)(void);
 
-__attribute__((section(".isr_vector"), used))
+/* __extension__: the range designators ([a ... b]) are GCC's. */
+__extension__ __attribute__((section(".isr_vector"), used))
 static const vector_t vectors[CORE_VECTORS + IRQ_VECTORS] = {
     [0] = (vector_t)(uintptr_t)&_estack,
     [1] = wf_reset_handler,

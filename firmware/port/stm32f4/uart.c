@@ -37,7 +37,8 @@ void wf_usart1_handler(void)
             rx_overflows = rx_overflows + 1u;
         }
         if (byte == 0u) {
-            debug_console_event('Z', wf_hal_millis(), 0, 0, 1);
+            const int32_t now = (int32_t)wf_hal_millis();
+            debug_console_line('Z', &now, 1u);
         }
     }
     if ((USART_CR1(USART1_BASE) & USART_CR1_TXEIE) && (status & USART_SR_TXE)) {
