@@ -6,8 +6,10 @@ The QoS profiles of every wirefish topic and service client, defined once.
 - ``RELIABLE``: commands, results and status a reader must not miss (/diagnostics,
   speed_estimate, retune results): reliable, volatile, depth 10. ``reliable(depth)`` for
   another depth.
+- ``COMMAND``: a control signal sent at its controller's rate, where only the latest counts
+  (cpg_command): reliable, volatile, keep last 1, so a late sample is superseded by the next.
 - ``LATCHED``: state a node announces once and a late joiner still needs (cpg_params,
-  target_wave): reliable, transient local, depth 1 (the last value).
+  cpg_status, target_wave): reliable, transient local, depth 1 (the last value).
 """
 
 from __future__ import annotations
@@ -23,5 +25,6 @@ def reliable(depth: int) -> QoSProfile:
 
 
 RELIABLE = reliable(10)
+COMMAND = reliable(1)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)

@@ -8,16 +8,24 @@ Publishes
     time has not advanced publishes nothing). The ticks come from a ``FixedRateLoop`` thread,
     not an executor timer: at 1 kHz the executor's own overhead was ~90 % of the node's CPU
     (see fixed_rate.py).
-    ``cpg_params`` (wirefish_msgs/CpgParams, reliable, transient local, depth 1): the current
-    parameters, re-published whenever they change.
+    ``cpg_params`` (wirefish_msgs/CpgParams, reliable, transient local, depth 1): the targets
+    the CPG runs, re-published whenever they change (from a command or a parameter set).
+    ``cpg_status`` (wirefish_msgs/CpgStatus, reliable, transient local, depth 1): which source
+    sets the targets and why the last command was refused, re-published when it changes.
+Subscribes
+    ``cpg_command`` (wirefish_msgs/CpgCommand, reliable, keep last 1): the control signal (the
+    planner's targets), judged as a parameter set is (``cpg_control``).
 Services
     ``start``, ``stop`` (std_srvs/Trigger): stop sends the amplitude and offset targets to 0,
     so the tail comes to rest along eq 1's convergence law, never by a jump; start restores
-    the parameters. Parameter changes while stopped are kept and apply at start.
+    the targets. Changes while stopped are kept and apply at start.
+    ``follow_commands`` (std_srvs/Trigger): end a manual override (``cpg_control`` says which
+    source wins: a parameter set overrides cpg_command until this is called).
 Parameters (flat scalars, each with a range; invalid updates are rejected with a reason):
-    see ``cpg_node_parameters``. Valid updates apply smoothly: the oscillator state persists,
-    the amplitudes and offsets converge to their new targets, a new frequency only changes the
-    phase velocity. Outputs beyond ``servo_limit_rad`` are clamped (rate 0) with a warning.
+    see ``cpg_node_parameters``; the configuration and the manual override. Valid targets apply
+    smoothly: the oscillator state persists, the amplitudes and offsets converge to their new
+    targets, a new frequency only changes the phase velocity. Outputs beyond
+    ``servo_limit_rad`` are clamped (rate 0) with a warning.
 """
 
 from __future__ import annotations
@@ -31,15 +39,16 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import LATCHED, SENSOR_DATA
+from wirefish_common.qos import COMMAND, LATCHED, SENSOR_DATA
 from wirefish_common.servo_joints import servo_joint_state
-from wirefish_cpg.cpg_messages import to_message
+from wirefish_cpg.cpg_control import CpgTargets, TargetSource
+from wirefish_cpg.cpg_messages import flat_message_values, to_message
 from wirefish_cpg.cpg_node_parameters import NODE_PARAMETERS, SPECS
 from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES, parameters_from
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import at_rest, CpgIntegrator
 from wirefish_cpg.servo_limit import clamp_to_limit
-from wirefish_msgs.msg import CpgParams
+from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus
 
 # Longest clock gap integrated step by step (s); a longer jump re-bases the clock instead.
 MAX_CATCH_UP_S = 0.5
@@ -53,7 +62,8 @@ class CpgNode(Node):
         super().__init__('cpg_node', **kwargs)
         declare(self, NODE_PARAMETERS, parameters_from)
         self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
-        params = parameters_from(self._values)
+        self._control = CpgTargets(SPECS, self._values, self.get_fully_qualified_name())
+        params = self._control.targets
         self._running = bool(self._values['autostart'])
         # The CPG is stepped on the loop's thread and re-parameterised on the executor's.
         self._lock = threading.Lock()
@@ -67,11 +77,16 @@ class CpgNode(Node):
         # JointState with its names and stamp was a fifth of a tick's CPU.
         self._command = servo_joint_state((0.0, 0.0), (0.0, 0.0))
         self._params_pub = self.create_publisher(CpgParams, 'cpg_params', LATCHED)
+        self._status_pub = self.create_publisher(CpgStatus, 'cpg_status', LATCHED)
+        self._status: tuple[TargetSource, str] | None = None  # what cpg_status last said
         self.create_service(Trigger, 'start', self._on_start)
         self.create_service(Trigger, 'stop', self._on_stop)
+        self.create_service(Trigger, 'follow_commands', self._on_follow_commands)
+        self.create_subscription(CpgCommand, 'cpg_command', self._on_command, COMMAND)
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)
         self._params_pub.publish(to_message(params))
+        self._publish_status()
         self._loop = FixedRateLoop(1.0 / self._values['publish_rate_hz'], self._on_tick,
                                    name='cpg_publish')
         self._loop.start()
@@ -98,11 +113,44 @@ class CpgNode(Node):
                 self._cpg.step_s = float(self._values['integration_step_s'])
             if 'publish_rate_hz' in names:
                 self._loop.period_s = 1.0 / self._values['publish_rate_hz']
-            if names & set(CPG_PARAMETER_NAMES):
-                params = parameters_from(self._values)
+            if names & set(CPG_PARAMETER_NAMES):  # a manual override (cpg_control)
+                self._control.parameters_set(self._values)
+                params = self._control.targets
                 self._cpg.set_parameters(params if self._running else at_rest(params))
         if params is not None:  # announced outside the lock: the loop must not wait on DDS
             self._params_pub.publish(to_message(params))
+            self._publish_status()
+
+    def _on_command(self, msg: CpgCommand) -> None:
+        with self._lock:
+            previous = self._control.targets
+            applied = self._control.command(self._values, flat_message_values(msg.targets))
+            targets = self._control.targets
+            if targets != previous:
+                self._cpg.set_parameters(targets if self._running else at_rest(targets))
+        if targets != previous:
+            self._params_pub.publish(to_message(targets))
+        if not applied:
+            self.get_logger().warn(self._control.refused, throttle_duration_sec=2.0)
+        self._publish_status()
+
+    def _publish_status(self) -> None:
+        """Publish cpg_status if the source or the verdict changed since it was last said."""
+        status = (self._control.source, self._control.refused)
+        if status == self._status:
+            return
+        self._status = status
+        msg = CpgStatus(source=status[0].value, refused=status[1])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self._status_pub.publish(msg)
+
+    def _on_follow_commands(self, request: Trigger.Request, response: Trigger.Response
+                            ) -> Trigger.Response:
+        response.success = True
+        response.message = ('cpg_command sets the targets again' if self._control.follow_commands()
+                            else 'already following cpg_command')
+        self._publish_status()
+        return response
 
     def _on_start(self, request: Trigger.Request, response: Trigger.Response
                   ) -> Trigger.Response:
@@ -110,7 +158,7 @@ class CpgNode(Node):
         response.message = 'already running' if self._running else 'started'
         with self._lock:
             self._running = True
-            self._cpg.set_parameters(parameters_from(self._values))
+            self._cpg.set_parameters(self._control.targets)
         return response
 
     def _on_stop(self, request: Trigger.Request, response: Trigger.Response
@@ -120,7 +168,7 @@ class CpgNode(Node):
                             if self._running else 'already stopped')
         with self._lock:
             self._running = False
-            self._cpg.set_parameters(at_rest(parameters_from(self._values)))
+            self._cpg.set_parameters(at_rest(self._control.targets))
         return response
 
     def _on_tick(self) -> None:

@@ -4,7 +4,8 @@ import math
 
 import numpy as np
 import pytest
-from wirefish_planner.planner_config import cpg_values, values_changed
+from wirefish_planner.planner_config import (command_targets, cpg_topic, cpg_values,
+                                             values_changed)
 from wirefish_planner.planner_core import command_problem, ignored_fields
 from wirefish_sim.faults import Disturbance
 
@@ -90,6 +91,30 @@ def test_offset_changes_inside_the_deadband_are_not_sent():
     assert not values_changed(sent, {'offset_1': 0.1005, 'offset_2': 0.1005})
     assert values_changed(sent, {'offset_1': 0.11, 'offset_2': 0.11})
     assert values_changed(sent, {'offset_1': 0.0, 'offset_2': 0.0})  # rest is exact
+
+
+def test_a_rest_command_keeps_what_the_cpg_runs_and_waits_to_know_it(make_planner):
+    rest = cpg_values(make_planner().step(1.0))
+    assert command_targets(rest, None) is None
+    running = {'frequency_hz': 1.3, 'amplitude_1': 0.3, 'amplitude_2': 0.4, 'offset_1': 0.1,
+               'offset_2': 0.1, 'w12': -0.4, 'w21': 0.6, 'phi12': 1.7, 'phi21': 1.0,
+               'alpha': 20.0}
+    assert command_targets(rest, running) == dict(running, amplitude_1=0.0, amplitude_2=0.0,
+                                                  offset_1=0.0, offset_2=0.0)
+
+
+def test_a_gait_command_names_every_target(make_planner):
+    planner = make_planner()
+    planner.command(0.0, 0.2, 0.0)
+    wanted = cpg_values(planner.step(0.05))
+    assert command_targets(wanted, None) == wanted and len(wanted) == 10
+
+
+@pytest.mark.parametrize('name, topic', [
+    ('cpg_node', 'cpg_command'), ('/cpg_node', '/cpg_command'),
+    ('/fish_2/cpg_node', '/fish_2/cpg_command'), ('sub/cpg_node', 'sub/cpg_command')])
+def test_the_command_topic_is_in_the_cpg_nodes_namespace(name, topic):
+    assert cpg_topic(name, 'cpg_command') == topic
 
 
 @pytest.fixture(scope='module')

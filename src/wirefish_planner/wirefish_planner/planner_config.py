@@ -3,7 +3,7 @@ The planner node's parameter table and what it builds (pure; no rclpy at import)
 
 ``planner_from(values)`` is both the validation of a parameter set (its ``ValueError`` is the
 reason an update is refused) and the construction of the ``Planner``; ``cpg_values`` turns a
-planner output into the cpg_node parameters to set.
+planner output into the CPG targets it asks for, ``command_targets`` into a whole cpg_command.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from wirefish_common.parameter_table import ParameterSpec
+from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES
 from wirefish_cpg.gait_library import default_library_path
 from wirefish_cpg.wave_loss import WaveSpec
 from wirefish_kinematics.node_parameters import (BODY_WAVE_GEOMETRY_FIELDS, geometry_from,
@@ -34,7 +35,7 @@ PLANNER_PARAMETERS = (
     ParameterSpec('imu_timeout_s', 0.5,
                   'Turn open loop (feed-forward only) after this long without imu/data (s)',
                   0.0, 60.0, low_exclusive=True),
-    ParameterSpec('control_rate_hz', 20.0, 'Rate of CPG updates and planner_state (Hz)', 1.0,
+    ParameterSpec('control_rate_hz', 20.0, 'Rate of cpg_command and planner_state (Hz)', 1.0,
                   200.0),
     ParameterSpec('min_frequency_hz', _LIMITS.min_frequency_hz,
                   'Lowest tail-beat frequency of a gait (Hz)', 0.0, 10.0, low_exclusive=True),
@@ -163,6 +164,29 @@ def cpg_values(out: PlannerOutput) -> dict[str, float]:
                                    p.phi21, p.alpha)))
     values.update({name: float(out.offset) for name in OFFSET_NAMES})
     return {name: float(value) for name, value in values.items()}
+
+
+def command_targets(wanted: dict[str, float], running: dict[str, float] | None
+                    ) -> dict[str, float] | None:
+    """
+    Return the whole target set of a cpg_command: ``wanted`` over what the CPG ``running``.
+
+    A gait names every target; rest names only amplitudes and offsets, and keeps the frequency
+    and couplings the CPG runs (None while that is not known: no command yet).
+    """
+    if set(wanted) >= set(CPG_PARAMETER_NAMES):
+        return {name: wanted[name] for name in CPG_PARAMETER_NAMES}
+    if running is None:
+        return None
+    return {name: float(wanted.get(name, running[name])) for name in CPG_PARAMETER_NAMES}
+
+
+def cpg_topic(cpg_node_name: str, topic: str) -> str:
+    """Return ``topic`` in the namespace of the node ``cpg_node_name`` (relative or not)."""
+    namespace, _, _ = cpg_node_name.rpartition('/')
+    if not namespace:
+        return f'/{topic}' if cpg_node_name.startswith('/') else topic
+    return f'{namespace}/{topic}'
 
 
 def values_changed(sent: dict[str, float] | None, wanted: dict[str, float]) -> bool:

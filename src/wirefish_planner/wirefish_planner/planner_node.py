@@ -11,12 +11,18 @@ Publishes
     ``planner_state`` (wirefish_msgs/PlannerState, reliable, depth 10) at ``control_rate_hz``;
     ``/diagnostics`` (diagnostic_msgs/DiagnosticArray) at 1 Hz.
 Drives
-    cpg_node (``cpg_node_name``) through its ``set_parameters_atomically`` service, as
-    tuner_node applies a fit: the gait (eq 18 inverted, ``gait_family``) and the offsets
-    b_1 = b_2 (``yaw_control``). Every change goes through the CPG's smooth convergence, never a
-    servo step. At rest (no cmd_vel yet, or none for ``cmd_vel_timeout_s``) the amplitudes and
-    offsets are 0 (``rest_at_start`` false: cpg_node is left alone until the first cmd_vel).
-    One request is in flight at a time; newer wishes replace older unsent ones.
+    cpg_node (``cpg_node_name``) by its control topic: ``cpg_command`` (wirefish_msgs/CpgCommand,
+    reliable, keep last 1) in the CPG node's namespace, the whole target set at every control
+    tick (no request in flight: a lost message is superseded by the next, a restarted CPG gets
+    the next one): the gait (eq 18 inverted, ``gait_family``) and the offsets b_1 = b_2
+    (``yaw_control``). Every change goes through the CPG's smooth convergence, never a servo
+    step. At rest (no cmd_vel yet, or none for ``cmd_vel_timeout_s``) the amplitudes and offsets
+    are 0, the frequency and couplings those the CPG runs (``rest_at_start`` false: nothing is
+    sent until the first cmd_vel).
+    Hears ``cpg_params`` (what the CPG runs: planner_state's cpg_* fields) and ``cpg_status``.
+    One owner of the gait: while the CPG is under a manual override (its parameters were set,
+    e.g. a retune applied) the planner sends nothing and says so (mode ``manual``); a refused
+    command is said in planner_state's note and on /diagnostics.
 Parameters: ``PLANNER_PARAMETERS`` (each with a range; an invalid set changes nothing).
 """
 
@@ -27,16 +33,17 @@ import math
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
 from rcl_interfaces.msg import SetParametersResult
-from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Imu
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import RELIABLE, SENSOR_DATA
-from wirefish_msgs.msg import PlannerState
-from wirefish_planner.planner_config import (cpg_values, planner_from, PLANNER_PARAMETERS,
-                                             values_changed)
+from wirefish_common.qos import COMMAND, LATCHED, RELIABLE, SENSOR_DATA
+from wirefish_cpg.cpg_control import TargetSource
+from wirefish_cpg.cpg_messages import flat_message_values
+from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
+from wirefish_planner.planner_config import (command_targets, cpg_topic, cpg_values,
+                                             planner_from, PLANNER_PARAMETERS, values_changed)
 from wirefish_planner.planner_core import ignored_fields, PlannerOutput
 from wirefish_planner.yaw_control import yaw_from_quaternion
 
@@ -46,23 +53,21 @@ WARN_THROTTLE_S = 2.0
 
 
 class PlannerNode(Node):
-    """cmd_vel and imu/data in; cpg_node's parameters, planner_state and /diagnostics out."""
+    """cmd_vel and imu/data in; cpg_command, planner_state and /diagnostics out."""
 
     def __init__(self, **kwargs) -> None:
-        """Declare the parameters, build the planner, wire topics, client and timers."""
+        """Declare the parameters, build the planner, wire topics and timers."""
         super().__init__('planner_node', **kwargs)
         declare(self, PLANNER_PARAMETERS, planner_from)
         self._values = {s.name: self.get_parameter(s.name).value for s in PLANNER_PARAMETERS}
         self._planner = planner_from(self._values)
         self._said_ignored: set[str] = set()
         self._last_cmd_s: float | None = None
-        self._sent: dict[str, float] | None = None  # what cpg_node last accepted
-        self._in_flight: dict[str, float] | None = None
-        self._refusal = ''
+        self._sent: dict[str, float] | None = None  # the targets cpg_command carries
+        self._cpg_params: CpgParams | None = None  # what the CPG last said it runs
+        self._cpg_status: CpgStatus | None = None
         self._output: PlannerOutput | None = None
-        self._client = self.create_client(
-            SetParametersAtomically,
-            f'{self._values["cpg_node_name"]}/set_parameters_atomically')
+        self._wire_cpg()
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
         self.create_subscription(Imu, 'imu/data', self._on_imu, SENSOR_DATA)
         self._state_pub = self.create_publisher(PlannerState, 'planner_state', RELIABLE)
@@ -91,11 +96,28 @@ class PlannerNode(Node):
             self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                     self._on_control)
         if 'cpg_node_name' in names:
-            self.destroy_client(self._client)
-            self._client = self.create_client(
-                SetParametersAtomically,
-                f'{self._values["cpg_node_name"]}/set_parameters_atomically')
-            self._sent = None  # a new CPG node gets the whole state
+            self.destroy_publisher(self._command_pub)
+            for subscription in self._cpg_subscriptions:
+                self.destroy_subscription(subscription)
+            self._sent = self._cpg_params = self._cpg_status = None
+            self._wire_cpg()
+
+    def _wire_cpg(self) -> None:
+        """Create cpg_command's publisher and the cpg_params, cpg_status subscriptions."""
+        name = self._values['cpg_node_name']
+        self._command_pub = self.create_publisher(CpgCommand, cpg_topic(name, 'cpg_command'),
+                                                  COMMAND)
+        self._cpg_subscriptions = [
+            self.create_subscription(CpgParams, cpg_topic(name, 'cpg_params'),
+                                     self._on_cpg_params, LATCHED),
+            self.create_subscription(CpgStatus, cpg_topic(name, 'cpg_status'),
+                                     self._on_cpg_status, LATCHED)]
+
+    def _on_cpg_params(self, msg: CpgParams) -> None:
+        self._cpg_params = msg
+
+    def _on_cpg_status(self, msg: CpgStatus) -> None:
+        self._cpg_status = msg
 
     # --- inputs ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
@@ -126,52 +148,63 @@ class PlannerNode(Node):
         now = self._now_s()
         out = self._planner.step(now)
         self._output = out
-        self._send(cpg_values(out))
+        if self._manual():
+            self._planner.pi.reset()  # the planner's offset is not applied: nothing to integrate
+        else:
+            self._send(cpg_values(out))
         self._state_pub.publish(self._state_message(out, now))
 
+    def _manual(self) -> bool:
+        status = self._cpg_status
+        return status is not None and status.source == TargetSource.MANUAL.value
+
+    def _refusal(self) -> str:
+        """Return why the CPG does not run the planner's targets ('' when it does)."""
+        status = self._cpg_status
+        if status is None:
+            return ''
+        if self._manual():
+            name = self._values['cpg_node_name']
+            return (f'{name} is under a manual override (its parameters were set, e.g. a retune '
+                    f'applied): cmd_vel is not followed until {name}/follow_commands is called')
+        return status.refused
+
     def _send(self, wanted: dict[str, float]) -> None:
-        if self._in_flight is not None or not values_changed(self._sent, wanted):
-            return
+        """Publish the targets (the last ones again if ``wanted`` is within the deadband)."""
         if self._last_cmd_s is None and not self._values['rest_at_start']:
             return  # cpg_node keeps its own parameters until the first cmd_vel
-        if not self._client.service_is_ready():
-            return
-        self._in_flight = wanted
-        request = SetParametersAtomically.Request(parameters=[
-            Parameter(name, Parameter.Type.DOUBLE, float(value)).to_parameter_msg()
-            for name, value in wanted.items()])
-        self._client.call_async(request).add_done_callback(self._on_sent)
-
-    def _on_sent(self, future) -> None:
-        wanted, self._in_flight = self._in_flight, None
-        try:
-            result = future.result().result
-        except Exception as error:  # noqa: B902 (a lost service: say why, try again later)
-            self._refusal = f'set_parameters_atomically failed: {error!r}'
-            self.get_logger().warn(self._refusal, throttle_duration_sec=WARN_THROTTLE_S)
-            return
-        if result.successful:
-            self._sent, self._refusal = wanted, ''
-        else:
-            self._refusal = f'{self._values["cpg_node_name"]} refused: {result.reason}'
-            self._sent = wanted  # not retried until the wish changes
-            self.get_logger().warn(self._refusal, throttle_duration_sec=WARN_THROTTLE_S)
+        running = None if self._cpg_params is None else flat_message_values(self._cpg_params)
+        targets = command_targets(wanted, running)
+        if targets is None:
+            return  # at rest before the CPG said what it runs: nothing to rest from yet
+        if self._sent is None or values_changed(self._sent, targets):
+            self._sent = targets
+        sent = self._sent
+        msg = CpgCommand()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.targets = CpgParams(
+            frequency_hz=sent['frequency_hz'], amplitude=[sent['amplitude_1'], sent['amplitude_2']],
+            offset=[sent['offset_1'], sent['offset_2']], w12=sent['w12'], w21=sent['w21'],
+            phi12=sent['phi12'], phi21=sent['phi21'], alpha=sent['alpha'])
+        self._command_pub.publish(msg)
 
     def _state_message(self, out: PlannerOutput, now: float) -> PlannerState:
         point = out.gait.point
         msg = PlannerState()
         msg.header.stamp = self.get_clock().now().to_msg()
-        msg.mode = out.mode
+        msg.mode = 'manual' if self._manual() else out.mode
         msg.target_speed = float(out.gait.target_speed)
         msg.predicted_speed = float(out.gait.predicted_speed)
         msg.clamp_reason = out.gait.clamp_reason
-        msg.note = out.note or self._planner.gaits.family_note
+        msg.note = self._refusal() or out.note or self._planner.gaits.family_note
         msg.gait_family = self._planner.gaits.family.name
         if point is not None:
             msg.tail_beat_hz = float(point.frequency_hz)
             msg.amplitude_scale = float(point.amplitude_scale)
-            msg.cpg_frequency_hz = float(point.params.frequency_hz)
-            msg.cpg_amplitude = [float(a) for a in point.params.amplitude]
+        running = self._cpg_params  # what the CPG runs, as it says (not what was asked)
+        msg.cpg_frequency_hz = math.nan if running is None else float(running.frequency_hz)
+        msg.cpg_amplitude = [math.nan] * 2 if running is None else [
+            float(a) for a in running.amplitude]
         msg.yaw_rate_target = float(out.yaw_rate_target)
         msg.yaw_rate_measured = float(out.yaw_rate_measured)
         msg.yaw_rate_error = float(out.yaw_rate_target - out.yaw_rate_measured)
@@ -184,10 +217,10 @@ class PlannerNode(Node):
     def _on_diagnostics(self) -> None:
         out = self._output
         level, message = DiagnosticStatus.OK, 'ok'
-        if not self._client.service_is_ready():
-            level, message = DiagnosticStatus.WARN, f'no {self._client.srv_name} service'
-        elif self._refusal:
-            level, message = DiagnosticStatus.WARN, self._refusal
+        if self._refusal():
+            level, message = DiagnosticStatus.WARN, self._refusal()
+        elif self._command_pub.get_subscription_count() == 0:
+            level, message = DiagnosticStatus.WARN, f'nobody hears {self._command_pub.topic_name}'
         elif out is not None and out.gait.clamp_reason:
             level, message = DiagnosticStatus.WARN, f'speed clamped: {out.gait.clamp_reason}'
         elif out is not None and out.mode == 'open_loop' and self._values['yaw_control']:
@@ -199,7 +232,8 @@ class PlannerNode(Node):
             'predicted_speed': f'{out.gait.predicted_speed:.3f}',
             'yaw_rate_target': f'{out.yaw_rate_target:.3f}',
             'yaw_rate_measured': f'{out.yaw_rate_measured:.3f}',
-            'offset': f'{out.offset:.4f}'}
+            'offset': f'{out.offset:.4f}',
+            'cpg_source': 'unknown' if self._cpg_status is None else self._cpg_status.source}
         status = DiagnosticStatus(level=level, name=f'{self.get_fully_qualified_name()}',
                                   hardware_id='wirefish', message=message,
                                   values=[KeyValue(key=k, value=v) for k, v in values.items()])
