@@ -6,8 +6,9 @@ from pathlib import Path
 import subprocess
 import sys
 
-from wirefish_bringup import mcap_records as rec
-from wirefish_bringup.bag_storage import storage_files
+from mcap.records import Channel, DataEnd, Message
+from mcap.stream_reader import StreamReader
+from wirefish_bringup.bag_storage import READ_ERRORS, storage_files
 from wirefish_bringup.bagfile import read_bag
 import yaml
 
@@ -56,31 +57,25 @@ class SequenceGap:
         return self.after_s + (self.before_s - self.after_s) / (self.missing + 1)
 
 
-def _messages(path: Path, *, being_written: bool = False
-              ) -> Iterator[tuple[str, rec.MessageRecord]]:
+def _messages(path: Path, *, being_written: bool = False) -> Iterator[tuple[str, Message]]:
     """
-    Yield (topic, message) for each message of an MCAP file, in file order.
+    Yield (topic, message) for each message of an MCAP file, in file order (mcap's reader).
 
     ``being_written``: the file's writer is still at work; its torn tail ends the messages.
     """
     topics: dict[int, str] = {}
-    try:
-        for opcode, _, content in rec.iter_records(Path(path).read_bytes(), len(rec.MAGIC)):
-            if opcode == rec.DATA_END:  # the summary and footer follow: no more messages
-                return
-            inner = [(opcode, content)]
-            if opcode == rec.CHUNK:
-                inner = [(op, c) for op, _, c in rec.iter_records(rec.decode_chunk(content))]
-            for op, body in inner:
-                if op == rec.CHANNEL:
-                    channel = rec.decode_channel(body)
-                    topics[channel.channel_id] = channel.topic
-                elif op == rec.MESSAGE:
-                    message = rec.decode_message(body)
-                    yield topics[message.channel_id], message
-    except rec.RecordError:
-        if not being_written:
-            raise
+    with Path(path).open('rb') as file:
+        try:
+            for record in StreamReader(file, validate_crcs=True).records:
+                if isinstance(record, DataEnd):  # the summary and footer follow
+                    return
+                if isinstance(record, Channel):
+                    topics[record.id] = record.topic
+                elif isinstance(record, Message):
+                    yield topics[record.channel_id], record
+        except READ_ERRORS:
+            if not being_written:
+                raise
 
 
 def sequence_gaps(bag_path: Path) -> tuple[list[SequenceGap], dict[str, int]]:
@@ -102,8 +97,8 @@ def sequence_gaps(bag_path: Path) -> tuple[list[SequenceGap], dict[str, int]]:
                 runs[topic] = runs.get(topic, 0) + 1
             elif message.sequence > previous[0] + 1:
                 gaps.append(SequenceGap(topic, message.sequence - previous[0] - 1,
-                                        previous[1] * 1e-9, message.log_time_ns * 1e-9))
-            last[topic] = (message.sequence, message.log_time_ns)
+                                        previous[1] * 1e-9, message.log_time * 1e-9))
+            last[topic] = (message.sequence, message.log_time)
     return gaps, runs
 
 

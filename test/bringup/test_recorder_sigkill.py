@@ -20,8 +20,8 @@ import numpy as np
 import psutil
 import pytest
 from ros_utils import spin_until, stop_process
-from wirefish_bringup import mcap_records as rec
 from wirefish_bringup.bag_storage import read_file_info, storage_files
+from wirefish_bringup.bag_writer import BagFileWriter
 from wirefish_bringup.bagfile import read_bag
 from wirefish_bringup.graph import expected_rates
 import yaml
@@ -37,16 +37,7 @@ def _record(namespace: str, bag: Path, *options: str) -> list[str]:
 
 def _flushed(bag: Path) -> bool:
     """Return True once a chunk holding a message is on disk."""
-    for path in bag.glob('*.mcap'):
-        try:
-            for opcode, _, content in rec.iter_records(path.read_bytes(), len(rec.MAGIC)):
-                if opcode == rec.CHUNK and any(
-                        op == rec.MESSAGE for op, _, _ in rec.iter_records(
-                            rec.decode_chunk(content))):
-                    return True
-        except rec.RecordError:
-            pass  # the tail is still being written
-    return False
+    return any(flushed_topics(path) for path in bag.glob('*.mcap'))
 
 
 def _wait_flushed(bag: Path, timeout_s: float) -> bool:
@@ -71,9 +62,15 @@ def _record_then_kill(spawn, listener, namespace: str, bag: Path, seed: int) -> 
     return killed_at
 
 
-def _torn_tail(path: Path, seed: int) -> None:
+def _torn_tail(path: Path, seed: int, scratch: Path) -> None:
     """Append what a kill inside a write would leave: half a chunk, then stray bytes."""
-    half_chunk = rec.chunk(0, 0, rec.message(1, 0, 0, bytes(200)))[:120]
+    writer = BagFileWriter(scratch)
+    start = scratch.stat().st_size
+    writer.add_channel('/torn', 0, {})
+    writer.write(1, 0, bytes(200))
+    writer.flush()
+    half_chunk = scratch.read_bytes()[start:start + 120]
+    writer.close()
     noise = np.random.default_rng(seed).integers(0, 256, 333, dtype=np.uint8).tobytes()
     with path.open('ab') as file:
         file.write(half_chunk + noise)
@@ -103,7 +100,7 @@ def test_a_killed_recording_loses_at_most_its_last_second(tmp_path, spawn, talke
     (mcap,) = storage_files(bag)
     assert not (bag / 'metadata.yaml').exists()  # what rosbags refused before the repair
     if tail == 'torn last write':
-        _torn_tail(mcap, kill_seed)
+        _torn_tail(mcap, kill_seed, tmp_path / 'torn.mcap')
     printed = reindex_bag(bag, ros_env)
     assert 'rebuilt from' in printed
     counts = assert_bag_readable(bag)
@@ -134,7 +131,8 @@ def test_a_clean_stop_writes_a_finished_bag(tmp_path, spawn, talker_namespace, l
     spin_until(listener.executor, lambda: False, 1.5)
     assert stop_process(recorder) == 0  # SIGINT
     info = read_file_info(bag / 'bag_0.mcap')  # summary and footer: no repair needed
-    assert info.message_count == assert_bag_readable(bag)[topic] > 0
+    counts = assert_bag_readable(bag)
+    assert info.message_count == sum(counts.values()) and counts[topic] > 0
     meta = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
     (topic,) = [t['topic_metadata'] for t in meta['topics_with_message_count']
                 if t['topic_metadata']['name'] == topic]

@@ -7,7 +7,7 @@ import pytest
 from rosbags.typesys import get_typestore, Stores
 
 from wirefish_bringup.bag_storage import add_topic, next_file_path, write_metadata
-from wirefish_bringup.mcap_writer import McapWriter
+from wirefish_bringup.bag_writer import BagFileWriter
 
 TYPE = 'std_msgs/msg/String'
 QOS = """- history: keep_last
@@ -35,24 +35,30 @@ class WrittenFile:
 
 def write_file(typestore, bag_dir: Path, flushes: int, per_flush: int,
                topics: tuple[str, ...] = ('/a', '/b'), first: int = 0,
-               close: bool = True) -> WrittenFile:
-    """Write ``flushes`` chunks of ``per_flush`` messages cycling over ``topics``."""
+               close: bool = True, recording: dict[str, str] | None = None) -> WrittenFile:
+    """
+    Write ``flushes`` chunks of ``per_flush`` messages cycling over ``topics``.
+
+    Message ``i`` is received at 1 s + i ms, published 500 ns before, with sequence number i;
+    ``recording`` is the recorder's account the file closes with.
+    """
     bag_dir.mkdir(exist_ok=True)
-    writer = McapWriter(next_file_path(bag_dir))
+    writer = BagFileWriter(next_file_path(bag_dir))
     channels = [add_topic(writer, typestore, topic, TYPE, QOS) for topic in topics]
     msg_class = typestore.types[TYPE]
     written = WrittenFile(bag_dir, writer.path, [])
     for i in range(first, first + flushes * per_flush):
         text = f'message {i}'
-        writer.write(channels[i % len(channels)], 1_000_000_000 + i * 1_000_000,
-                     typestore.serialize_cdr(msg_class(data=text), TYPE), i)
+        received_ns = 1_000_000_000 + i * 1_000_000
+        writer.write(channels[i % len(channels)], received_ns,
+                     typestore.serialize_cdr(msg_class(data=text), TYPE), i, received_ns - 500)
         written.texts.append(text)
         if (i - first + 1) % per_flush == 0:
             writer.flush()
             written.flush_ends.append(writer.path.stat().st_size)
             written.flushed_counts.append(len(written.texts))
     if close:
-        writer.close()
+        writer.close(recording)
         write_metadata(bag_dir)
     return written
 

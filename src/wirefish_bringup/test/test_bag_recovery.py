@@ -6,14 +6,16 @@ Every bag is read with rosbags (an independent MCAP reader), never with our own 
 
 from pathlib import Path
 
+from mcap.reader import make_reader
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from wirefish_bringup import cli, mcap_records as rec
-from wirefish_bringup.bag_storage import (IncompleteFile, next_file_path, read_file_info,
+from wirefish_bringup import cli
+from wirefish_bringup.bag_storage import (IncompleteFile, MAGIC, next_file_path, read_file_info,
                                           storage_files)
 from wirefish_bringup.recorder import open_bag_file
 from wirefish_bringup.reindex import reindex
+from wirefish_bringup.sequence_gaps import loss_line, recording_losses
 import yaml
 
 SEED = 20261201
@@ -65,7 +67,7 @@ def test_reindex_recovers_every_flushed_message_of_a_killed_bag(killed_bag, type
 
 def _cut_points(written, count: int) -> list[int]:
     rng = np.random.default_rng(SEED)
-    header_end = len(rec.MAGIC) + 1
+    header_end = len(MAGIC) + 1
     return sorted(int(c) for c in rng.integers(header_end, written.flush_ends[-1], count))
 
 
@@ -148,22 +150,36 @@ def test_a_bag_of_several_files_reads_as_one(killed_bag, typestore, write_bag):
     assert metadata(killed_bag.bag_dir)['relative_file_paths'] == ['bag_0.mcap', 'bag_1.mcap']
 
 
-@pytest.mark.parametrize('encoded, decode, expected', [
-    (rec.schema(3, 'a/msg/B', 'ros2msg', 'int32 x'), rec.decode_schema,
-     rec.SchemaRecord(3, 'a/msg/B', 'ros2msg', 'int32 x')),
-    (rec.channel(2, 3, '/t', 'cdr', {'k': 'v'}), rec.decode_channel,
-     rec.ChannelRecord(2, 3, '/t', 'cdr', {'k': 'v'})),
-    (rec.message(2, 2**32 + 5, 77, b'xyz'), rec.decode_message,
-     rec.MessageRecord(2, 5, 77, b'xyz')),
+def test_every_message_keeps_its_sequence_number_and_publish_time(finished_bag):
+    with finished_bag.path.open('rb') as file:
+        messages = [m for _, _, m in make_reader(file).iter_messages()]
+    assert [m.sequence for m in messages] == list(range(120))
+    assert all(m.publish_time == m.log_time - 500 for m in messages)
+
+
+def test_a_sequence_number_beyond_32_bits_wraps_as_mcap_stores_it(tmp_path, write_bag):
+    written = write_bag(tmp_path / 'bag', flushes=1, per_flush=2, first=2**32 + 5)
+    with written.path.open('rb') as file:
+        assert [m.sequence for _, _, m in make_reader(file).iter_messages()] == [5, 6]
+
+
+def test_the_recorders_account_is_summed_into_custom_data(killed_bag, write_bag):
+    reindex(killed_bag.bag_dir)  # a killed file carries no account
+    for first in (1000, 2000):
+        write_bag(killed_bag.bag_dir, flushes=1, per_flush=2, first=first, recording={
+            'missing:/a': '2', 'missing:/b': 'unchecked', 'lag_max_s:/a': f'{first / 1e4}'})
+    custom = metadata(killed_bag.bag_dir)['custom_data']
+    assert custom == {'missing:/a': '4', 'missing:/b': 'unchecked', 'lag_max_s:/a': '0.2'}
+    assert recording_losses(custom) == {'/a': 4}
+    assert loss_line(custom) == 'recording: LOST 4 messages: /a 4'
+
+
+@pytest.mark.parametrize('custom, line', [
+    ({'missing:/a': '0', 'missing:/b': '0'}, 'recording: 0 lost on 2 topics'),
+    (None, 'recording: no account of loss (the recorder was killed before it closed the bag)'),
 ])
-def test_records_decode_to_what_was_encoded(encoded, decode, expected):
-    ((opcode, offset, content),) = list(rec.iter_records(encoded))
-    assert decode(content) == expected
-
-
-def test_a_record_running_past_the_end_is_an_error():
-    with pytest.raises(rec.RecordError, match='past the end'):
-        list(rec.iter_records(rec.message(1, 0, 0, b'abc')[:-1]))
+def test_a_run_says_what_it_lost(custom, line):
+    assert loss_line(custom) == line
 
 
 def test_bag_info_names_the_repair_for_a_killed_bag(killed_bag, capsys):

@@ -13,7 +13,7 @@ import sys
 
 from wirefish_bringup.bag_storage import (IncompleteFile, METADATA_FILE, read_file_info,
                                           rosbag2_metadata, storage_files)
-from wirefish_bringup.mcap_records import RecordError
+from wirefish_bringup.input_checks import bag_directory_problem
 from wirefish_bringup.reindex import reindex
 import yaml
 
@@ -54,8 +54,9 @@ def _counts(metadata: dict) -> tuple[list[str], dict[str, int]]:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish bag ...`; return the process exit code."""
-    if not args.bag.is_dir():
-        print(f'wirefish bag: {args.bag} is not a directory', file=sys.stderr)
+    problem = bag_directory_problem(args.bag)
+    if problem is not None:
+        print(f'wirefish bag {args.action}: {problem}', file=sys.stderr)
         return 2
     try:
         if args.action == 'reindex':
@@ -67,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         metadata = rosbag2_metadata([read_file_info(p) for p in storage_files(args.bag)])
         written = yaml.safe_load((args.bag / METADATA_FILE).read_text())
         _counts(written)
-    except (OSError, IncompleteFile, RecordError, KeyError, TypeError) as error:
+    except (OSError, IncompleteFile, KeyError, TypeError) as error:
         print(f'wirefish bag {args.action}: {error}{REINDEX_HINT}', file=sys.stderr)
         return 1
     if _counts(written) != _counts(metadata):

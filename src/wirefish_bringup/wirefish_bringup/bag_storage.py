@@ -3,24 +3,33 @@ A rosbag2 bag directory: its MCAP files and the metadata.yaml that rosbag2 Jazzy
 
 A bag is ``<dir>/metadata.yaml`` plus ``<dir>/<dir>_0.mcap``, ``<dir>_1.mcap``, ... (the names
 of rosbag2's split files; a recorder resumed after a kill adds the next one). metadata.yaml is
-always built from the files' own MCAP summaries, so it can never disagree with them.
+always built from the files' own MCAP summaries (read with the ``mcap`` library's reader), so
+it can never disagree with them. What the recorder counted (messages missing from the
+publishers' sequences, how late they were taken) is each file's ``wirefish_recording`` metadata
+record, summed over the files into metadata.yaml's ``custom_data``.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import os
 from pathlib import Path
 import re
+import struct
 
+from mcap.exceptions import McapError
+from mcap.reader import SeekingReader
 from rosbags.typesys.store import Typestore
 
-from wirefish_bringup import mcap_records as rec
-from wirefish_bringup.mcap_writer import McapWriter
+from wirefish_bringup.bag_writer import BagFileWriter, RECORDING_METADATA
+from wirefish_bringup.sequence_gaps import merged_recording
 import yaml
 
 METADATA_FILE = 'metadata.yaml'
 BAG_VERSION = 9  # rosbag2 metadata version of ROS 2 Jazzy
 QOS_KEY = 'offered_qos_profiles'  # the channel metadata keys rosbag2's MCAP plugin writes
 HASH_KEY = 'topic_type_hash'
+MAGIC = b'\x89MCAP0\r\n'
+# Errors of mcap's reader on bytes that are no (whole) MCAP file: a file's tail cut by a kill.
+READ_ERRORS = (McapError, struct.error, ValueError, EOFError, KeyError)
 
 
 class IncompleteFile(ValueError):
@@ -47,6 +56,7 @@ class FileInfo:
     end_ns: int
     message_count: int
     topics: tuple[TopicInfo, ...]
+    recording: dict[str, str] = field(default_factory=dict)  # the recorder's own account
 
 
 def _split_index(path: Path) -> int:
@@ -66,53 +76,51 @@ def next_file_path(bag_dir: Path) -> Path:
     return bag_dir / f'{bag_dir.name}_{index}.mcap'
 
 
-def add_topic(writer: McapWriter, typestore: Typestore, topic: str, type_name: str,
-              offered_qos_profiles: str) -> int:
-    """Add ``topic`` to ``writer`` with its type's definition from ``typestore``; return its id."""
+def add_topic(writer: BagFileWriter, typestore: Typestore, topic: str, type_name: str,
+              offered_qos_profiles: str, type_hash: str | None = None) -> int:
+    """
+    Add ``topic`` to ``writer`` with its type's definition from ``typestore``; return its id.
+
+    ``type_hash``: the RIHS01 hash the publishers announce (rosbag2 stores theirs); the
+    typestore's when None.
+    """
     definition, _ = typestore.generate_msgdef(type_name, ros_version=2)
     schema_id = writer.add_schema(type_name, 'ros2msg', definition)
     return writer.add_channel(topic, schema_id, {
-        QOS_KEY: offered_qos_profiles, HASH_KEY: typestore.hash_rihs01(type_name)})
-
-
-def _summary_section(path: Path) -> tuple[bytes, int, int]:
-    """Return the summary section's bytes and where it and its offsets start (footer first)."""
-    with path.open('rb') as file:
-        size = file.seek(0, os.SEEK_END)
-        file.seek(0)
-        if size < 2 * len(rec.MAGIC) + rec.FOOTER_SIZE or file.read(8) != rec.MAGIC:
-            raise rec.RecordError('too short, or not an MCAP file')
-        file.seek(size - rec.FOOTER_SIZE)
-        summary_start, offsets_start = rec.decode_footer(file.read(rec.FOOTER_SIZE))
-        if not 0 < summary_start <= offsets_start <= size - rec.FOOTER_SIZE:
-            raise rec.RecordError('the footer points to no summary')
-        file.seek(summary_start)
-        return file.read(size - rec.FOOTER_SIZE - summary_start), summary_start, offsets_start
+        QOS_KEY: offered_qos_profiles,
+        HASH_KEY: type_hash or typestore.hash_rihs01(type_name)})
 
 
 def read_file_info(path: Path) -> FileInfo:
     """Return what the summary of the MCAP file ``path`` says; IncompleteFile if it has none."""
-    try:
-        summary, summary_start, offsets_start = _summary_section(Path(path))
-        schemas, channels, counts, start_ns, end_ns = {}, [], None, 0, 0
-        for opcode, _, content in rec.iter_records(summary, 0, offsets_start - summary_start):
-            if opcode == rec.SCHEMA:
-                schema = rec.decode_schema(content)
-                schemas[schema.schema_id] = schema.name
-            elif opcode == rec.CHANNEL:
-                channels.append(rec.decode_channel(content))
-            elif opcode == rec.STATISTICS:
-                counts, start_ns, end_ns = rec.decode_statistics(content)
-    except rec.RecordError as error:
-        raise IncompleteFile(f'{path}: {error}') from error
-    if counts is None:
+    path = Path(path)
+    with path.open('rb') as file:
+        size = file.seek(0, os.SEEK_END)
+        file.seek(size - len(MAGIC) if size >= 2 * len(MAGIC) else 0)
+        # A killed file ends in the middle of a chunk: no closing magic, no footer to read.
+        if size < 2 * len(MAGIC) or file.read(len(MAGIC)) != MAGIC:
+            raise IncompleteFile(f'{path}: no footer (too short, or not a finished MCAP file)')
+        file.seek(0)
+        reader = SeekingReader(file)
+        try:
+            summary = reader.get_summary()
+            recording: dict[str, str] = {}
+            for record in reader.iter_metadata() if summary is not None else ():
+                if record.name == RECORDING_METADATA:
+                    recording.update(record.metadata)
+        except READ_ERRORS as error:
+            raise IncompleteFile(f'{path}: {error}') from error
+    if summary is None or summary.statistics is None:
         raise IncompleteFile(f'{path}: the summary has no statistics')
+    stats = summary.statistics
+    schemas = {i: s.name for i, s in summary.schemas.items()}
     topics = tuple(TopicInfo(c.topic, schemas.get(c.schema_id, ''), c.metadata.get(QOS_KEY, ''),
-                             c.metadata.get(HASH_KEY, ''), counts.get(c.channel_id, 0))
-                   for c in channels)
-    total = sum(counts.values())
-    return FileInfo(Path(path).name, start_ns if total else 0, end_ns if total else 0, total,
-                    topics)
+                             c.metadata.get(HASH_KEY, ''),
+                             stats.channel_message_counts.get(c.id, 0))
+                   for c in summary.channels.values())
+    total = stats.message_count
+    return FileInfo(path.name, stats.message_start_time if total else 0,
+                    stats.message_end_time if total else 0, total, topics, recording)
 
 
 def rosbag2_metadata(files: list[FileInfo]) -> dict:
@@ -155,7 +163,7 @@ def rosbag2_metadata(files: list[FileInfo]) -> dict:
             'duration': {'nanoseconds': f.end_ns - f.start_ns},
             'message_count': f.message_count,
         } for f in files],
-        'custom_data': None,
+        'custom_data': merged_recording([f.recording for f in files]) or None,
         'ros_distro': 'jazzy',
     }}
 

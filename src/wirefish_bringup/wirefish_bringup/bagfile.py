@@ -15,16 +15,36 @@ def wirefish_typestore() -> Typestore:
     """
     Return the ROS 2 Jazzy type store extended with the workspace's own messages.
 
-    The definitions are read from the installed ``.msg`` files, so a bag carries exactly the
-    definitions the nodes were built with.
+    The definitions are read from the installed ``.msg`` and ``.action`` files, so a bag
+    carries exactly the definitions the nodes were built with. An action's feedback topic
+    (``<action>/_action/feedback``) carries ``<pkg>/action/<Name>_FeedbackMessage``: the goal's
+    UUID and the feedback section of the ``.action`` file.
     """
     store = get_typestore(Stores.ROS2_JAZZY)
     types = {}
     for package in INTERFACE_PACKAGES:
-        for path in sorted(Path(get_package_share_directory(package), 'msg').glob('*.msg')):
+        share = Path(get_package_share_directory(package))
+        for path in sorted((share / 'msg').glob('*.msg')):
             types.update(get_types_from_msg(path.read_text(), f'{package}/msg/{path.stem}'))
+        for path in sorted((share / 'action').glob('*.action')):
+            types.update(action_feedback_types(package, path.stem, path.read_text()))
     store.register(types)
     return store
+
+
+def action_feedback_types(package: str, action: str, text: str) -> dict:
+    """
+    Return the types of ``action``'s feedback message, from its ``.action`` text.
+
+    The feedback section is named ``<pkg>/msg/<Action>_Feedback`` in the bag's definitions:
+    rosbags writes nested types only under ``msg`` (the bytes on the wire are the same).
+    """
+    feedback_section = text.split('\n---\n')[2]
+    feedback = f'{package}/msg/{action}_Feedback'
+    types = dict(get_types_from_msg(feedback_section, feedback))
+    types.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{feedback} feedback',
+                                    f'{package}/action/{action}_FeedbackMessage'))
+    return types
 
 
 @dataclass

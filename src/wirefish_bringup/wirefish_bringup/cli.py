@@ -14,6 +14,8 @@ import sys
 # so `wirefish --help` stays fast and a plotting dependency never slows `wirefish up`.
 SUBCOMMANDS = {
     'up': ('wirefish_bringup.launcher', 'start the whole graph (virtual fish by default)'),
+    'qemu': ('wirefish_bringup.qemu_board',
+             "the firmware's ARM build on an emulated board (QEMU), its link on a pty"),
     'record': ('wirefish_bringup.record', 'record the graph into a rosbag2 (MCAP) bag'),
     'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait action)'),
     'gaits': ('wirefish_bringup.gaits', 'build, list and plot the gait library'),

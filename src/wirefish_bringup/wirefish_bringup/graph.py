@@ -36,6 +36,8 @@ _NAMESPACE_PATTERN = re.compile(r'^(/[A-Za-z][A-Za-z0-9_]*)+$|^/$')
 # When an entry is part of the graph: always, only with the virtual fish, only when recording,
 # only when the fish runs apart from its shore (role fish: the link relay, see crossing.py).
 ALWAYS, SIM, RECORD, APART = 'always', 'sim', 'record', 'apart'
+# Only with the emulated board: the firmware's ARM build in QEMU (`wirefish up --fish qemu`).
+QEMU = 'qemu'
 # Which side of the radio link an entry runs on. The fish side is everything that
 # keeps the fish safe and swimming without shore; the shore side only tunes, records, drives.
 FISH, SHORE, ALL = 'fish', 'shore', 'all'
@@ -150,6 +152,10 @@ NODES: tuple[NodeEntry, ...] = (
     NodeEntry('wirefish_sim', 'fish_sim', 'fish_sim', start_order=0, when=SIM,
               arguments=('--link', '{device}', '--ros'), creates_link=True, frames=True,
               restart=RestartPolicy(required=True), rates_hz={'sim/ground_truth': 50.0}),
+    # The firmware on an emulated STM32F405 (qemu_board): no physics, so no sim/ground_truth.
+    NodeEntry('wirefish_bringup', 'wirefish', 'qemu_fish', start_order=0, when=QEMU,
+              arguments=('qemu', '--link', '{device}'), creates_link=True, ros_args=False,
+              restart=RestartPolicy(required=True)),
     NodeEntry('wirefish_bridge', 'bridge_node', 'bridge_node', start_order=10,
               node_class='wirefish_bridge.bridge_node:BridgeNode',
               parameters={'port': '{device}'}, restart=RestartPolicy(required=True), frames=True,
@@ -260,23 +266,32 @@ def default_params_file() -> Path:
     return Path(get_package_share_directory('wirefish_bringup'), 'config', PARAMS_FILE_NAME)
 
 
+def qemu_tty_link(namespace: str) -> Path:
+    """Return the symlink path under which the emulated board publishes its USART1 pty."""
+    token = validate_namespace(namespace).strip('/').replace('/', '_') or 'root'
+    return Path('/tmp', f'wirefish-{token}-qemu-tty')
+
+
 def sim_tty_link(namespace: str) -> Path:
     """Return the symlink path under which the virtual fish publishes its pseudo-terminal."""
     token = validate_namespace(namespace).strip('/').replace('/', '_') or 'root'
     return Path('/tmp', f'wirefish-{token}-tty')
 
 
-def entries(*, sim: bool, record: bool = False, role: str = ALL) -> list[NodeEntry]:
+def entries(*, sim: bool, record: bool = False, role: str = ALL,
+            qemu: bool = False) -> list[NodeEntry]:
     """
     Return the registry entries of a graph, in start order.
 
     ``sim``: with the virtual fish; ``record``: with the recorder; ``role``: one side of the
     radio link (FISH, SHORE) or both on one machine (ALL). The link relay runs with the fish
-    role only: with both sides on one host nothing crosses a radio.
+    role only: with both sides on one host nothing crosses a radio. ``qemu``: with the
+    emulated board (the firmware in QEMU) as the fish.
     """
     if role not in ROLES:
         raise ValueError(f'unknown role {role!r}: choose one of {", ".join(ROLES)}')
-    active = {ALWAYS, *([SIM] if sim else []), *([RECORD] if record else []),
+    active = {ALWAYS, *([SIM] if sim else []), *([QEMU] if qemu else []),
+              *([RECORD] if record else []),
               *([APART] if role == FISH else [])}
     return sorted((e for e in NODES if e.when in active and role in (ALL, e.role)),
                   key=lambda e: e.start_order)
@@ -328,7 +343,7 @@ def expected_rates(*, sim: bool = True) -> tuple[dict[str, float], dict[str, flo
 def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
                port: str | None = None, params_file: Path | str | None = None,
                single_process: bool = False, bag: Path | None = None, role: str = ALL,
-               frame_prefix: str = '') -> list[NodeSpec]:
+               frame_prefix: str = '', qemu: bool = False) -> list[NodeSpec]:
     """
     Return the processes of one fish's graph, in start order (the virtual fish first).
 
@@ -338,9 +353,14 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     ``single_process`` runs the ROS nodes with a node class in one process (`wirefish
     compose`); ``bag`` adds the recorder, writing there; ``role`` starts one side of the radio
     link only (FISH or SHORE; ALL: both); ``frame_prefix`` goes to every node that writes frame
-    ids (``fish_1``: ``fish_1/base_link``).
+    ids (``fish_1``: ``fish_1/base_link``); ``qemu`` (with ``sim`` False): the fish is the
+    firmware on an emulated board, the bridge on its pty.
     """
     namespace = validate_namespace(namespace)
+    if qemu and (sim or port):
+        raise ValueError('the emulated board is the fish: no virtual fish or port with it')
+    if qemu:
+        port = str(qemu_tty_link(namespace))
     if not sim and not port:
         raise ValueError('a real fish needs its serial port (e.g. --port /dev/ttyUSB0)')
     if sim and port:  # e.g. `ros2 launch ... port:=/dev/ttyUSB0` without sim:=false
@@ -361,7 +381,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
         raise ValueError('the single-process mode hosts one whole fish (wirefish compose): '
                          'a role or a frame prefix needs one process per node')
     with_prefix = {'frame_prefix': frame_prefix} if frame_prefix else {}
-    for e in entries(sim=sim, record=bag is not None, role=role):
+    for e in entries(sim=sim, record=bag is not None, role=role, qemu=qemu):
         if single_process and e.node_class is not None:
             composed.append(e)
             continue

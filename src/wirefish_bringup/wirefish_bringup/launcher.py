@@ -18,6 +18,7 @@ import sys
 import time
 
 from wirefish_bringup.cli import duration_s
+from wirefish_bringup.errors import QemuBoardError
 from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
                                     validate_namespace)
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
@@ -45,6 +46,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     target.add_argument('--sim', action='store_true', default=True,
                         help='drive the virtual fish on a pseudo-terminal (default)')
     target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
+    target.add_argument('--fish', choices=('sim', 'qemu'), default=None,
+                        help='sim: the virtual fish (as --sim); qemu: the firmware on an '
+                        'emulated STM32F405 (QEMU; built with make -C firmware qemu), the bridge '
+                        'on its pty (no physics: no sim/ground_truth)')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
                         help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
     parser.add_argument('--role', choices=ROLES, default=ALL,
@@ -207,9 +212,10 @@ def run(args: argparse.Namespace) -> int:
     bag_path = run_dir / 'bag' if args.duration else None
     try:
         namespace = validate_namespace(args.namespace)
-        sim = args.port is None
+        qemu = args.fish == 'qemu'
+        sim = args.port is None and not qemu
         if args.fleet is not None:
-            if args.port is not None or args.single_process or args.frame_prefix:
+            if args.port is not None or qemu or args.single_process or args.frame_prefix:
                 raise ValueError('--fleet starts virtual fish, one process per node, each '
                                  'with frames fish_<i>/...: no --port, --single-process or '
                                  '--frame-prefix with it')
@@ -219,10 +225,17 @@ def run(args: argparse.Namespace) -> int:
         else:
             specs = fish_graph(namespace, sim=sim, port=args.port,
                                params_file=args.params_file, single_process=args.single_process,
-                               bag=bag_path, role=args.role, frame_prefix=args.frame_prefix)
+                               bag=bag_path, role=args.role, frame_prefix=args.frame_prefix,
+                               qemu=qemu)
+            if qemu:
+                from wirefish_bringup.qemu_board import build_image
+                build_image()
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2
+    except QemuBoardError as error:
+        print(f'wirefish up: {error}', file=sys.stderr)
+        return 1
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
@@ -257,9 +270,10 @@ def run(args: argparse.Namespace) -> int:
                 proc = supervisor.start(spec)
                 if spec.link is not None:
                     if not wait_for_path(spec.link, [proc], DEVICE_TIMEOUT_S):
-                        raise RuntimeError('the virtual fish did not open its pseudo-terminal:\n'
+                        raise RuntimeError(f'{spec.name} did not open its pseudo-terminal:\n'
                                            + supervisor.log_tail(spec.name))
-                    print(f'virtual fish on {spec.link} -> {spec.link.resolve()}')
+                    fish = 'emulated board' if qemu else 'virtual fish'
+                    print(f'{fish} on {spec.link} -> {spec.link.resolve()}')
             print(f'started {len(supervisor.processes)} processes in {namespace}; '
                   f'logs in {run_dir / "logs"}', flush=True)
             status = _wait_ready(node, executor, namespace, specs, supervisor,

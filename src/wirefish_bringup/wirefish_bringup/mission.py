@@ -14,15 +14,18 @@ import argparse
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
+import shutil
 import sys
 
 CMD_RATE_HZ = 20.0
 DISCOVERY_TIMEOUT_S = 30.0
+HINT_AFTER_S = 5.0  # of waiting for the graph, before saying what is waited for
 SHIPPED = ('square',)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish mission`."""
+    from wirefish_bringup.cli import duration_s
     from wirefish_bringup.graph import DEFAULT_NAMESPACE
 
     parser.add_argument('mission',
@@ -31,6 +34,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('-o', '--output', type=Path, default=None,
                         help='directory for the bag and the PNG '
                         '(default: out/missions/<name>_<time>); must not exist')
+    parser.add_argument('--wait', type=duration_s, default=DISCOVERY_TIMEOUT_S,
+                        help="how long to wait for the graph's planner_state and ground truth "
+                        '(s, default %(default)g)')
 
 
 def mission_path(text: str) -> Path:
@@ -58,13 +64,19 @@ def run(args: argparse.Namespace) -> int:
     if out.exists():
         print(f'wirefish mission: {out} exists; choose a new -o', file=sys.stderr)
         return 2
+    created = [d for d in (out, *out.parents) if not d.exists()]
     out.mkdir(parents=True)
     bag_path = out / 'bag'
-    t0, problem = _drive(mission, namespace, bag_path)
+    t0, problem = _drive(mission, namespace, bag_path, args.wait)
+    if t0 is None:  # no leg was sent: nothing to keep
+        shutil.rmtree(out, ignore_errors=True)
+        for directory in created[1:]:
+            if directory.exists() and not any(directory.iterdir()):
+                directory.rmdir()
     if problem is not None:
         print(f'wirefish mission: {problem}', file=sys.stderr)
         return 1
-    return _report(mission, namespace, bag_path, out, t0)
+    return _report(mission, namespace, bag_path, out, t0 or 0.0)
 
 
 @dataclass
@@ -76,8 +88,13 @@ class _Run:
     done: bool = False
 
 
-def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
-    """Send the legs and record; return (first leg's start on the node clock s, problem)."""
+def _drive(mission, namespace: str, bag_path: Path,
+           wait_s: float) -> tuple[float | None, str | None]:
+    """
+    Send the legs and record; return (first leg's start on the node clock s, problem).
+
+    The start is None when no leg was sent (no graph within ``wait_s``, or interrupted first).
+    """
     from geometry_msgs.msg import Twist
     import rclpy
     from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -94,7 +111,7 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
     signals.attach(node)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
-    executor.add_node(recorder)
+    recorder.start_thread()  # takes its messages itself, beside the executor
     reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     publisher = node.create_publisher(Twist, 'cmd_vel', reliable)
     heard: list[PlannerState] = []
@@ -102,6 +119,7 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
     run = _Run()
     started = node.get_clock().now().nanoseconds * 1e-9
+    hinted = []
 
     def now() -> float:
         return node.get_clock().now().nanoseconds * 1e-9
@@ -109,15 +127,19 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
     def tick() -> None:
         t = now()
         if run.t0 is None:
-            if heard and recorder.counts.get(truth_topic, 0) > 0:
+            if heard and recorder.count(truth_topic) > 0:
                 run.t0 = t + mission.rest_s
                 print(f'mission {mission.name}: {len(mission.legs)} legs, '
                       f'{mission.duration_s:.1f} s, recording to {bag_path}', flush=True)
-            elif t - started > DISCOVERY_TIMEOUT_S:
+            elif t - started > wait_s:
                 run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
-                               f'within {DISCOVERY_TIMEOUT_S:g} s: are the graph and '
-                               'the planner running?')
+                               f'within {wait_s:g} s: are the graph and the planner running? '
+                               f'(wirefish up --namespace {namespace}); nothing was written')
                 rclpy.try_shutdown()
+            elif t - started > HINT_AFTER_S and not hinted:
+                hinted.append(t)
+                print(f'wirefish mission: waiting for planner_state and sim/ground_truth '
+                      f'under {namespace} (is the graph running?)', file=sys.stderr, flush=True)
             return
         command = mission.command_at(t - run.t0)
         if command is not None:
@@ -140,8 +162,9 @@ def _drive(mission, namespace: str, bag_path: Path) -> tuple[float, str | None]:
         node.destroy_node()
         rclpy.try_shutdown()
     if run.problem is None and not run.done:
-        run.problem = f'interrupted; the bag so far is in {bag_path}'
-    return run.t0 or 0.0, run.problem
+        run.problem = (f'interrupted; the bag so far is in {bag_path}' if run.t0 is not None
+                       else 'interrupted before the first leg; nothing was written')
+    return run.t0, run.problem
 
 
 def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float) -> int:

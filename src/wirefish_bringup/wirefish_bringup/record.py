@@ -7,7 +7,7 @@ import sys
 
 from wirefish_bringup.cli import duration_s
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
-from wirefish_bringup.sequence_gaps import SequenceGaps
+from wirefish_bringup.sequence_gaps import loss_line, recording_account, TopicAccount
 
 NOTHING_TIMEOUT_S = 30.0
 
@@ -28,8 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish record`; return the process exit code."""
+    import time
+
     import rclpy
-    from rclpy.executors import ExternalShutdownException
     from rclpy.signals import SignalHandlerOptions
 
     from wirefish_bringup.recorder import BagRecorder
@@ -47,7 +48,9 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
     bag_path.parent.mkdir(parents=True, exist_ok=True)
-    signals = SignalShutdown()  # Ctrl-C between callbacks: the bag is closed cleanly
+    # Ctrl-C and SIGTERM set a flag the recording loop reads between two takes: the readers
+    # are drained and the bag is closed cleanly.
+    signals = SignalShutdown()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     try:
         recorder = BagRecorder(bag_path, namespace, resume=args.resume)
@@ -55,49 +58,46 @@ def run(args: argparse.Namespace) -> int:
         rclpy.try_shutdown()
         print(f'wirefish record: {error}', file=sys.stderr)
         return 2
-    signals.attach(recorder)
-    if args.duration is not None:
-        started_ns = recorder.get_clock().now().nanoseconds
+    started_ns = time.time_ns()
 
-        def stop_when_done() -> None:
-            now = recorder.get_clock().now().nanoseconds
-            first = recorder.first_message_ns
-            # Discovery can take a few seconds on a loaded machine: the duration counts from
-            # the first message, with a bound for a graph that never publishes anything.
-            if (first is not None and now - first >= args.duration * 1e9) or \
-                    now - started_ns >= (args.duration + NOTHING_TIMEOUT_S) * 1e9:
-                rclpy.try_shutdown()
-        recorder.create_timer(0.02, stop_when_done)
+    def stopped() -> bool:
+        if signals.requested:
+            return True
+        if args.duration is None:
+            return False
+        now, first = time.time_ns(), recorder.first_message_ns
+        # Discovery can take a few seconds on a loaded machine: the duration counts from
+        # the first message, with a bound for a graph that never publishes anything.
+        return (first is not None and now - first >= args.duration * 1e9) or \
+            now - started_ns >= (args.duration + NOTHING_TIMEOUT_S) * 1e9
     try:
-        rclpy.spin(recorder)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        recorder.record(stopped)
     finally:
         recorder.close()
-        counts = dict(recorder.counts)
-        lost = dict(recorder.lost)
-        sequences = dict(recorder.sequences)
+        accounts = dict(recorder.accounts)
         recorder.destroy_node()
         rclpy.try_shutdown()
-    print(recording_summary(bag_path, counts, lost, sequences), flush=True)
+    print(recording_summary(bag_path, accounts), flush=True)
     return 0
 
 
-def recording_summary(bag_path: Path, counts: dict[str, int], lost: dict[str, int],
-                      sequences: dict[str, SequenceGaps]) -> str:
+def recording_summary(bag_path: Path, accounts: dict[str, TopicAccount]) -> str:
     """
-    Return what was written and what never arrived, per topic.
+    Return what was written, what never arrived and how late it came, per topic; then the loss.
 
-    'lost in transport' is the middleware's own count; 'missing' counts the numbers absent from
-    each publisher's sequence between its first and last sample in the bag (every cause of loss;
-    not checked on a topic where a second publisher appeared).
+    'missing' counts the numbers absent from each publisher's sequence between its first and
+    last sample in the bag: every cause of loss (in transport, a reader's history overrun); not
+    checked on a topic where a second publisher appeared. 'lag' is the longest a message waited
+    between its publication and the bag.
     """
-    checked = {t: s for t, s in sequences.items() if not s.ambiguous}
-    lines = [f'wrote {sum(counts.values())} messages on {len(counts)} topics to {bag_path}; '
-             f"lost in transport: {sum(lost.values())}; missing from the publishers' "
-             f'sequences: {sum(s.missing for s in checked.values())}']
-    for topic, count in sorted(counts.items()):
+    checked = {t: a.sequence for t, a in accounts.items() if not a.sequence.ambiguous}
+    total_missing = sum(s.missing for s in checked.values())
+    lines = [f'wrote {sum(a.count for a in accounts.values())} messages on {len(accounts)} '
+             f"topics to {bag_path}; missing from the publishers' sequences: {total_missing}"]
+    for topic, account in sorted(accounts.items()):
         missing = (f'missing {checked[topic].missing}' if topic in checked
                    else 'several publishers: sequence not checked')
-        lines.append(f'  {topic:<40} {count:>7} (lost {lost[topic]}, {missing})')
+        lines.append(f'  {topic:<40} {account.count:>7} ({missing}, lag max '
+                     f'{account.lag_max_ns * 1e-9:.2f} s)')
+    lines.append(loss_line(recording_account(accounts)))
     return '\n'.join(lines)

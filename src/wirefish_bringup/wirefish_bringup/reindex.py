@@ -9,16 +9,17 @@ of the old one (an atomic rename: a reindex that is itself killed changes nothin
 metadata.yaml from the summaries of all the bag's files. Finished files are left as they are.
 """
 
-from collections.abc import Callable, Generator, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
-import mmap
 import os
 from pathlib import Path
 
-from wirefish_bringup import mcap_records as rec
-from wirefish_bringup.bag_storage import (IncompleteFile, read_file_info, storage_files,
-                                          write_metadata)
-from wirefish_bringup.mcap_writer import McapWriter
+from mcap.records import Channel, Chunk, DataEnd, Footer, Message, Schema
+from mcap.stream_reader import breakup_chunk, StreamReader
+
+from wirefish_bringup.bag_storage import (IncompleteFile, MAGIC, READ_ERRORS, read_file_info,
+                                          storage_files, write_metadata)
+from wirefish_bringup.bag_writer import BagFileWriter
 
 
 @dataclass(frozen=True)
@@ -28,76 +29,66 @@ class Recovery:
     name: str
     chunks: int
     messages: int
-    # Chunks framed whole whose content failed its CRC or could not be decoded (or compressed:
-    # the recorder never compresses).
+    # Chunks framed whole whose content failed its CRC or could not be decoded.
     damaged_chunks: int
     orphan_messages: int  # messages whose channel or type was defined in a damaged chunk
     dropped_tail_bytes: int  # from the end of the last whole record to the end of the file
 
 
-Decoded = rec.SchemaRecord | rec.ChannelRecord | rec.MessageRecord
-DECODERS: dict[int, Callable[[memoryview], Decoded]] = {
-    rec.SCHEMA: rec.decode_schema, rec.CHANNEL: rec.decode_channel,
-    rec.MESSAGE: rec.decode_message}
+Decoded = Schema | Channel | Message
 
 
 @dataclass
 class _Scan:
     damaged_chunks: int = 0
-    end: int = len(rec.MAGIC)  # offset just past the last whole record
+    end: int = len(MAGIC)  # offset just past the last whole record
 
 
-def _decode_all(records: memoryview) -> list[Decoded]:
-    return [DECODERS[opcode](content) for opcode, _, content in rec.iter_records(records)
-            if opcode in DECODERS]
-
-
-def _intact_chunks(data: memoryview, scan: _Scan) -> Generator[list[Decoded], None, None]:
+def _intact_chunks(file, size: int, scan: _Scan) -> Iterator[list[Decoded]]:
     """
-    Yield the decoded records of each intact chunk of an MCAP file's data, in file order.
+    Yield the records of each intact chunk of an MCAP file, in file order (mcap's reader).
 
     Records at the top level (some writers leave schemas, channels or messages unchunked) count
-    as chunks of one record. A record cut short or an unknown opcode ends the data: nothing after
-    it can be framed. A chunk whose framing is whole but whose content is damaged is skipped.
+    as chunks of one record. A record cut short, or one longer than the rest of the file, ends
+    the data: nothing after it can be framed. A chunk whose framing is whole but whose content
+    fails its CRC or cannot be decoded is skipped.
     """
-    if bytes(data[:len(rec.MAGIC)]) != rec.MAGIC:
-        raise rec.RecordError('not an MCAP file (no magic)')
+    reader = StreamReader(file, emit_chunks=True, record_size_limit=size)
     try:
-        for opcode, offset, content in rec.iter_records(data, len(rec.MAGIC)):
-            if opcode not in rec.KNOWN_OPCODES or opcode in (rec.DATA_END, rec.FOOTER):
+        for record in reader.records:
+            if isinstance(record, (DataEnd, Footer)):
                 return
-            scan.end = offset + rec.RECORD_PREFIX.size + len(content)
-            if opcode == rec.CHUNK:
+            scan.end = file.tell()  # the reader has consumed exactly this record
+            if isinstance(record, Chunk):
                 try:
-                    decoded = _decode_all(rec.decode_chunk(content))
-                except rec.RecordError:
+                    yield [r for r in breakup_chunk(record, validate_crc=True)
+                           if isinstance(r, (Schema, Channel, Message))]
+                except READ_ERRORS:
                     scan.damaged_chunks += 1
-                    continue
-                yield decoded
-            elif opcode in DECODERS:
-                yield _decode_all(data[offset:scan.end])
-    except rec.RecordError:
+            elif isinstance(record, (Schema, Channel, Message)):
+                yield [record]
+    except READ_ERRORS:
         return  # a truncated tail: the data ends at the last whole record
 
 
-def _copy(chunks: Iterator[list[Decoded]], writer: McapWriter) -> tuple[int, int, int]:
+def _copy(chunks: Iterator[list[Decoded]], writer: BagFileWriter) -> tuple[int, int, int]:
     """Write the chunks' records through ``writer``; return (chunks, messages, orphans)."""
     schema_ids: dict[int, int] = {}
     channel_ids: dict[int, int] = {}
     count = messages = orphans = 0
     for records in chunks:
         for record in records:
-            if isinstance(record, rec.SchemaRecord):
-                schema_ids[record.schema_id] = writer.add_schema(
-                    record.name, record.encoding, record.data)
-            elif isinstance(record, rec.ChannelRecord):
+            if isinstance(record, Schema):
+                schema_ids[record.id] = writer.add_schema(
+                    record.name, record.encoding, record.data.decode())
+            elif isinstance(record, Channel):
                 if record.schema_id in schema_ids:  # else its type is lost: orphans follow
-                    channel_ids[record.channel_id] = writer.add_channel(
+                    channel_ids[record.id] = writer.add_channel(
                         record.topic, schema_ids[record.schema_id], record.metadata,
-                        record.encoding)
+                        record.message_encoding)
             elif record.channel_id in channel_ids:
-                writer.write(channel_ids[record.channel_id], record.log_time_ns, record.data,
-                             record.sequence)
+                writer.write(channel_ids[record.channel_id], record.log_time, record.data,
+                             record.sequence, record.publish_time)
                 messages += 1
             else:
                 orphans += 1
@@ -109,7 +100,7 @@ def _copy(chunks: Iterator[list[Decoded]], writer: McapWriter) -> tuple[int, int
 def rebuild(source: Path, target: Path) -> Recovery:
     """Write the intact chunks of ``source`` into a new, finished MCAP file ``target``."""
     scan = _Scan()
-    writer = McapWriter(target)
+    writer = BagFileWriter(target)
     try:
         with Path(source).open('rb') as file:
             size = os.fstat(file.fileno()).st_size
@@ -117,15 +108,10 @@ def rebuild(source: Path, target: Path) -> Recovery:
                 chunks = messages = orphans = 0
                 scan.end = 0
             else:
-                # Mapped, not read: a long recording need not fit in memory.
-                with mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ) as data:
-                    view = memoryview(data)
-                    intact = _intact_chunks(view, scan)
-                    try:
-                        chunks, messages, orphans = _copy(intact, writer)
-                    finally:
-                        intact.close()  # drops its views of the map, so the map can close
-                        view.release()
+                if file.read(len(MAGIC)) != MAGIC:
+                    raise IncompleteFile(f'{source}: not an MCAP file (no magic)')
+                file.seek(0)
+                chunks, messages, orphans = _copy(_intact_chunks(file, size, scan), writer)
     finally:
         writer.close()
     return Recovery(Path(source).name, chunks, messages, scan.damaged_chunks, orphans,
@@ -154,7 +140,7 @@ def reindex(bag_dir: Path) -> list[Recovery]:
         tmp.unlink(missing_ok=True)  # left by a reindex that was itself interrupted
         try:
             recoveries.append(rebuild(path, tmp))
-        except rec.RecordError as error:
+        except IncompleteFile as error:
             tmp.unlink(missing_ok=True)
             raise IncompleteFile(f'{path}: cannot be recovered: {error}') from error
         os.replace(tmp, path)

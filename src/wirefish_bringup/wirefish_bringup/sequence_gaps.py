@@ -10,9 +10,17 @@ exactly, where gaps in the header stamps also hold timer ticks that a starved pu
 
 Sequence numbers belong to one writer; a topic with several publishers interleaves several
 sequences, so its count is only exact while one publisher is seen (``ambiguous`` says when not).
+
+A recording's account of each topic (``TopicAccount``) is kept in the bag as strings
+(``recording_account``: metadata.yaml's ``custom_data``, one ``<key>:<topic>`` per figure), and
+``loss_line`` is what a run says of it at its end.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+MISSING_KEY = 'missing'  # numbers absent from the publisher's sequence ('unchecked': several)
+LAG_KEY = 'lag_max_s'  # the most a message waited between its publication and the bag
+UNCHECKED = 'unchecked'
 
 
 @dataclass
@@ -41,3 +49,62 @@ class SequenceGaps:
     def ambiguous(self) -> bool:
         """Return True when another writer appeared, so ``missing`` may be off."""
         return self.restarts > 0
+
+
+@dataclass
+class TopicAccount:
+    """What a recorder took of one topic."""
+
+    count: int = 0
+    sequence: SequenceGaps = field(default_factory=SequenceGaps)
+    lag_max_ns: int = 0  # take time minus the publisher's source timestamp
+
+
+def recording_account(accounts: dict[str, TopicAccount]) -> dict[str, str]:
+    """Return each topic's missing count and worst lag, as the bag's custom_data keeps them."""
+    recording = {}
+    for topic, account in sorted(accounts.items()):
+        sequence = account.sequence
+        recording[f'{MISSING_KEY}:{topic}'] = (UNCHECKED if sequence.ambiguous
+                                               else str(sequence.missing))
+        recording[f'{LAG_KEY}:{topic}'] = f'{account.lag_max_ns * 1e-9:.3f}'
+    return recording
+
+
+def merged_recording(parts: list[dict[str, str]]) -> dict[str, str]:
+    """Return several files' accounts as one: missing numbers summed, the worst lag."""
+    merged: dict[str, str] = {}
+    for part in parts:
+        for key, value in part.items():
+            kind, _, _ = key.partition(':')
+            old = merged.get(key)
+            if old is None:
+                merged[key] = value
+            elif kind == MISSING_KEY:
+                merged[key] = (UNCHECKED if UNCHECKED in (old, value)
+                               else str(int(old) + int(value)))
+            elif kind == LAG_KEY:
+                merged[key] = str(max(float(old), float(value)))
+    return merged
+
+
+def recording_losses(custom_data: dict | None) -> dict[str, int]:
+    """Return {topic: messages missing} of a bag's ``custom_data`` (checked topics only)."""
+    losses = {}
+    for key, value in (custom_data or {}).items():
+        kind, _, topic = str(key).partition(':')
+        if kind == MISSING_KEY and str(value) != UNCHECKED:
+            losses[topic] = int(value)
+    return losses
+
+
+def loss_line(custom_data: dict | None) -> str:
+    """Return 'recording: 0 lost ...' or 'recording: LOST n messages: <topic> <count>, ...'."""
+    losses = recording_losses(custom_data)
+    if not losses:
+        return 'recording: no account of loss (the recorder was killed before it closed the bag)'
+    lost = {t: n for t, n in sorted(losses.items()) if n}
+    if not lost:
+        return f'recording: 0 lost on {len(losses)} topics'
+    return (f'recording: LOST {sum(lost.values())} messages: '
+            + ', '.join(f'{t} {n}' for t, n in lost.items()))

@@ -12,10 +12,34 @@ import yaml
 DIAGNOSTICS_TOPIC = '/diagnostics'
 
 
+ACTION_MESSAGES = ('_FeedbackMessage', '_SendGoal_Request', '_SendGoal_Response',
+                   '_GetResult_Request', '_GetResult_Response')
+
+
 def message_class(type_name: str) -> type:
-    """Return the Python class of a ROS message type such as ``sensor_msgs/msg/Imu``."""
+    """
+    Return the Python class of a ROS message type such as ``sensor_msgs/msg/Imu``.
+
+    An action's hidden types (``pkg/action/Name_FeedbackMessage``, on its ``_action/feedback``
+    topic) are classes of the action's ``Impl``.
+    """
     package, kind, name = type_name.split('/')
-    return getattr(importlib.import_module(f'{package}.{kind}'), name)
+    module = importlib.import_module(f'{package}.{kind}')
+    if kind == 'action':
+        for suffix in ACTION_MESSAGES:
+            if name.endswith(suffix):
+                impl = getattr(module, name[:-len(suffix)]).Impl
+                return getattr(impl, suffix[1:].replace('_', ''))
+    return getattr(module, name)
+
+
+def type_hash(node: Node, topic: str) -> str | None:
+    """Return the RIHS01 type hash ``topic``'s first publisher announces (None if unknown)."""
+    for info in node.get_publishers_info_by_topic(topic):
+        text = str(info.topic_type_hash)
+        if text.startswith('RIHS01_'):
+            return text
+    return None
 
 
 def graph_topics(node: Node, namespace: str) -> dict[str, str]:
