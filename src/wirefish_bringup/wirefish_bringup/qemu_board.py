@@ -127,7 +127,8 @@ class QemuBoard:
     @property
     def pid(self) -> int | None:
         """Return QEMU's pid while it runs, else None."""
-        return self._proc.pid if self.running() else None
+        proc = self._proc
+        return proc.pid if proc is not None and proc.poll() is None else None
 
     def running(self) -> bool:
         """Return True while QEMU runs."""
