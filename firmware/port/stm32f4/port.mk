@@ -25,7 +25,16 @@ ARM_PORT_SRCS := $(wildcard $(STM32F4_DIR)/*.c)
 
 .PHONY: arm qemu arm-toolchain
 arm: $(ARM_BUILD)/arm/wirefish.elf $(ARM_BUILD)/arm/wirefish.bin
+	@$(call ARM_BUDGET,arm,$<)
 qemu: $(ARM_BUILD)/qemu/wirefish.elf
+	@$(call ARM_BUDGET,qemu,$<)
+
+# Prints an image's flash (text + data) and RAM (data + bss + stack) use; fails beyond budget.
+ARM_BUDGET = set -- $$($(ARM_SIZE) -B $(2) | awk 'NR == 2 {print $$1 + $$2, $$2 + $$3}'); \
+	echo "firmware $(1): flash $$1 B of $(ARM_FLASH_BUDGET), RAM $$2 B of $(ARM_RAM_BUDGET)" \
+	  "(stack included): $(2)"; \
+	if [ "$$1" -gt $(ARM_FLASH_BUDGET) ] || [ "$$2" -gt $(ARM_RAM_BUDGET) ]; then \
+	  echo "firmware $(1): over budget" >&2; exit 1; fi
 
 arm-toolchain:
 	@command -v $(ARM_CC) >/dev/null 2>&1 || { echo "firmware: $(ARM_CC) not found: run" \
@@ -40,11 +49,6 @@ $(ARM_BUILD)/$(1)/obj/%.o: %.c | arm-toolchain
 	$(ARM_CC) $(ARM_CFLAGS) $(2) -MMD -MP -c $$< -o $$@
 $(ARM_BUILD)/$(1)/wirefish.elf: $$($(1)_OBJS) $(STM32F4_DIR)/stm32f4.ld
 	$(ARM_CC) $(ARM_LDFLAGS) -Wl,-Map=$(ARM_BUILD)/$(1)/wirefish.map -o $$@ $$($(1)_OBJS) -lm
-	@set -- $$$$($(ARM_SIZE) -B $$@ | awk 'NR == 2 {print $$$$1 + $$$$2, $$$$2 + $$$$3}'); \
-	echo "firmware $(1): flash $$$$1 B of $(ARM_FLASH_BUDGET), RAM $$$$2 B of" \
-	  "$(ARM_RAM_BUDGET) (stack included): $$@"; \
-	if [ "$$$$1" -gt $(ARM_FLASH_BUDGET) ] || [ "$$$$2" -gt $(ARM_RAM_BUDGET) ]; then \
-	  echo "firmware $(1): over budget" >&2; rm -f $$@; exit 1; fi
 -include $$($(1)_OBJS:.o=.d)
 endef
 
