@@ -1,0 +1,113 @@
+/*
+ * Cycles per received frame and per telemetry frame, host build (make cycles).
+ *
+ * Each figure is one wf_app_poll: one that finds one frame in the UART (nothing else due), and
+ * one that sends the telemetry (with the IMU sample, failsafe and servo update of that poll),
+ * timed with the x86 time-stamp counter (TSC ticks: cycles at the nominal clock; other CPUs:
+ * nanoseconds from clock_gettime). Prints one JSON object: median, 99.9th percentile and
+ * maximum of each over the runs (the maximum includes whatever the OS did meanwhile).
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "wf_host.h"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#define COUNTER "tsc"
+static uint64_t counter_now(void)
+{
+    unsigned aux;
+    return __rdtscp(&aux);
+}
+#else
+#define COUNTER "ns"
+static uint64_t counter_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+#endif
+
+enum { RUNS = 20000 };
+
+static int by_value(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void print_figure(const char *name, uint64_t *samples, size_t n, const char *tail)
+{
+    qsort(samples, n, sizeof *samples, by_value);
+    printf("\"%s\": {\"median\": %llu, \"p999\": %llu, \"max\": %llu, \"runs\": %zu}%s", name,
+           (unsigned long long)samples[n / 2], (unsigned long long)samples[n * 999 / 1000],
+           (unsigned long long)samples[n - 1], n, tail);
+}
+
+static size_t frame(uint8_t type, uint16_t seq, uint8_t *wire)
+{
+    wf_msg_t msg;
+    memset(&msg, 0, sizeof msg);
+    msg.type = type;
+    msg.seq = seq;
+    if (type == WF_MSG_HEARTBEAT) {
+        msg.u.heartbeat.version = WF_PROTOCOL_VERSION;
+    } else if (type == WF_MSG_SERVO_CMD) {
+        msg.u.servo_cmd.servo[0] = 0.3f + 1e-5f * (float)seq;
+        msg.u.servo_cmd.servo[1] = -0.7f;
+    } else {
+        msg.u.telemetry.roll = 0.1f;
+        msg.u.telemetry.battery_v = 8.0f;
+    }
+    return wf_encode_frame(&msg, wire, WF_MAX_WIRE);
+}
+
+static uint64_t timed_poll(wf_app_t *app, uint32_t t, const uint8_t *in, size_t len)
+{
+    static uint8_t sink[4096];
+    wf_host_set_millis(t);
+    wf_host_feed(in, len);
+    const uint64_t start = counter_now();
+    wf_app_poll(app);
+    const uint64_t ticks = counter_now() - start;
+    wf_host_take_output(sink, sizeof sink);
+    return ticks;
+}
+
+int main(void)
+{
+    static uint64_t command[RUNS], telemetry_in[RUNS], telemetry_out[RUNS];
+    static wf_app_t app;
+    wf_config_t config;
+    wf_config_defaults(&config);
+    config.imu_mode = WF_IMU_SYNTHETIC;
+    config.heartbeat_timeout_ms = 0x7FFFFFFF;
+    config.command_timeout_ms = 0x7FFFFFFF;
+    wf_host_reset();
+    wf_app_init(&app, &config);
+    uint8_t wire[WF_MAX_WIRE];
+    uint16_t seq = 0;
+    timed_poll(&app, 0, wire, frame(WF_MSG_HEARTBEAT, seq++, wire));
+    uint32_t t = 1;
+    for (size_t i = 0; i < RUNS; i++) {
+        /* t % 10 == 1 and 3: no telemetry, heartbeat or IMU sample is due. */
+        command[i] = timed_poll(&app, t, wire, frame(WF_MSG_SERVO_CMD, seq++, wire));
+        /* The longest frame the decoder takes whole (62 bytes; the fish then ignores it). */
+        telemetry_in[i] = timed_poll(&app, t + 2, wire, frame(WF_MSG_TELEMETRY, seq++, wire));
+        t += 9; /* a poll that sends the telemetry (and the IMU sample of its 5 ms) */
+        telemetry_out[i] = timed_poll(&app, t, NULL, 0);
+        t += 1;
+    }
+    printf("{\"counter\": \"%s\", ", COUNTER);
+    print_figure("servo_cmd_received", command, RUNS, ", ");
+    print_figure("longest_frame_received", telemetry_in, RUNS, ", ");
+    print_figure("telemetry_sent", telemetry_out, RUNS, "");
+    printf(", \"commands_applied\": %u}\n", app.commands_applied);
+    return app.commands_applied == RUNS ? 0 : 1;
+}
