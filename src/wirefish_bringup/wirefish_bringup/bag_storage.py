@@ -77,18 +77,17 @@ def next_file_path(bag_dir: Path) -> Path:
 
 
 def add_topic(writer: BagFileWriter, typestore: Typestore, topic: str, type_name: str,
-              offered_qos_profiles: str, type_hash: str | None = None) -> int:
+              offered_qos_profiles: str) -> int:
     """
     Add ``topic`` to ``writer`` with its type's definition from ``typestore``; return its id.
 
-    ``type_hash``: the RIHS01 hash the publishers announce (rosbag2 stores theirs); the
-    typestore's when None.
+    The type hash is the typestore's RIHS01 (the one rosidl computes, and the one rosbags checks
+    on reading; an action's feedback publisher announces another).
     """
     definition, _ = typestore.generate_msgdef(type_name, ros_version=2)
     schema_id = writer.add_schema(type_name, 'ros2msg', definition)
     return writer.add_channel(topic, schema_id, {
-        QOS_KEY: offered_qos_profiles,
-        HASH_KEY: type_hash or typestore.hash_rihs01(type_name)})
+        QOS_KEY: offered_qos_profiles, HASH_KEY: typestore.hash_rihs01(type_name)})
 
 
 def read_file_info(path: Path) -> FileInfo:
@@ -176,3 +175,12 @@ def write_metadata(bag_dir: Path) -> dict:
     tmp.write_text(yaml.safe_dump(metadata, sort_keys=False, default_flow_style=False))
     os.replace(tmp, bag_dir / METADATA_FILE)
     return metadata
+
+
+def recording_custom_data(bag_dir: Path) -> dict | None:
+    """Return the custom_data of ``bag_dir``'s metadata.yaml (the recorder's account), if any."""
+    try:
+        info = yaml.safe_load((Path(bag_dir) / METADATA_FILE).read_text())
+        return info['rosbag2_bagfile_information'].get('custom_data')
+    except (OSError, yaml.YAMLError, KeyError, TypeError, AttributeError):
+        return None

@@ -323,4 +323,8 @@ def run(args: argparse.Namespace) -> int:
         report_dir = run_dir / 'report'
         write_report(bag_path, report_dir)
         print(f'bag: {bag_path}\nreport: {report_dir}')
+    if bag_path is not None and bag_path.exists():
+        from wirefish_bringup.bag_storage import recording_custom_data
+        from wirefish_bringup.sequence_gaps import loss_line
+        print(loss_line(recording_custom_data(bag_path)), flush=True)
     return code

@@ -97,7 +97,7 @@ def recording_summary(bag_path: Path, accounts: dict[str, TopicAccount]) -> str:
     for topic, account in sorted(accounts.items()):
         missing = (f'missing {checked[topic].missing}' if topic in checked
                    else 'several publishers: sequence not checked')
-        lines.append(f'  {topic:<40} {account.count:>7} ({missing}, lag max '
-                     f'{account.lag_max_ns * 1e-9:.2f} s)')
+        lag = 'latched' if account.latched else f'lag max {account.lag_max_ns * 1e-9:.2f} s'
+        lines.append(f'  {topic:<40} {account.count:>7} ({missing}, {lag})')
     lines.append(loss_line(recording_account(accounts)))
     return '\n'.join(lines)

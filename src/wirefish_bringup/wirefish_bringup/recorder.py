@@ -31,6 +31,7 @@ import time
 from typing import Any
 
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
 
 from wirefish_bringup.bag_storage import (add_topic, next_file_path, read_file_info,
                                           storage_files, write_metadata)
@@ -38,8 +39,7 @@ from wirefish_bringup.bag_writer import BagFileWriter
 from wirefish_bringup.bagfile import wirefish_typestore
 from wirefish_bringup.reindex import reindex
 from wirefish_bringup.sequence_gaps import recording_account, TopicAccount
-from wirefish_bringup.topics import (graph_topics, matching_qos, message_class, offered_qos_yaml,
-                                     type_hash)
+from wirefish_bringup.topics import graph_topics, matching_qos, message_class, offered_qos_yaml
 
 QUEUE_DEPTH = 1000
 POLL_PERIOD_S = 0.05
@@ -94,12 +94,13 @@ class BagRecorder(Node):
                                           f'({type(error).__name__}: {error})')
                 continue
             qos = self._known_qos.get(topic) or offered_qos_yaml(self, topic)
-            channel = add_topic(self._writer, self._typestore, topic, type_name, qos,
-                                type_hash(self, topic))
-            account = self.accounts[topic] = TopicAccount()
+            channel = add_topic(self._writer, self._typestore, topic, type_name, qos)
+            qos_profile = matching_qos(self, topic, QUEUE_DEPTH)
+            # A latched sample may be older than the recorder: its wait is no lag.
+            latched = qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+            account = self.accounts[topic] = TopicAccount(latched=latched)
             subscription = self.create_subscription(
-                msg_class, topic, _unused_callback, matching_qos(self, topic, QUEUE_DEPTH),
-                raw=True)
+                msg_class, topic, _unused_callback, qos_profile, raw=True)
             self._streams.append(_Stream(topic, subscription, channel, account))
             self.get_logger().info(f'recording {topic} [{type_name}]')
 
@@ -131,7 +132,7 @@ class BagRecorder(Node):
                 write(stream.channel, now, data, number or 0, source_ns)
                 account.count += 1
                 account.sequence.add(number)
-                if now - source_ns > account.lag_max_ns:
+                if now - source_ns > account.lag_max_ns and not account.latched:
                     account.lag_max_ns = now - source_ns
                 if published_before_ns is None or source_ns < published_before_ns:
                     taken += 1

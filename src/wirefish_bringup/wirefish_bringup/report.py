@@ -76,6 +76,9 @@ def write_report(bag_path: Path, out_dir: Path) -> list[TopicStats]:
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
 
+    from wirefish_bringup.bag_storage import recording_custom_data
+    from wirefish_bringup.sequence_gaps import loss_line
+
     bag = read_bag(bag_path)
     out_dir.mkdir(parents=True, exist_ok=True)
     stats = []
@@ -147,7 +150,9 @@ def write_report(bag_path: Path, out_dir: Path) -> list[TopicStats]:
         fig.tight_layout()
         fig.savefig(out_dir / 'attitude.png', dpi=110)
         plt.close(fig)
-    (out_dir / 'summary.txt').write_text(summary_table(stats, bag) + '\n')
+    # What the recorder itself counted: messages missing from the publishers' sequences.
+    loss = loss_line(recording_custom_data(bag_path))
+    (out_dir / 'summary.txt').write_text(summary_table(stats, bag) + '\n' + loss + '\n')
     return stats
 
 

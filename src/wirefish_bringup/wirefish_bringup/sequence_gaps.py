@@ -58,6 +58,7 @@ class TopicAccount:
     count: int = 0
     sequence: SequenceGaps = field(default_factory=SequenceGaps)
     lag_max_ns: int = 0  # take time minus the publisher's source timestamp
+    latched: bool = False  # transient-local: a sample may predate the recorder, no lag kept
 
 
 def recording_account(accounts: dict[str, TopicAccount]) -> dict[str, str]:
@@ -67,7 +68,8 @@ def recording_account(accounts: dict[str, TopicAccount]) -> dict[str, str]:
         sequence = account.sequence
         recording[f'{MISSING_KEY}:{topic}'] = (UNCHECKED if sequence.ambiguous
                                                else str(sequence.missing))
-        recording[f'{LAG_KEY}:{topic}'] = f'{account.lag_max_ns * 1e-9:.3f}'
+        if not account.latched:
+            recording[f'{LAG_KEY}:{topic}'] = f'{account.lag_max_ns * 1e-9:.3f}'
     return recording
 
 

@@ -33,15 +33,6 @@ def message_class(type_name: str) -> type:
     return getattr(module, name)
 
 
-def type_hash(node: Node, topic: str) -> str | None:
-    """Return the RIHS01 type hash ``topic``'s first publisher announces (None if unknown)."""
-    for info in node.get_publishers_info_by_topic(topic):
-        text = str(info.topic_type_hash)
-        if text.startswith('RIHS01_'):
-            return text
-    return None
-
-
 def graph_topics(node: Node, namespace: str) -> dict[str, str]:
     """
     Return {topic: type} for the topics under ``namespace`` plus /diagnostics.
