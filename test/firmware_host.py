@@ -3,7 +3,9 @@ The firmware's host build from Python: the make step and ctypes bindings of wf_h
 
 ``build_firmware`` runs ``make -C firmware`` once per process under a file lock (pytest-xdist
 workers share the tree); ``FirmwareHost`` wraps ``build/host/libwirefish_fw.so``: the process's
-one board (init, step at a time, snapshot, I2C device model, ADC) and the batch codec.
+one board (init, step at a time, snapshot, I2C device model, ADC) and the batch codec;
+``random_messages`` draws valid messages as flat records and ``to_python`` makes the
+wirefish_bridge message of one.
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ from pathlib import Path
 import subprocess
 
 import numpy as np
+from wirefish_bridge.protocol import (ErrorReport, Heartbeat, ProtocolMessage, Role, ServoCommand,
+                                      Telemetry)
 
 WORKSPACE = Path(__file__).resolve().parents[1]
 FIRMWARE = WORKSPACE / 'firmware'
@@ -30,6 +34,50 @@ STATS_FIELDS = ('bytes_in', 'frames_ok', 'cobs_errors', 'short_frames', 'crc_err
                 'unknown_type', 'length_errors', 'invalid_payload', 'overflows', 'resyncs',
                 'seq_gaps', 'seq_resets')
 I2cDevice = Callable[[int, bytes, int], 'bytes | None']
+MESSAGE_TYPES = np.array([0x01, 0x10, 0x20, 0x7F], np.uint8)
+
+
+def random_messages(rng: np.random.Generator, count: int) -> np.ndarray:
+    """Return ``count`` random valid messages (MSG_DTYPE): any seq, any value a field may hold."""
+    records = np.zeros(count, MSG_DTYPE)
+    records['type'] = rng.choice(MESSAGE_TYPES, count)
+    records['seq'] = rng.integers(0, 1 << 16, count)
+    records['time'] = rng.integers(0, 1 << 32, count, dtype=np.uint64)
+    records['ref'] = rng.integers(0, 1 << 16, count)
+    records['code'] = rng.integers(0, 256, count)
+    records['role'] = rng.integers(0, 2, count)
+    bits = rng.integers(0, 1 << 32, (count, 12), dtype=np.uint64).astype(np.uint32)
+    not_finite = (bits & 0x7F800000) == 0x7F800000
+    bits[not_finite] &= 0xBFFFFFFF  # clear the top exponent bit: finite, sign kept
+    bits[rng.random((count, 12)) < 0.02] = 0x80000000  # -0.0 is a value of its own
+    records['f'] = bits.view(np.float32)
+    is_heartbeat = records['type'] == 0x01
+    is_servo = records['type'] == 0x10
+    is_telemetry = records['type'] == 0x20
+    is_error = records['type'] == 0x7F
+    # Only the fields a type carries (the C side leaves the others zero).
+    records['time'][is_servo | is_error] = 0
+    records['ref'][is_heartbeat | is_servo] = 0
+    records['code'][is_servo | is_telemetry] = 0
+    records['role'][~is_heartbeat] = 0
+    records['f'][~(is_servo | is_telemetry)] = 0.0
+    records['f'][is_servo, 2:] = 0.0
+    return records
+
+
+def to_python(record: np.void) -> ProtocolMessage:
+    """Return the wirefish_bridge message of one record."""
+    kind = int(record['type'])
+    f = record['f'].tolist()
+    if kind == 0x01:
+        return Heartbeat(int(record['code']), Role(int(record['role'])), int(record['time']))
+    if kind == 0x10:
+        return ServoCommand(f[0], f[1])
+    if kind == 0x20:
+        return Telemetry(board_time_ms=int(record['time']), roll=f[0], pitch=f[1], yaw=f[2],
+                         gyro=tuple(f[3:6]), accel=tuple(f[6:9]), servo_1=f[9],
+                         servo_2=f[10], battery_v=f[11], status=int(record['ref']))
+    return ErrorReport(int(record['code']), int(record['ref']))
 
 
 def build_firmware(*targets: str) -> None:
