@@ -10,7 +10,7 @@ from firmware_host import FirmwareHost, MSG_DTYPE, MESSAGE_TYPES, random_message
 import numpy as np
 import pytest
 from wirefish_bridge.codec import encode_frame, StreamDecoder
-from wirefish_bridge.protocol import ErrorReport, Heartbeat, ServoCommand, Telemetry
+from wirefish_bridge.protocol import Heartbeat, ServoCommand, Telemetry
 
 COUNT = 100_000
 
