@@ -6,7 +6,7 @@ decode in Python to the same values; every field of every type, floats compared 
 (finite binary32 of every kind: normal, subnormal, +-0).
 """
 
-from firmware_host import FirmwareHost, MSG_DTYPE, MESSAGE_TYPES, random_messages, to_python
+from firmware_host import FirmwareHost, MESSAGE_TYPES, MSG_DTYPE, random_messages, to_python
 import numpy as np
 import pytest
 from wirefish_bridge.codec import encode_frame, StreamDecoder
