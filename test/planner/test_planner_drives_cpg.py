@@ -9,6 +9,8 @@ refuses is said there too.
 
 from dataclasses import dataclass, field
 import math
+import subprocess
+import sys
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Twist
@@ -16,7 +18,6 @@ import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from ros_utils import spin_until
-from std_srvs.srv import Trigger
 
 NAMESPACE = '/h24_topic'
 WAIT_S = 20.0
@@ -86,15 +87,6 @@ def _runs_the_planners_gait(heard) -> bool:
         state.cpg_frequency_hz == pytest.approx(running.frequency_hz)
 
 
-def _call(executor, node, service: str) -> Trigger.Response:
-    client = node.create_client(Trigger, service)
-    assert spin_until(executor, client.service_is_ready, WAIT_S)
-    future = client.call_async(Trigger.Request())
-    assert spin_until(executor, future.done, WAIT_S)
-    node.destroy_client(client)
-    return future.result()
-
-
 @pytest.mark.ros
 def test_the_planner_drives_the_cpg_by_topic(graph):
     _, _, _, executor, heard, publisher = graph
@@ -104,7 +96,7 @@ def test_the_planner_drives_the_cpg_by_topic(graph):
 
 
 @pytest.mark.ros
-def test_a_fit_set_on_the_cpg_is_a_manual_override_the_planner_says_and_keeps(graph):
+def test_a_fit_set_on_the_cpg_is_a_manual_override_the_planner_says_and_keeps(graph, ros_env):
     cpg, _, peer, executor, heard, publisher = graph
     assert spin_until(executor, _drive(publisher, heard, lambda: _runs_the_planners_gait(heard)),
                       WAIT_S)
@@ -127,8 +119,14 @@ def test_a_fit_set_on_the_cpg_is_a_manual_override_the_planner_says_and_keeps(gr
     assert heard.params[-1].frequency_hz == FIT['frequency_hz']
     assert list(heard.params[-1].amplitude) == [FIT['amplitude_1'], FIT['amplitude_2']]
 
-    response = _call(executor, peer, f'{NAMESPACE}/follow_commands')
-    assert response.success and 'again' in response.message
+    # `wirefish hand-back` (cpg_node/follow_commands) gives the gait back to the planner.
+    hand_back = subprocess.Popen(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'hand-back', '--namespace', NAMESPACE],
+        env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert spin_until(executor, lambda: hand_back.poll() is not None, WAIT_S)
+    out, err = hand_back.communicate()
+    assert hand_back.returncode == 0, err
+    assert out.strip() == 'cpg_node: cpg_command sets the targets again'
     assert spin_until(executor, _drive(publisher, heard, lambda: _runs_the_planners_gait(heard)),
                       WAIT_S)
 
@@ -185,3 +183,11 @@ def test_a_command_the_cpg_refused_is_said_by_the_planner(ros_context):
         executor.shutdown()
         peer.destroy_node()
         planner.destroy_node()
+
+
+def test_hand_back_without_a_graph_says_so(ros_env):
+    done = subprocess.run(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'hand-back', '--namespace', '/h24_none',
+         '--timeout', '1'], env=ros_env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1
+    assert 'no /h24_none/cpg_node/follow_commands service' in done.stderr

@@ -118,6 +118,11 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
                          for e in shore.events('cpg_params')), 10.0,
              "the fit in the shore's copy of cpg_params")
 
+    # The fit is a manual override (the planner does not drive it); the shore hands it back.
+    handed = hosts.run(SHORE, ['wirefish', 'hand-back', '--namespace', hosts.namespace],
+                       timeout_s=30.0)
+    assert handed.returncode == 0, handed.stderr
+
     # The shore drives; the link is cut for 10 s.
     shore.send('go 0.2 0.0')
     wait_for(lambda: fish.events('planner_state')[-1]['mode'] != 'rest', 15.0,
@@ -154,8 +159,8 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
     wait_for(lambda: fish.events('planner_state')[-1]['mode'] != 'rest', 10.0,
              'cmd_vel from shore reaches the planner again')
 
-    # A retune from shore after the outage (the shore stops driving first: a driving planner
-    # would set the gait again at once).
+    # A retune from shore after the outage (the shore stops driving first, so the fish rests
+    # before the fit takes over as a manual override).
     shore.send('halt')
     wait_for(lambda: fish.events('planner_state')[-1]['mode'] == 'rest', 10.0,
              'the fish rests when the shore stops driving')

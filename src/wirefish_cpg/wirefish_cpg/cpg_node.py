@@ -19,7 +19,7 @@ Services
     ``start``, ``stop`` (std_srvs/Trigger): stop sends the amplitude and offset targets to 0,
     so the tail comes to rest along eq 1's convergence law, never by a jump; start restores
     the targets. Changes while stopped are kept and apply at start.
-    ``follow_commands`` (std_srvs/Trigger): end a manual override (``cpg_control`` says which
+    ``~/follow_commands`` (std_srvs/Trigger): end a manual override (``cpg_control`` says which
     source wins: a parameter set overrides cpg_command until this is called).
 Parameters (flat scalars, each with a range; invalid updates are rejected with a reason):
     see ``cpg_node_parameters``; the configuration and the manual override. Valid targets apply
@@ -81,7 +81,7 @@ class CpgNode(Node):
         self._status: tuple[TargetSource, str] | None = None  # what cpg_status last said
         self.create_service(Trigger, 'start', self._on_start)
         self.create_service(Trigger, 'stop', self._on_stop)
-        self.create_service(Trigger, 'follow_commands', self._on_follow_commands)
+        self.create_service(Trigger, '~/follow_commands', self._on_follow_commands)
         self.create_subscription(CpgCommand, 'cpg_command', self._on_command, COMMAND)
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)
