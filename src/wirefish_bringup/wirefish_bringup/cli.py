@@ -18,6 +18,8 @@ SUBCOMMANDS = {
              "the firmware's ARM build on an emulated board (QEMU), its link on a pty"),
     'record': ('wirefish_bringup.record', 'record the graph into a rosbag2 (MCAP) bag'),
     'retune': ('wirefish_bringup.retune', 'fit the CPG to a body wave (retune_gait action)'),
+    'hand-back': ('wirefish_bringup.hand_back',
+                  "give the gait back to the planner after a retune's manual override"),
     'gaits': ('wirefish_bringup.gaits', 'build, list and plot the gait library'),
     'drive': ('wirefish_bringup.drive', 'drive the fish from the keyboard (cmd_vel teleop)'),
     'mission': ('wirefish_bringup.mission',

@@ -178,6 +178,9 @@ def run(args: argparse.Namespace) -> int:
             print(f'wirefish retune: {result.message}', file=sys.stderr)
             return 1
         print(result_table(result))
+        if result.applied:  # cpg_control's rule: a parameter set is a manual override
+            print('wirefish retune: cpg_node runs this fit as a manual override; the planner '
+                  'does not drive it until `wirefish hand-back`', file=sys.stderr)
         return 0 if math.isfinite(result.loss) else 1
     except KeyboardInterrupt:
         if drawn[0]:
