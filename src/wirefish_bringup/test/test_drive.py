@@ -66,3 +66,9 @@ def test_status_line_shows_the_planner_state_and_why_it_clamps():
     assert 'hold' in line and '0.39 m/s' in line and 'above the fastest' in line
     assert f'{math.degrees(0.5):+.0f} deg' in line
     assert 'no planner_state' in state_line(0.0, 0.0, None)
+
+
+def test_without_planner_state_the_line_names_the_graph_it_waits_for():
+    assert 'no planner_state yet' in state_line(0.0, 0.0, None, waited_s=1.0, namespace='/f')
+    line = state_line(0.0, 0.0, None, waited_s=3.5, namespace='/f')
+    assert 'no planner_state in /f after 4 s' in line and 'wirefish up --namespace /f' in line

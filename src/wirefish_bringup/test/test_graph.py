@@ -107,6 +107,12 @@ def test_namespaces_are_normalised(given, normalised):
     assert validate_namespace(given) == normalised
 
 
+@pytest.mark.parametrize('empty', ['', '  '])
+def test_an_empty_namespace_is_refused_not_taken_as_the_root(empty):
+    with pytest.raises(ValueError, match='an empty namespace'):
+        validate_namespace(empty)
+
+
 @pytest.mark.parametrize('bad', ['/1fish', '/a//b', '/fish-1', '/a b'])
 def test_invalid_namespaces_are_refused(bad):
     with pytest.raises(ValueError, match='invalid ROS namespace'):

@@ -4,8 +4,8 @@
 The single-process mode of `wirefish up --single-process`: every registry entry with a node
 class (`wirefish_bringup.graph.NODES`), with the same names, namespace, parameter file and
 extra parameters as the one-process-per-node graph, but one Python interpreter and one DDS
-participant instead of five, which is what limits how many fish fit on one machine. An entry
-marked ``own_executor`` (the tuner) spins on an executor and thread of its own: a fit then
+participant instead of one per node, which is what limits how many fish fit on one machine. An
+entry marked ``own_executor`` (the tuner) spins on an executor and thread of its own: a fit then
 never stalls the fish's streams, and its apply step, which waits for cpg_node's parameter
 service, can be answered.
 """

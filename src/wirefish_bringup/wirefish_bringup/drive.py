@@ -17,8 +17,10 @@ from dataclasses import dataclass
 import math
 import os
 import sys
+import time
 
 PUBLISH_HZ = 10.0
+NO_GRAPH_HINT_S = 3.0  # without planner_state, when the status line says what may be wrong
 ESC = '\x1b'
 ARROWS = {f'{prefix}{final}': key for prefix in ('\x1b[', '\x1bO')
           for final, key in (('A', 'w'), ('B', 's'), ('D', 'a'), ('C', 'd'))}
@@ -100,9 +102,18 @@ def _sequence_end(text: str, start: int) -> int | None:
     return None
 
 
-def state_line(speed: float, turn: float, state) -> str:
-    """Return the status line: what is sent, and the planner's state (or that none came)."""
+def state_line(speed: float, turn: float, state, waited_s: float = 0.0,
+               namespace: str = '') -> str:
+    """
+    Return the status line: what is sent, and the planner's state (or that none came).
+
+    ``waited_s`` is how long drive has run without a planner_state: after NO_GRAPH_HINT_S
+    the line says which graph it waits for.
+    """
     sent = f'cmd_vel {speed:.2f} m/s {turn:+.2f} rad/s'
+    if state is None and waited_s >= NO_GRAPH_HINT_S:
+        return (f'{sent} | no planner_state in {namespace or "/"} after {waited_s:.0f} s: '
+                f'is the graph running? (wirefish up --namespace {namespace or "/"})')
     if state is None:
         return f'{sent} | no planner_state yet'
     heading = '' if math.isnan(state.heading_target) else \
@@ -156,6 +167,7 @@ def run(args: argparse.Namespace) -> int:
     saved = termios.tcgetattr(fd)
     speed, turn = 0.0, 0.0
     print(__doc__.strip().split('\n\n')[1].replace('\n', ' '))
+    started = time.monotonic()
     try:
         tty.setcbreak(fd)
         while link.ok():
@@ -169,7 +181,9 @@ def run(args: argparse.Namespace) -> int:
                         return 0
                     speed, turn = result
             link.send(speed, turn)
-            sys.stdout.write('\r\x1b[K' + state_line(speed, turn, link.state)[:160])
+            waited = time.monotonic() - started
+            line = state_line(speed, turn, link.state, waited, namespace)
+            sys.stdout.write('\r\x1b[K' + line[:160])
             sys.stdout.flush()
     except KeyboardInterrupt:
         pass

@@ -252,6 +252,8 @@ def ros_arguments(name: str, namespace: str, params_file: str | None,
 
 def validate_namespace(namespace: str) -> str:
     """Return ``namespace`` normalised to an absolute ROS namespace, or raise ValueError."""
+    if not namespace.strip():  # '' would silently be the root namespace
+        raise ValueError('an empty namespace: give one, e.g. /wirefish (or / for the root)')
     if not namespace.startswith('/'):
         namespace = '/' + namespace
     namespace = namespace.rstrip('/') or '/'

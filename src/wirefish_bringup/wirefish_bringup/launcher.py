@@ -21,6 +21,7 @@ from wirefish_bringup.cli import duration_s
 from wirefish_bringup.errors import QemuBoardError
 from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
                                     validate_namespace)
+from wirefish_bringup.input_checks import params_file_problem, serial_port_problem
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
@@ -68,8 +69,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--out', type=Path, default=Path('out'),
                         help='where run logs, bags and reports go (default: ./out)')
     parser.add_argument('--single-process', action='store_true',
-                        help="run the fish's four ROS nodes in one process (wirefish compose)")
+                        help="run the fish's ROS nodes in one process (wirefish compose)")
     parser.add_argument('--no-status', action='store_true', help='skip the topic-rate table')
+    parser.add_argument('--view', action='store_true',
+                        help='also the live view: Foxglove WebSocket server and dashboard '
+                        '(wirefish view; view_node parameters port, http_port)')
     parser.add_argument('--allow-duplicate', action='store_true',
                         help='start even if nodes of the graph already run in this namespace '
                         '(e.g. a graph that just died is still discovered)')
@@ -236,6 +240,11 @@ def run(args: argparse.Namespace) -> int:
     except QemuBoardError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 1
+    problem = ((serial_port_problem(args.port) if args.port is not None else None)
+               or (params_file_problem(args.params_file) if args.params_file else None))
+    if problem is not None:
+        print(f'wirefish up: {problem}', file=sys.stderr)
+        return 2
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)

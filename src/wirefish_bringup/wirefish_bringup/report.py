@@ -175,11 +175,15 @@ def summary_table(stats: list[TopicStats], bag) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish report`; return the process exit code."""
+    from wirefish_bringup.input_checks import bag_directory_problem
+
+    problem = bag_directory_problem(args.bag)
+    if problem is not None:
+        print(f'wirefish report: {problem}', file=sys.stderr)
+        return 2
     if not (args.bag / 'metadata.yaml').is_file():
-        killed = any(args.bag.glob('*.mcap'))
-        print(f'wirefish report: {args.bag} has no metadata.yaml: '
-              + (f'its recorder was killed? `wirefish bag reindex {args.bag}` repairs it'
-                 if killed else 'not a rosbag2 directory'), file=sys.stderr)
+        print(f'wirefish report: {args.bag} has no metadata.yaml: its recorder was killed? '
+              f'`wirefish bag reindex {args.bag}` repairs it', file=sys.stderr)
         return 2
     out_dir = args.output or args.bag.with_name(args.bag.name + '_report')
     stats = write_report(args.bag, out_dir)
