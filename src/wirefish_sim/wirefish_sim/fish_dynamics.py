@@ -24,12 +24,18 @@ part of y_tip averages out and leaves the head's small yaw oscillation.
 from __future__ import annotations
 
 import math
+from typing import TypeVar
+
+import numpy as np
 
 GRAVITY = 9.80665  # m/s^2, standard gravity
+# A value of one fish, or an array of a school's (one per fish: ``virtual_fish.swim``).
+Value = float | np.ndarray
+Angle = TypeVar('Angle', float, np.ndarray)
 
 
-def surge_acceleration(tip_thrust: float, k1_rate: float, k2: float, k2_rate: float,
-                       speed: float, drag: float, total_mass: float) -> float:
+def surge_acceleration(tip_thrust: Value, k1_rate: Value, k2: Value, k2_rate: Value,
+                       speed: Value, drag: Value, total_mass: float) -> Value:
     """
     Return dU/dt (m/s^2) of the surge equation above.
 
@@ -54,13 +60,13 @@ def surge_time_constant(total_mass: float, mean_k2: float, speed: float,
     return (total_mass + mean_k2) / damping
 
 
-def yaw_acceleration(yaw_rate: float, tail_tip_offset: float, speed: float, gain: float,
-                     time_constant: float, body_length: float) -> float:
+def yaw_acceleration(yaw_rate: Value, tail_tip_offset: Value, speed: Value, gain: float,
+                     time_constant: float, body_length: float) -> Value:
     """Return d(yaw rate)/dt (rad/s^2) of the yaw model above (a model assumption)."""
     target = -gain * speed * tail_tip_offset / body_length
     return (target - yaw_rate) / time_constant
 
 
-def wrap_angle(angle: float) -> float:
+def wrap_angle(angle: Angle) -> Angle:
     """Return ``angle`` wrapped into [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi

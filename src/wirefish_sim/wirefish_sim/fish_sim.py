@@ -1,45 +1,61 @@
 """
-fish_sim: the virtual fish on a pseudo-terminal, playing the board's firmware in real time.
+fish_sim: virtual fish on pseudo-terminals, playing the boards' firmware in real time.
 
 ``fish_sim --link /tmp/wirefish-tty`` opens a pty pair, prints the device path on stdout (one
-line, flushed), points the link at it and runs until SIGINT/SIGTERM (exit code 0). The core
-(``VirtualFish``) needs no ROS; with ``--ros`` the process also publishes ``sim/ground_truth``
+line, flushed), points the link at it and runs until SIGINT/SIGTERM (exit code 0). Each further
+``--link`` is one more fish of the same process (a fleet: one clock, one physics vectorised over
+the fish, ``VirtualFleet``), each on a pty of its own, one device line each in order. The core
+needs no ROS; with ``--ros`` the process also publishes each fish's ``sim/ground_truth``
 (nav_msgs/Odometry, frame ``odom``, child ``base_link``, both under the ROS parameter
-``frame_prefix`` when set) and swims with the fish's geometry from its ROS parameters (l1 ...
-drag_coefficient: the graph's one ``/**`` block of the params file, which kinematics_node,
-tuner_node and planner_node read too; read at start). Without ``--ros`` it swims with
-``FishGeometry``'s defaults. Fault flags: ``--corrupt-fraction``,
+``frame_prefix`` when set; of a fleet's fish ``--fish`` NAME: ``NAME/sim/ground_truth``
+with frames ``NAME/odom``, ``NAME/base_link``) and swims with the geometry from its ROS
+parameters (l1 ... drag_coefficient: the graph's one ``/**`` block of the params file,
+which kinematics_node, tuner_node and planner_node read too; read at start). Without
+``--ros`` it swims with ``FishGeometry``'s defaults. Fault flags: ``--corrupt-fraction``,
 ``--drop-fraction``, ``--stall-every/--stall-for`` (firmware freezes: no output, input lost),
 ``--reopen-every/--reopen-count/--reopen-delay`` (close the device, wait, open a new one).
 Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns the fish) and
-``--surge-disturbance`` (N along the body, + forward); see ``faults.Disturbance``.
+``--surge-disturbance`` (N along the body, + forward); see ``faults.Disturbance``. Faults and
+disturbances apply to every fish, each fish with its own device, schedule state and
+Generators (fish k, from 0: ``--seed`` + 2k for its IMU, + 2k + 1 for its faults).
+
+The loop wakes every ``tick_s`` (half a telemetry period, 5 ms at 100 Hz): it reads every
+device, steps the physics of every fish by the wall-clock time since the last tick, and writes
+what each firmware emitted. A command takes effect at the tick after it arrived (the servos'
+own PWM frame is 3 ms), however many fish share the process.
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from dataclasses import fields
 import math
 from pathlib import Path
-import select
 import sys
 import time
 
 import numpy as np
 
+from wirefish_common.frames import frame_prefix_problem
 from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
+from wirefish_sim.virtual_fleet import VirtualFleet
 
 
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser (every option of the virtual fish is a flag)."""
     p = argparse.ArgumentParser(prog='fish_sim', description=__doc__.split('\n\n')[0])
-    p.add_argument('--link', type=Path, default=None,
-                   help='symlink pointing at the current pty device (e.g. /tmp/wirefish-tty)')
+    p.add_argument('--link', type=Path, action='append', default=None,
+                   help='symlink pointing at the current pty device (e.g. /tmp/wirefish-tty); '
+                   'once per fish')
+    p.add_argument('--fish', action='append', default=None, metavar='NAME',
+                   help='name of each fish (with several --link; default fish_1 ... fish_N): '
+                   'the namespace of its sim/ground_truth and the prefix of its frames')
     p.add_argument('--ros', action='store_true', help='publish sim/ground_truth')
     p.add_argument('--ground-truth-hz', type=float, default=50.0)
     p.add_argument('--seed', type=int, default=0, help='seed of IMU noise and faults')
@@ -92,10 +108,12 @@ class GroundTruthPublisher:
 
     The geometry (``geometry``) comes from the node's parameters, judged as kinematics_node
     judges them (``InvalidParameters`` names the first bad one); sim/ground_truth is
-    nav_msgs/Odometry of the fish state.
+    nav_msgs/Odometry of each fish's state: one publisher per name of ``names`` (``''``: the
+    node's own ``sim/ground_truth``; ``fish_1``: ``fish_1/sim/ground_truth``, frames
+    ``fish_1/odom`` under the node's ``frame_prefix``).
     """
 
-    def __init__(self, ros_args: list[str]) -> None:
+    def __init__(self, ros_args: list[str], names: Sequence[str] = ('',)) -> None:
         """Initialise rclpy without its signal handlers (ours stop the loop cleanly)."""
         import rclpy
         from rclpy.signals import SignalHandlerOptions
@@ -117,22 +135,26 @@ class GroundTruthPublisher:
         self.geometry = geometry_from({spec.name: self.node.get_parameter(spec.name).value
                                        for spec in specs})
         prefix = declare_frame_prefix(self.node)  # fish_1: fish_1/odom, fish_1/base_link
-        self._frames = prefixed(prefix, 'odom'), prefixed(prefix, 'base_link')
+        self._frames = [(prefixed(prefixed(prefix, name), 'odom'),
+                         prefixed(prefixed(prefix, name), 'base_link')) for name in names]
         self._odometry = Odometry
-        self.publisher = self.node.create_publisher(Odometry, 'sim/ground_truth', RELIABLE)
+        self.publishers = [self.node.create_publisher(
+            Odometry, prefixed(name, 'sim/ground_truth'), RELIABLE) for name in names]
 
-    def publish(self, fish: VirtualFish) -> None:
-        """Publish the fish's ground truth now."""
-        s = fish.state
-        msg = self._odometry()
-        msg.header.stamp = self.node.get_clock().now().to_msg()
-        msg.header.frame_id, msg.child_frame_id = self._frames
-        msg.pose.pose.position.x, msg.pose.pose.position.y = s.x, s.y
-        msg.pose.pose.orientation.z = math.sin(s.yaw / 2.0)
-        msg.pose.pose.orientation.w = math.cos(s.yaw / 2.0)
-        msg.twist.twist.linear.x = s.speed
-        msg.twist.twist.angular.z = s.yaw_rate
-        self.publisher.publish(msg)
+    def publish(self, school: Sequence[VirtualFish]) -> None:
+        """Publish the ground truth of every fish now (one stamp: one clock)."""
+        stamp = self.node.get_clock().now().to_msg()
+        for fish, frames, publisher in zip(school, self._frames, self.publishers):
+            s = fish.state
+            msg = self._odometry()
+            msg.header.stamp = stamp
+            msg.header.frame_id, msg.child_frame_id = frames
+            msg.pose.pose.position.x, msg.pose.pose.position.y = s.x, s.y
+            msg.pose.pose.orientation.z = math.sin(s.yaw / 2.0)
+            msg.pose.pose.orientation.w = math.cos(s.yaw / 2.0)
+            msg.twist.twist.linear.x = s.speed
+            msg.twist.twist.angular.z = s.yaw_rate
+            publisher.publish(msg)
 
     def close(self) -> None:
         """Destroy the node and shut rclpy down."""
@@ -157,73 +179,99 @@ class Schedule:
         return n if t - n * self.every_s < self.duration_s else None
 
 
+def fish_names(args: argparse.Namespace) -> list[str]:
+    """Return each fish's name: ``--fish`` as given, else '' for one fish, fish_1 ... for more."""
+    count = len(args.link or [None])
+    if args.fish:
+        return list(args.fish)
+    return [''] if count == 1 else [f'fish_{i}' for i in range(1, count + 1)]
+
+
+class _FishLink:
+    """One fish's end of the process: its device, its faults and its reopen state."""
+
+    def __init__(self, name: str, link: Path | None, faults: FaultInjector) -> None:
+        self.name, self.device, self.faults = name, PtyDevice(link), faults
+        self.reopened = 0
+
+    def label(self) -> str:
+        return f'fish_sim{f" {self.name}" if self.name else ""}'
+
+
 def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     """Run the virtual fish until SIGINT/SIGTERM; return the exit code."""
     # However many SIGINT/SIGTERM arrive: one stop, exit 0 (see wirefish_common.shutdown).
     signals = SignalShutdown()
-    rng = np.random.default_rng(args.seed)
+    names = fish_names(args)
     try:
-        ground_truth = GroundTruthPublisher(ros_args) if args.ros else None
+        ground_truth = GroundTruthPublisher(ros_args, names) if args.ros else None
     except InvalidParameters as error:  # one line, as a node's FATAL at start-up
         print(error, file=sys.stderr, flush=True)  # it names fish_sim
         return 1
-    fish = VirtualFish(config_from(args), rng=rng,
-                       geometry=ground_truth.geometry if ground_truth is not None else None)
+    fleet = VirtualFleet([np.random.default_rng(args.seed + 2 * k) for k in range(len(names))],
+                         config_from(args),
+                         ground_truth.geometry if ground_truth is not None else None)
     print(f'fish_sim: geometry ({"ROS parameters" if ground_truth else "defaults"}) '
-          + ', '.join(f'{f.name} {getattr(fish.geometry, f.name):g}'
-                      for f in fields(fish.geometry)), file=sys.stderr, flush=True)
-    faults = FaultInjector(np.random.default_rng(args.seed + 1), args.corrupt_fraction,
-                           args.drop_fraction)
+          + ', '.join(f'{f.name} {getattr(fleet.geometry, f.name):g}'
+                      for f in fields(fleet.geometry))
+          + (f'; {len(fleet)} fish: {", ".join(names)}' if len(fleet) > 1 else ''),
+          file=sys.stderr, flush=True)
+    links = [_FishLink(name, link, FaultInjector(np.random.default_rng(args.seed + 2 * k + 1),
+                                                 args.corrupt_fraction, args.drop_fraction))
+             for k, (name, link) in enumerate(zip(names, args.link or [None]))]
     disturbance = Disturbance(args.yaw_disturbance, args.surge_disturbance)
     stalls = Schedule(args.stall_every, args.stall_for)
     reopens = Schedule(args.reopen_every, args.reopen_delay, args.reopen_count)
-    device = PtyDevice(args.link)
+    tick_s = max(0.0005, min(0.01, 1.0 / args.telemetry_hz / 2.0))
     try:
-        print(device.open_pair(), flush=True)
-        start = last = time.monotonic()
+        for link in links:
+            print(link.device.open_pair(), flush=True)
+        start = last = next_tick = time.monotonic()
         next_truth = start
-        reopened = 0
         while not signals.requested:
             now = time.monotonic()
             elapsed = now - start
             closing = reopens.index(elapsed)
-            if closing is not None and device.is_open:
-                device.close()
-                print(f'fish_sim: device closed (reopen {closing})', file=sys.stderr, flush=True)
-            elif closing is None and not device.is_open:
-                path = device.open_pair()
-                reopened += 1
-                print(f'fish_sim: reopened as {path} ({reopened})', file=sys.stderr, flush=True)
             stalled = stalls.index(elapsed) is not None
-            data = device.read()
-            if data and not stalled:
-                fish.receive(data)
-            fish.step(now - last)
-            if disturbance.active:
+            for fish, link in zip(fleet.fish, links):
+                _reopen(link, closing)
+                data = link.device.read()
+                if data and not stalled:
+                    fish.receive(data)
+            fleet.step(now - last)
+            for fish in fleet.fish if disturbance.active else ():
                 disturb(fish.state, disturbance, now - last, fish.config.yaw_time_constant_s,
                         fish.total_mass)
             last = now
-            output = fish.take_output()
-            if device.is_open and not stalled and output:
-                device.write(faults.apply(output))
+            for fish, link in zip(fleet.fish, links):
+                output = fish.take_output()
+                if link.device.is_open and not stalled and output:
+                    link.device.write(link.faults.apply(output))
             if ground_truth is not None and now >= next_truth:
-                ground_truth.publish(fish)
+                ground_truth.publish(fleet.fish)
                 next_truth += 1.0 / args.ground_truth_hz
-            # Sleep until the next telemetry is due or the host writes, whichever is first.
-            wait = max(0.0005, min(0.01, 1.0 / args.telemetry_hz / 2.0))
-            if device.is_open:
-                try:
-                    select.select([device], [], [], wait)
-                except InterruptedError:
-                    pass
-            else:
-                time.sleep(wait)
+            # One wake-up per tick for every fish, whatever the host writes in between.
+            next_tick = max(next_tick + tick_s, now)
+            time.sleep(max(0.0, next_tick - time.monotonic()))
     finally:
-        device.close()
-        device.remove_link()
+        for link in links:
+            link.device.close()
+            link.device.remove_link()
         if ground_truth is not None:
             ground_truth.close()
     return 0
+
+
+def _reopen(link: _FishLink, closing: int | None) -> None:
+    """Close or reopen ``link``'s device as the reopen schedule says now."""
+    if closing is not None and link.device.is_open:
+        link.device.close()
+        print(f'{link.label()}: device closed (reopen {closing})', file=sys.stderr, flush=True)
+    elif closing is None and not link.device.is_open:
+        path = link.device.open_pair()
+        link.reopened += 1
+        print(f'{link.label()}: reopened as {path} ({link.reopened})', file=sys.stderr,
+              flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -262,6 +310,20 @@ def flags_problem(args: argparse.Namespace) -> str | None:
         value = getattr(args, name)
         if not math.isfinite(value):
             return f'--{name.replace("_", "-")} must be finite, got {value}'
+    links = args.link or [None]
+    if len(links) > 1 and None in links:
+        return 'every fish of several needs its --link'
+    if len({str(link) for link in links}) < len(links):
+        return 'each fish needs a --link of its own'
+    if args.fish is not None:
+        if len(args.fish) != len(links):
+            return f'{len(args.fish)} --fish names for {len(links)} fish (--link)'
+        for name in args.fish:
+            problem = frame_prefix_problem(name)
+            if problem is not None or not name:
+                return f'--fish {name!r}: a name of letters, digits and _ (e.g. fish_1)'
+        if len(set(args.fish)) < len(args.fish):
+            return 'each fish needs a name of its own (--fish)'
     try:
         config_from(args)
     except ValueError as error:  # the servo model's own checks

@@ -25,8 +25,15 @@ factor ~ 2 pi f tau, so the tip velocity (amplitude x f) falls and so does the s
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 import math
+from typing import TypeVar
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+Angles = TypeVar('Angles', float, np.ndarray)
 
 
 @dataclass(frozen=True)
@@ -46,43 +53,74 @@ class ServoParameters:
                 raise ValueError(f'{name} must be finite and > 0, got {value}')
 
 
-def clamp_to_limit(angle: float, limit: float) -> float:
+def clamp_to_limit(angle: Angles, limit: float) -> Angles:
     """Return ``angle`` clamped to [-limit, limit] (rad): the mechanical end stops."""
-    return min(limit, max(-limit, angle))
+    return np.clip(angle, -limit, limit)
 
 
-def slew(motor: float, setpoint: float, rate_limit: float, dt: float) -> float:
+def slew(motor: Angles, setpoint: Angles, rate_limit: float, dt: float) -> Angles:
     """Return the motor angle (rad) after moving toward ``setpoint`` at <= ``rate_limit``."""
     step = rate_limit * dt
-    return motor + min(step, max(-step, setpoint - motor))
+    return motor + np.clip(setpoint - motor, -step, step)
 
 
-def lag(output: float, motor: float, time_constant: float, dt: float) -> float:
+def lag(output: Angles, motor: Angles, time_constant: float, dt: float) -> Angles:
     """Return the first-order lag's output after ``dt`` with the motor held (exact step)."""
     return motor + (output - motor) * math.exp(-dt / time_constant)
 
 
 class Servo:
-    """One servo: set-point held between PWM frames, slewing motor, lagging output."""
+    """
+    Servos of one model: set-point held between PWM frames, slewing motor, lagging output.
 
-    def __init__(self, params: ServoParameters, angle: float = 0.0) -> None:
-        """Start at rest at ``angle`` (rad)."""
+    Each state is an array of ``shape`` (``()``: one servo; ``(2,)``: a fish's pair; ``(N,
+    2)``: a school's pairs, stepped in one call). The servos of one object share their PWM
+    frame instants, as the servos of one board (and of fish on one clock) do.
+    """
+
+    def __init__(self, params: ServoParameters, shape: tuple[int, ...] = ()) -> None:
+        """Start at rest at 0 rad."""
         self.params = params
-        self.setpoint = angle
-        self.motor = angle
-        self.angle = angle
-        self.rate = 0.0
-        self._until_update = 0.0
+        self.setpoint = np.zeros(shape)
+        self.motor = np.zeros(shape)
+        self.angle = np.zeros(shape)
+        self.rate = np.zeros(shape)
+        self.until_update = 0.0
 
-    def step(self, command: float, dt: float) -> None:
-        """Advance by ``dt`` s; ``command`` (rad) is latched when a PWM frame is due."""
+    @classmethod
+    def stacked(cls, servos: Sequence[Servo]) -> Servo:
+        """Return one object holding every state of ``servos`` (one model, one PWM timing)."""
+        first = servos[0]
+        if any(s.params != first.params or s.until_update != first.until_update
+               for s in servos):
+            raise ValueError('stacked servos need one model and one PWM frame timing')
+        bank = cls(first.params)
+        for name in _STATES:
+            setattr(bank, name, np.stack([getattr(s, name) for s in servos]))
+        bank.until_update = first.until_update
+        return bank
+
+    def unstack_into(self, servos: Sequence[Servo]) -> None:
+        """Copy row ``i`` of every state back into ``servos[i]`` (the inverse of ``stacked``)."""
+        for name in _STATES:
+            rows = getattr(self, name)
+            for i, servo in enumerate(servos):
+                setattr(servo, name, rows[i].copy())
+        for servo in servos:
+            servo.until_update = self.until_update
+
+    def step(self, command: ArrayLike, dt: float) -> None:
+        """Advance by ``dt`` s; ``command`` (rad, ``shape``) is latched when a frame is due."""
         p = self.params
-        self._until_update -= dt
-        if self._until_update <= 0.0:
-            self.setpoint = clamp_to_limit(command, p.limit_rad)
-            self._until_update += 1.0 / p.update_hz
+        self.until_update -= dt
+        if self.until_update <= 0.0:
+            self.setpoint = clamp_to_limit(np.asarray(command, dtype=float), p.limit_rad)
+            self.until_update += 1.0 / p.update_hz
         self.motor = slew(self.motor, self.setpoint, p.rate_limit_rad_s, dt)
         previous = self.angle
         self.angle = lag(self.angle, self.motor, p.time_constant_s, dt)
         # The mean rate over the step (exact for the step taken, also when tau << dt).
         self.rate = (self.angle - previous) / dt
+
+
+_STATES = ('setpoint', 'motor', 'angle', 'rate')

@@ -12,8 +12,8 @@ and emits telemetry (100 Hz) and heartbeats as encoded frames (``take_output``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-import math
 
 import numpy as np
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
@@ -25,6 +25,25 @@ from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust, rea
 from wirefish_sim.fish_dynamics import (GRAVITY, surge_acceleration, wrap_angle,
                                         yaw_acceleration)
 from wirefish_sim.servo_model import Servo, ServoParameters
+
+# The decoder's drops that an ERROR reports: one ERROR per kind that a received chunk saw,
+# with ref_seq 0 (a dropped frame's seq is not to be trusted). The C firmware has the same
+# rule (firmware/src/app.c, report_drops); test/firmware/test_fw_virtual_fish_parity.py holds
+# the two equal.
+_DROP_REPORTS = ((ErrorCode.BAD_CRC, ('crc_errors',)),
+                 (ErrorCode.BAD_FRAME, ('cobs_errors', 'short_frames', 'overflows')),
+                 (ErrorCode.UNKNOWN_TYPE, ('unknown_type',)),
+                 (ErrorCode.BAD_LENGTH, ('length_errors',)),
+                 (ErrorCode.COMMAND_OUT_OF_RANGE, ('invalid_payload',)))
+
+_FAILSAFE_COMMAND = int(Status.FAILSAFE_COMMAND)
+_FAILSAFE_HEARTBEAT = int(Status.FAILSAFE_HEARTBEAT)
+_VERSION_MISMATCH = int(Status.VERSION_MISMATCH)
+_SERVO_CLAMPED = int(Status.SERVO_CLAMPED)
+_LOW_BATTERY = int(Status.LOW_BATTERY)
+_NEUTRAL_FLAGS = _FAILSAFE_COMMAND | _FAILSAFE_HEARTBEAT | _VERSION_MISMATCH
+# The flags the failsafe check leaves as they are (it sets every other one anew).
+_KEPT_FLAGS = 0xFFFF & ~(_NEUTRAL_FLAGS | _SERVO_CLAMPED | _LOW_BATTERY)
 
 
 @dataclass(frozen=True)
@@ -95,9 +114,9 @@ class VirtualFish:
         c = self.config
         self.total_mass = c.mass_kg + c.added_mass_kg
         self.state = FishState()
-        self.servos = (Servo(c.servo), Servo(c.servo))
+        self.servos = Servo(c.servo, (2,))  # the pair: servo_1, servo_2
         self.target = (0.0, 0.0)
-        self.status = Status.FAILSAFE_COMMAND | Status.FAILSAFE_HEARTBEAT
+        self.status = _FAILSAFE_COMMAND | _FAILSAFE_HEARTBEAT  # Status flags, as an int
         self.decoder = StreamDecoder()
         self.encoder = FrameEncoder()
         self.commands_received = 0
@@ -110,7 +129,7 @@ class VirtualFish:
         self._next_telemetry = 1.0 / self.config.telemetry_hz
         self._next_heartbeat = 0.0
         self._remainder = 0.0
-        self._crc_errors_reported = 0
+        self._drops_reported = [0] * len(_DROP_REPORTS)
         self._last_momentum: tuple[float, float] | None = None  # K1, K2 of the last step
         noise = c.imu_noise
         self._gyro_bias = self.rng.normal(0.0, noise.gyro_bias_rad_s, 3)
@@ -130,10 +149,12 @@ class VirtualFish:
             elif isinstance(message, ServoCommand):
                 if self._host_version_ok:
                     self.command(message.servo_1, message.servo_2)
-        crc_errors = self.decoder.stats.crc_errors
-        if crc_errors > self._crc_errors_reported:
-            self._crc_errors_reported = crc_errors
-            self._outbox.append(self.encoder.encode(ErrorReport(ErrorCode.BAD_CRC, 0)))
+        stats = self.decoder.stats
+        for i, (code, counters) in enumerate(_DROP_REPORTS):
+            count = sum(getattr(stats, name) for name in counters)
+            if count != self._drops_reported[i]:
+                self._drops_reported[i] = count
+                self._outbox.append(self.encoder.encode(ErrorReport(code, 0)))
 
     def command(self, servo_1: float, servo_2: float) -> None:
         """Register servo targets (rad) now, as a SERVO_CMD frame would."""
@@ -147,78 +168,44 @@ class VirtualFish:
         self._last_heartbeat_time = self.state.time_s
 
     def _update_failsafe(self) -> None:
+        # Plain ints: this runs every physics step of every fish (IntFlag arithmetic costs
+        # several times more than the rest of the check).
         c, now = self.config, self.state.time_s
-        status = self.status & ~(Status.FAILSAFE_COMMAND | Status.FAILSAFE_HEARTBEAT
-                                 | Status.SERVO_CLAMPED | Status.LOW_BATTERY
-                                 | Status.VERSION_MISMATCH)
+        status = self.status & _KEPT_FLAGS
         if c.command_timeout_s is not None and (
                 self._last_command_time is None
                 or now - self._last_command_time > c.command_timeout_s):
-            status |= Status.FAILSAFE_COMMAND
+            status |= _FAILSAFE_COMMAND
         if c.heartbeat_timeout_s is not None and (
                 self._last_heartbeat_time is None
                 or now - self._last_heartbeat_time > c.heartbeat_timeout_s):
-            status |= Status.FAILSAFE_HEARTBEAT
+            status |= _FAILSAFE_HEARTBEAT
         if not self._host_version_ok:
-            status |= Status.VERSION_MISMATCH
-        failsafe = status & (Status.FAILSAFE_COMMAND | Status.FAILSAFE_HEARTBEAT
-                             | Status.VERSION_MISMATCH)
-        self.target = (0.0, 0.0) if failsafe else self._commanded
+            status |= _VERSION_MISMATCH
+        self.target = (0.0, 0.0) if status & _NEUTRAL_FLAGS else self._commanded
         limit = c.servo.limit_rad
-        if any(abs(a) > limit for a in self.target):
-            status |= Status.SERVO_CLAMPED
+        if abs(self.target[0]) > limit or abs(self.target[1]) > limit:
+            status |= _SERVO_CLAMPED
         if self.battery_voltage() < c.low_battery_v:
-            status |= Status.LOW_BATTERY
+            status |= _LOW_BATTERY
         self.status = status
 
     # --- physics ----------------------------------------------------------------------------
     def step(self, dt: float) -> None:
         """Advance simulated time by ``dt`` s in fixed physics steps (the rest is carried)."""
-        self._remainder += dt
-        h = self.config.physics_dt_s
-        count = int(self._remainder / h + 1e-9)
-        if count <= 0:
-            return
-        self._remainder -= count * h
-        # A block of servo steps first (they do not depend on the speed), then the tail
-        # kinematics for the whole block at once, then the surge/yaw integration step by step.
-        angles = np.empty((count, 2))
-        rates = np.empty((count, 2))
-        for i in range(count):
-            self._update_failsafe()
-            for j, servo in enumerate(self.servos):
-                servo.step(self.target[j], h)
-                angles[i, j], rates[i, j] = servo.angle, servo.rate
-            self.state.time_s += h
-            self._emit_due(angles[i])
-        velocity, slope, k1, k2 = reactive_state(angles, rates, self.geometry)
-        tip = tail_tip_lateral_positions(angles, self.geometry)
-        # Rates of the tail's lateral momentum terms by differences between physics steps
-        # (their sum over a period telescopes to zero, as the exact mean does).
-        first = self._last_momentum or (float(k1[0]), float(k2[0]))
-        k1_rate = np.diff(k1, prepend=first[0]) / h
-        k2_rate = np.diff(k2, prepend=first[1]) / h
-        self._last_momentum = (float(k1[-1]), float(k2[-1]))
-        self._integrate(velocity, slope, tip, k1_rate, k2, k2_rate, h)
+        count, self._remainder = physics_steps(self._remainder, dt, self.config.physics_dt_s)
+        if count > 0:
+            swim((self,), count)
 
-    def _integrate(self, velocity: np.ndarray, slope: np.ndarray, tip: np.ndarray,
-                   k1_rate: np.ndarray, k2: np.ndarray, k2_rate: np.ndarray,
-                   h: float) -> None:
-        s, c, g = self.state, self.config, self.geometry
-        for v, dydq, y_tip, dk1, mass_k2, dk2 in zip(
-                velocity.tolist(), slope.tolist(), tip.tolist(), k1_rate.tolist(),
-                k2.tolist(), k2_rate.tolist()):
-            thrust = float(instantaneous_thrust(v, dydq, s.speed, g))
-            drag = float(drag_force(s.speed, g))
-            s.acceleration = surge_acceleration(thrust, dk1, mass_k2, dk2, s.speed, drag,
-                                                self.total_mass)
-            s.speed += s.acceleration * h
-            s.yaw_rate += h * yaw_acceleration(s.yaw_rate, y_tip, s.speed, c.yaw_gain,
-                                               c.yaw_time_constant_s, g.body_length)
-            s.yaw = wrap_angle(s.yaw + s.yaw_rate * h)
-            s.x += s.speed * math.cos(s.yaw) * h
-            s.y += s.speed * math.sin(s.yaw) * h
-            s.tail_tip_offset = y_tip
+    def firmware_target(self) -> tuple[float, float]:
+        """Run the firmware's failsafe check of now; return the servo targets (rad) it sets."""
+        self._update_failsafe()
+        return self.target
+
+    def tick(self, step_s: float, servo_angles: np.ndarray) -> None:
+        """End one physics step of ``step_s`` s: the clock moves on, due frames are emitted."""
+        self.state.time_s += step_s
+        self._emit_due(servo_angles)
 
     def battery_voltage(self) -> float:
         """Return the battery voltage (V): a slow linear discharge (model assumption)."""
@@ -234,20 +221,20 @@ class VirtualFish:
         if now + 1e-9 >= self._next_heartbeat:
             self._next_heartbeat += 1.0 / self.config.heartbeat_hz
             self._outbox.append(self.encoder.encode(
-                Heartbeat(PROTOCOL_VERSION, Role.FISH, int(now * 1000.0))))
+                Heartbeat(PROTOCOL_VERSION, Role.FISH, round(now * 1000.0))))
 
     def telemetry(self, servo_angles: np.ndarray | None = None) -> Telemetry:
         """Return the telemetry message of now: the IMU model applied to the ground truth."""
         s, noise, rng = self.state, self.config.imu_noise, self.rng
         if servo_angles is None:
-            servo_angles = np.array([servo.angle for servo in self.servos])
+            servo_angles = self.servos.angle
         attitude = rng.normal(0.0, noise.attitude_rad, 3)
         gyro = np.array([0.0, 0.0, s.yaw_rate]) + self._gyro_bias + rng.normal(
             0.0, noise.gyro_rad_s, 3)
         # Specific force in FLU: surge acceleration on x, centripetal U r on y, gravity on z.
         accel = np.array([s.acceleration, s.speed * s.yaw_rate, GRAVITY]) + self._accel_bias \
             + rng.normal(0.0, noise.accel_m_s2, 3)
-        return Telemetry(board_time_ms=int(s.time_s * 1000.0) & 0xFFFFFFFF,
+        return Telemetry(board_time_ms=round(s.time_s * 1000.0) & 0xFFFFFFFF,
                          roll=float(attitude[0]), pitch=float(attitude[1]),
                          yaw=wrap_angle(s.yaw + float(attitude[2])),
                          gyro=tuple(gyro.tolist()), accel=tuple(accel.tolist()),
@@ -258,3 +245,71 @@ class VirtualFish:
         """Return and clear the encoded frames emitted since the last call, in order."""
         frames, self._outbox = self._outbox, []
         return frames
+
+
+def physics_steps(remainder: float, dt: float, step_s: float) -> tuple[int, float]:
+    """Return how many whole ``step_s`` steps ``remainder + dt`` s hold, and what is left."""
+    remainder += dt
+    count = int(remainder / step_s + 1e-9)
+    if count <= 0:
+        return 0, remainder
+    return count, remainder - count * step_s
+
+
+def swim(school: Sequence[VirtualFish], count: int) -> None:
+    """
+    Advance every fish of ``school`` by ``count`` physics steps: one clock, one physics.
+
+    The fish share one ``SimConfig`` and one geometry (``VirtualFleet`` checks). Step by step,
+    each fish's firmware sets its servo targets and every fish's servos move in one call;
+    the servos do not depend on the speed, so the whole block goes first (the telemetry
+    emitted within it sees the state at the block's start). Then the tail kinematics of
+    every fish and step in one evaluation (``reactive_state`` over (fish, step, 2)), then the
+    surge/yaw integration step by step, each step vectorised over the fish: a fish of a school
+    swims as it would alone.
+    """
+    first = school[0]
+    c, g, h = first.config, first.geometry, first.config.physics_dt_s
+    servos = Servo.stacked([fish.servos for fish in school])  # (fish, 2)
+    angles = np.empty((len(school), count, 2))
+    rates = np.empty((len(school), count, 2))
+    targets = np.empty((len(school), 2))
+    for i in range(count):
+        for f, fish in enumerate(school):
+            targets[f] = fish.firmware_target()
+        servos.step(targets, h)
+        angles[:, i], rates[:, i] = servos.angle, servos.rate
+        for f, fish in enumerate(school):
+            fish.tick(h, angles[f, i])
+    servos.unstack_into([fish.servos for fish in school])
+    velocity, slope, k1, k2 = reactive_state(angles, rates, g)  # each (fish, step)
+    tip = tail_tip_lateral_positions(angles, g)
+    # Rates of the tail's lateral momentum terms by differences between physics steps
+    # (their sum over a period telescopes to zero, as the exact mean does).
+    last = np.array([fish._last_momentum or (k1[f, 0], k2[f, 0])
+                     for f, fish in enumerate(school)])
+    k1_rate = np.diff(k1, axis=1, prepend=last[:, :1]) / h
+    k2_rate = np.diff(k2, axis=1, prepend=last[:, 1:]) / h
+    states = [fish.state for fish in school]
+    speed = np.array([s.speed for s in states])
+    yaw_rate = np.array([s.yaw_rate for s in states])
+    yaw = np.array([s.yaw for s in states])
+    x = np.array([s.x for s in states])
+    y = np.array([s.y for s in states])
+    acceleration = np.array([s.acceleration for s in states])
+    for i in range(count):  # sequential in time: thrust and drag depend on the speed
+        thrust = instantaneous_thrust(velocity[:, i], slope[:, i], speed, g)
+        acceleration = np.asarray(surge_acceleration(
+            thrust, k1_rate[:, i], k2[:, i], k2_rate[:, i], speed, drag_force(speed, g),
+            first.total_mass))
+        speed = speed + acceleration * h
+        yaw_rate = yaw_rate + h * yaw_acceleration(yaw_rate, tip[:, i], speed, c.yaw_gain,
+                                                   c.yaw_time_constant_s, g.body_length)
+        yaw = wrap_angle(yaw + yaw_rate * h)
+        x = x + speed * np.cos(yaw) * h
+        y = y + speed * np.sin(yaw) * h
+    for f, (fish, s) in enumerate(zip(school, states)):
+        fish._last_momentum = (float(k1[f, -1]), float(k2[f, -1]))
+        s.speed, s.acceleration = float(speed[f]), float(acceleration[f])
+        s.yaw_rate, s.yaw = float(yaw_rate[f]), float(yaw[f])
+        s.x, s.y, s.tail_tip_offset = float(x[f]), float(y[f]), float(tip[f, -1])
