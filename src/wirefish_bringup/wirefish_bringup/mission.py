@@ -119,7 +119,7 @@ def _drive(mission, namespace: str, bag_path: Path,
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
     run = _Run()
     started = node.get_clock().now().nanoseconds * 1e-9
-    hinted = []
+    hinted: list[float] = []
 
     def now() -> float:
         return node.get_clock().now().nanoseconds * 1e-9
