@@ -33,6 +33,7 @@ SUBCOMMANDS = {
 # Other packages add subcommands through this entry-point group ('name = module'), as ros2cli
 # extensions do: wirefish_analysis adds `sweep`, and bringup needs no import of them.
 PLUGIN_GROUP = 'wirefish.commands'
+INTERRUPTED = 130  # the exit code of a command stopped by Ctrl-C (128 + SIGINT)
 
 
 def subcommands() -> dict[str, tuple[str, str]]:
@@ -85,7 +86,14 @@ def main(argv: list[str] | None = None) -> int:
     if '--ros-args' in argv:
         argv = argv[:argv.index('--ros-args')]
     args = build_parser(argv).parse_args(argv)
-    return args.run(args)
+    try:
+        return args.run(args)
+    except KeyboardInterrupt:
+        # A command without its own SIGINT handling (a sweep, a fit): one line, no traceback.
+        from wirefish_common.progress import end_line
+        end_line()
+        print(f'wirefish {args.command}: interrupted (Ctrl-C)', file=sys.stderr)
+        return INTERRUPTED
 
 
 if __name__ == '__main__':

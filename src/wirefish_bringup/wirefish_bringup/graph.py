@@ -198,7 +198,8 @@ class NodeSpec:
 
     ``arguments`` come first, verbatim; when ``namespace`` is set, a ``--ros-args`` section
     follows with the node name, namespace, ``params_file`` and ``parameters``. ``ros_nodes``
-    are the ROS node names the process hosts; ``link`` the device symlink it creates.
+    are the ROS node names the process hosts; ``links`` the device symlinks it creates (a
+    fleet's one virtual-fish process: one per fish).
     """
 
     package: str
@@ -210,7 +211,7 @@ class NodeSpec:
     parameters: Mapping[str, str] = field(default_factory=dict)
     restart: RestartPolicy = NO_RESTART
     ros_nodes: tuple[str, ...] = ()
-    link: Path | None = None
+    links: tuple[Path, ...] = ()
 
     def executable_path(self) -> Path:
         """Return the installed executable, where `ros2 run` finds it (lib/<package>/)."""
@@ -397,7 +398,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
             # A process that parses its own options names its node itself (the recorder's
             # is outside the namespace): nothing to wait for or to look for there.
             restart=e.restart, ros_nodes=(e.name,) if e.ros_args else (),
-            link=Path(device) if e.creates_link else None))
+            links=(Path(device),) if e.creates_link else ()))
     if composed:
         specs.append(NodeSpec(
             'wirefish_bringup', 'wirefish', COMPOSED_NAME,
