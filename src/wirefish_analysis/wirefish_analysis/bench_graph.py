@@ -73,8 +73,8 @@ def processes(specs: list[NodeSpec], domain_id: int, log_dir: Path | None = None
     try:
         for spec in specs:
             proc = supervisor.start(spec)  # removes a stale device link first
-            if spec.link is not None:
-                wait_for_path(spec.link, [proc], 15.0)
+            for link in spec.links:
+                wait_for_path(link, [proc], 15.0)
         yield supervisor
     finally:
         supervisor.stop()

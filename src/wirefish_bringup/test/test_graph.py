@@ -20,7 +20,7 @@ def test_the_virtual_fish_starts_first_and_the_bridge_opens_its_link():
         'tuner_node']
     link = str(sim_tty_link('/tank/fish_1'))
     assert specs[0].command_arguments()[:3] == ('--link', link, '--ros')
-    assert specs[0].link == Path(link)
+    assert specs[0].links == (Path(link),)
     assert f'port:={link}' in specs[1].command_arguments()
     for spec in specs:
         args = spec.command_arguments()

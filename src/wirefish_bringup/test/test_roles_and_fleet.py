@@ -62,10 +62,27 @@ def test_a_fleet_is_one_namespace_and_one_frame_prefix_per_fish():
     specs = fleet_graph('/tank', 3)
     for i in (1, 2, 3):
         mine = [s for s in specs if s.namespace == f'/tank/fish_{i}']
-        assert _names(mine) == _names(fish_graph('/w'))
-        sim = next(s for s in mine if s.name == 'fish_sim')
-        assert f'frame_prefix:=fish_{i}' in sim.command_arguments()
-        assert f'/tmp/wirefish-tank_fish_{i}-tty' in sim.command_arguments()
+        assert _names(mine) == [n for n in _names(fish_graph('/w')) if n != 'fish_sim']
+        bridge = next(s for s in mine if s.name == 'bridge_node')
+        assert f'frame_prefix:=fish_{i}' in bridge.command_arguments()
+        assert f'port:=/tmp/wirefish-tank_fish_{i}-tty' in bridge.command_arguments()
+
+
+def test_a_fleets_virtual_fish_are_one_process_first_with_each_fishs_link_and_name():
+    specs = fleet_graph('/tank', 3)
+    sims = [s for s in specs if s.name == 'fish_sim']
+    assert len(sims) == 1 and specs[0] is sims[0] and sims[0].namespace == '/tank'
+    args = sims[0].command_arguments()
+    links = [args[i + 1] for i, a in enumerate(args) if a == '--link']
+    assert links == [f'/tmp/wirefish-tank_fish_{i}-tty' for i in (1, 2, 3)]
+    assert [str(link) for link in sims[0].links] == links
+    assert [args[i + 1] for i, a in enumerate(args) if a == '--fish'] == [
+        'fish_1', 'fish_2', 'fish_3']
+    assert '--ros' in args and not any('frame_prefix' in a for a in args)
+
+
+def test_the_shore_side_of_a_fleet_has_no_virtual_fish():
+    assert 'fish_sim' not in _names(fleet_graph('/tank', 2, role=SHORE))
 
 
 def test_a_fleet_recording_is_one_recorder_of_the_base_namespace():
@@ -87,7 +104,8 @@ def _everything_named(specs) -> set[str]:
 def test_two_fleets_share_no_namespace_and_no_virtual_fish_link():
     one, other = _everything_named(fleet_graph('/tank_a', 3)), _everything_named(
         fleet_graph('/tank_b', 3))
-    assert len(one) == 6 and len(other) == 6  # 3 namespaces and 3 links each
+    # The base (the virtual fish's), 3 fish namespaces and 3 links each
+    assert len(one) == 7 and len(other) == 7
     assert not one & other
 
 

@@ -277,12 +277,12 @@ def run(args: argparse.Namespace) -> int:
                     return 0
             for spec in specs:
                 proc = supervisor.start(spec)
-                if spec.link is not None:
-                    if not wait_for_path(spec.link, [proc], DEVICE_TIMEOUT_S):
+                for link in spec.links:
+                    if not wait_for_path(link, [proc], DEVICE_TIMEOUT_S):
                         raise RuntimeError(f'{spec.name} did not open its pseudo-terminal:\n'
                                            + supervisor.log_tail(spec.name))
                     fish = 'emulated board' if qemu else 'virtual fish'
-                    print(f'{fish} on {spec.link} -> {spec.link.resolve()}')
+                    print(f'{fish} on {link} -> {link.resolve()}')
             print(f'started {len(supervisor.processes)} processes in {namespace}; '
                   f'logs in {run_dir / "logs"}', flush=True)
             status = _wait_ready(node, executor, namespace, specs, supervisor,

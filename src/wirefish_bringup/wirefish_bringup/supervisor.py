@@ -75,8 +75,8 @@ class Supervisor:
 
     def _launch(self, key: str) -> subprocess.Popen:
         spec = self.specs[key]
-        if spec.link is not None:
-            remove_stale_link(spec.link)
+        for link in spec.links:
+            remove_stale_link(link)
         log = self._logs.get(key)
         if log is None:
             self._log_dir.mkdir(parents=True, exist_ok=True)
@@ -113,8 +113,8 @@ class Supervisor:
             if key in self._pending or key in self.given_up or proc.poll() is None:
                 continue
             spec, budget, code = self.specs[key], self.budgets[key], proc.returncode
-            if spec.link is not None:  # a killed virtual fish leaves its link behind
-                remove_stale_link(spec.link)
+            for link in spec.links:  # a killed virtual fish leaves its links behind
+                remove_stale_link(link)
             delay = budget.on_exit(now)
             if delay is not None:
                 self._pending[key] = now + delay
