@@ -105,3 +105,14 @@ def sequence_gaps(bag_path: Path) -> tuple[list[SequenceGap], dict[str, int]]:
 def flushed_topics(path: Path) -> set[str]:
     """Return the topics with a message in the flushed chunks of an MCAP file being written."""
     return {topic for topic, _ in _messages(path, being_written=True)}
+
+
+def publish_lags(bag_path: Path) -> dict[str, tuple[list[float], list[float]]]:
+    """Return {topic: (receive times s, publish times s)} of every message in the bag's files."""
+    times: dict[str, tuple[list[float], list[float]]] = {}
+    for path in storage_files(Path(bag_path)):
+        for topic, message in _messages(path):
+            received, published = times.setdefault(topic, ([], []))
+            received.append(message.log_time * 1e-9)
+            published.append(message.publish_time * 1e-9)
+    return times
