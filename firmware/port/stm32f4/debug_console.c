@@ -37,32 +37,62 @@ static void put_number(int32_t value)
     }
 }
 
+static uint32_t lines_dropped;   /* Z lines the interrupt found no room for */
+
+static bool in_interrupt(void)
+{
+    uint32_t ipsr;
+    __asm volatile("mrs %0, ipsr" : "=r"(ipsr));
+    return (ipsr & 0x1FFu) != 0u;
+}
+
+/* The main loop is the ring's consumer: it sends what the ring holds to USART2 (QEMU 7.2's
+ * USART has no TXE interrupt and sends each DR write at once). */
+static void flush(void)
+{
+    uint8_t byte;
+    while (ring_get(&debug_ring, &byte)) {
+        while (!(USART_SR(USART2_BASE) & USART_SR_TXE)) {
+        }
+        USART_DR(USART2_BASE) = byte;
+    }
+}
+
 /* Called from the main loop and from the USART1 interrupt: the line is written with
- * interrupts masked, so the ring keeps a single producer at a time. A full ring drops whole
- * lines only (the tests count what they read, a cut line would be misread). */
+ * interrupts masked, so the ring keeps a single producer at a time. The main loop makes room
+ * first (it is the consumer), so none of its lines is lost; an interrupt that finds no room
+ * drops its whole line and counts it (the "C" line reports the count): a cut line would be
+ * misread. */
 void debug_console_line(char tag, const int32_t *values, unsigned count)
 {
+    const uint32_t needed = 2u + 12u * count;
+    if (!in_interrupt()) {
+        while (debug_ring.mask + 1u - ring_used(&debug_ring) < needed) {
+            flush();
+        }
+    }
     uint32_t primask = board_irq_save();
-    if (debug_ring.mask + 1u - ring_used(&debug_ring) >= 2u + 12u * count) {
+    if (debug_ring.mask + 1u - ring_used(&debug_ring) >= needed) {
         (void)ring_put(&debug_ring, (uint8_t)tag);
         for (unsigned i = 0u; i < count; i++) {
             (void)ring_put(&debug_ring, ' ');
             put_number(values[i]);
         }
         (void)ring_put(&debug_ring, '\n');
+    } else {
+        lines_dropped++;
     }
     board_irq_restore(primask);
 }
 
-/* QEMU 7.2's USART has no TXE interrupt (see uart.c): the main loop sends the lines. */
 void debug_console_poll(void)
 {
     uint32_t now = wf_hal_millis();
     if (now - last_config_ms >= 1000u) {
         last_config_ms = now;
-        const int32_t timer[2] = {(int32_t)wf_hal_pwm_ticks_per_us(),
-                                  (int32_t)board_pwm_period()};
-        debug_console_line('C', timer, 2u);
+        const int32_t timer[3] = {(int32_t)wf_hal_pwm_ticks_per_us(),
+                                  (int32_t)board_pwm_period(), (int32_t)lines_dropped};
+        debug_console_line('C', timer, 3u);
         for (unsigned i = 0u; i < WF_SERVO_COUNT; i++) {
             const wf_servo_cal_t *cal = &config->servo_cal[i];
             const int32_t servo[5] = {(int32_t)i, (int32_t)(cal->neutral_us * 1000.0f + 0.5f),
@@ -72,12 +102,7 @@ void debug_console_poll(void)
             debug_console_line('K', servo, 5u);
         }
     }
-    uint8_t byte;
-    while (ring_get(&debug_ring, &byte)) {
-        while (!(USART_SR(USART2_BASE) & USART_SR_TXE)) {
-        }
-        USART_DR(USART2_BASE) = byte;
-    }
+    flush();
 }
 
 #endif /* WF_PORT_QEMU */

@@ -3,7 +3,8 @@
  * read by the in-the-loop tests, unseen by the core.
  *   "Z <ms>"              a 0x00 byte (frame delimiter) arrived on USART1, board time
  *   "P <ms> <ch> <ticks>" servo channel ch's compare register changed; the value read back
- *   "C <ticks_per_us> <period_ticks>" the PWM timer's set-up, once a second
+ *   "C <ticks_per_us> <period_ticks> <dropped>" the PWM timer's set-up and the count of
+ *                         "Z" lines lost for want of room, once a second
  *   "K <servo> <neutral_ns> <ns_per_rad> <direction> <limit_urad>" the servo calibration
  *                         (pulse widths in ns, the limit in microradians), once a second
  * Every build but the QEMU one compiles the calls away.

@@ -1,0 +1,270 @@
+"""
+bridge_node and the firmware's ARM build on an emulated STM32F405 (QEMU netduinoplus2), over
+the board's USART1 pseudo-terminal: the link as PROTOCOL.md defines it, end to end.
+
+What the board did is read from the board itself: its telemetry, and its debug console
+(qemu_loop.py), which reports every compare register write (read back from the timer) and the
+board time of every delimiter it received. Times of the firmware's rules are measured on the
+board's clock: from the board time a frame arrived to the board time of the first telemetry
+that shows the rule acted. A timeout is "no frame for more than the timeout" (the virtual
+fish's rule too): at the board's 1 ms resolution it fires 1 ms after the timeout.
+"""
+
+import os
+import signal
+import time
+
+from cobs import cobs
+import pytest
+from qemu_loop import board_time_of, Console, Tap
+from wirefish_bridge.codec import encode_body, FrameEncoder, StreamDecoder
+from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, Role, ServoCommand,
+                                      Status, Telemetry)
+from wirefish_bringup.graph import entry
+
+pytestmark = pytest.mark.ros
+
+# The graph's servo_cmd rate (the CPG's stream, as the registry lists it).
+GRAPH_RATE_HZ = entry('cpg_node').rates_hz['servo_cmd']
+# PROTOCOL.md's firmware defaults.
+COMMAND_TIMEOUT_MS = 500
+HEARTBEAT_TIMEOUT_MS = 1500
+TELEMETRY_PERIOD_MS = 10
+CLOCK_RESOLUTION_MS = 1
+
+
+def command_at(i: int) -> tuple[float, float]:
+    """
+    Return the i-th test command: two permutations of 97 angles in [-1.2, 1.2] rad.
+
+    Any 97 commands in a row differ pairwise by at least 0.025 rad (16 timer ticks), so the
+    bridge's rate limit, which forwards a subsequence, never sends the same value twice in a
+    row: every command it sends must show as a change of both compare registers.
+    """
+    return (1.2 * ((i * 37) % 97 - 48) / 48.0, -1.2 * ((i * 53 + 11) % 97 - 48) / 48.0)
+
+
+def _connected(probe) -> bool:
+    values = probe.last_diagnostics()
+    return values.get('link_state') == 'connected' and values.get('fish_protocol_version') == '1'
+
+
+def _telemetry(tap: Tap) -> list[Telemetry]:
+    return [c.frame.message for c in tap.record.to_host if isinstance(c.frame.message, Telemetry)]
+
+
+def _servo_commands(tap: Tap, start: int = 0) -> list:
+    return [c for c in tap.record.to_board[start:] if isinstance(c.frame.message, ServoCommand)
+            and not c.dropped]
+
+
+def _wait_board_time(tap: Tap, board_ms: int, timeout_s: float = 30.0) -> None:
+    """Wait until the board's telemetry says its clock passed ``board_ms``.
+
+    The emulated board's clock runs slower than the wall's on a loaded machine (QEMU misses
+    SysTick periods it had no CPU for): waits are in board time.
+    """
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        telemetry = _telemetry(tap)
+        if telemetry and telemetry[-1].board_time_ms > board_ms:
+            return
+        time.sleep(0.05)
+    raise AssertionError(f'the board clock did not pass {board_ms} ms within {timeout_s:g} s')
+
+
+def _wait_console_caught_up(console: Console, tap: Tap, timeout_s: float = 30.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while len(console.zeros) < tap.zeros_forwarded and time.monotonic() < deadline:
+        time.sleep(0.05)
+    # Every delimiter the tap forwarded reached USART1, none more: the board times of the
+    # frames below are the board's own record of their arrival.
+    assert len(console.zeros) == tap.zeros_forwarded, (len(console.zeros), tap.zeros_forwarded)
+    assert console.lines_dropped == 0
+
+
+def test_hello_then_sixty_seconds_of_servo_cmd_every_command_applied(
+        board, console, tap, start_bridge, probe, tmp_path):
+    start_bridge(tap.link)
+    assert probe.spin_until(lambda: _connected(probe), 30.0), probe.last_diagnostics()
+    # The board took the bridge's hello: neither heartbeat failsafe nor version mismatch.
+    assert probe.spin_until(lambda: any(
+        not t.status & (Status.FAILSAFE_HEARTBEAT | Status.VERSION_MISMATCH)
+        for t in _telemetry(tap)[-5:]), 10.0)
+    assert probe.spin_until(
+        lambda: 'fish says hello (protocol 1)' in (tmp_path / 'bridge.log').read_text(), 5.0)
+    start = len(tap.record.to_board)
+    telemetry_start = len(tap.record.to_host)
+
+    probe.spin_for(60.0, command_at, GRAPH_RATE_HZ)
+    probe.spin_for(1.5)   # the bridge's command timeout passes: it commands neutral
+    _wait_console_caught_up(console, tap)
+
+    sent = _servo_commands(tap, start)
+    first = next(i for i, c in enumerate(sent) if (c.frame.message.servo_1,
+                                                   c.frame.message.servo_2) != (0.0, 0.0))
+    sent = sent[first:]
+    since = board_time_of(console, sent[0])
+    applied = 0
+    for channel in (0, 1):
+        wanted = [(c.frame.message.servo_1, c.frame.message.servo_2)[channel] for c in sent]
+        changes = [wanted[0]] + [b for a, b in zip(wanted, wanted[1:]) if b != a]
+        seen = [ticks for t, ch, ticks in console.compares if ch == channel and t >= since]
+        assert len(seen) == len(changes), (channel, len(seen), len(changes))
+        tick = console.tick_rad(channel)
+        misses = [(i, want, console.angle(channel, got)) for i, (want, got)
+                  in enumerate(zip(changes, seen)) if abs(console.angle(channel, got) - want)
+                  > tick + 1e-9]
+        assert not misses, misses[:5]
+        applied += len(seen)
+    # The servo angles the board reports are the commands it was sent (a PWM servo reports
+    # what it is commanded), never anything else.
+    commanded = {(c.frame.message.servo_1, c.frame.message.servo_2) for c in sent}
+    reported = [(t.servo_1, t.servo_2) for t in (c.frame.message for c in
+                tap.record.to_host[telemetry_start:]) if isinstance(t, Telemetry)]
+    assert set(reported) <= commanded | {(0.0, 0.0)}
+    errors = [c for c in tap.record.to_host if isinstance(c.frame.message, ErrorReport)]
+    diagnostics = probe.last_diagnostics()
+    print(f'\n60 s at {GRAPH_RATE_HZ:g} Hz: {probe.published} servo_cmd published, '
+          f'{len(sent)} SERVO_CMD frames sent by the bridge, {applied} compare writes '
+          f'matching them ({len(sent)} x 2 channels, within one timer tick); '
+          f'{len(reported)} telemetry frames; bridge: crc_errors {diagnostics["crc_errors"]}, '
+          f'seq gaps {diagnostics["drops"]}; board side: ERROR frames {len(errors)}, '
+          f'host stream crc errors {tap.host_decoder.stats.crc_errors} gaps '
+          f'{tap.host_decoder.stats.seq_gaps}, board stream crc errors '
+          f'{tap.board_decoder.stats.crc_errors} gaps {tap.board_decoder.stats.seq_gaps}')
+    assert applied == 2 * len(sent) + 2   # every command on both channels, and neutral at the end
+    assert diagnostics['crc_errors'] == '0' and diagnostics['drops'] == '0', diagnostics
+    assert not errors
+    for stats in (tap.host_decoder.stats, tap.board_decoder.stats):
+        assert stats.crc_errors == 0 and stats.seq_gaps == 0 and stats.resyncs == 0, stats
+
+
+def test_commands_stopped_on_the_wire_failsafe_command_and_neutral(
+        board, console, tap, start_bridge, probe):
+    start_bridge(tap.link)
+    assert probe.spin_until(lambda: _connected(probe), 30.0), probe.last_diagnostics()
+    probe.spin_for(1.0, lambda i: (0.4, -0.4), GRAPH_RATE_HZ)
+    tap.drop_servo_cmd = True   # the radio loses every command; heartbeats still pass
+    probe.spin_for(0.5, lambda i: (0.4, -0.4), GRAPH_RATE_HZ)
+    _wait_console_caught_up(console, tap)
+    last_arrival = board_time_of(console, _servo_commands(tap)[-1])
+    while _telemetry(tap)[-1].board_time_ms <= last_arrival + COMMAND_TIMEOUT_MS + 100:
+        probe.spin_for(0.2, lambda i: (0.4, -0.4), GRAPH_RATE_HZ)
+    after = [t for t in _telemetry(tap) if t.board_time_ms > last_arrival]
+    early = [t for t in after if t.board_time_ms <= last_arrival + COMMAND_TIMEOUT_MS]
+    assert early and all(not t.status & Status.FAILSAFE_COMMAND for t in early)
+    assert all((t.servo_1, t.servo_2) == (pytest.approx(0.4), pytest.approx(-0.4))
+               for t in early)
+    failsafe = next(t for t in after if t.status & Status.FAILSAFE_COMMAND)
+    neutral = [t for t, ch, ticks in console.compares if t > last_arrival
+               and console.angle(ch, ticks) == pytest.approx(0.0, abs=console.tick_rad(ch))]
+    latency = failsafe.board_time_ms - last_arrival
+    print(f'\nlast command arrived at board time {last_arrival} ms; FAILSAFE_COMMAND in '
+          f'telemetry after {latency} ms, compare registers neutral after '
+          f'{[t - last_arrival for t in neutral]} ms')
+    assert (failsafe.servo_1, failsafe.servo_2) == (0.0, 0.0)
+    assert not failsafe.status & Status.FAILSAFE_HEARTBEAT
+    assert latency <= COMMAND_TIMEOUT_MS + CLOCK_RESOLUTION_MS + TELEMETRY_PERIOD_MS
+    assert len(neutral) == 2
+
+
+def test_bridge_killed_failsafe_heartbeat_and_neutral(board, console, tap, start_bridge, probe):
+    bridge = start_bridge(tap.link)
+    assert probe.spin_until(lambda: _connected(probe), 30.0), probe.last_diagnostics()
+    probe.spin_for(1.0, lambda i: (0.4, -0.4), GRAPH_RATE_HZ)
+    os.killpg(bridge.pid, signal.SIGKILL)
+    bridge.wait()
+    _wait_console_caught_up(console, tap)   # the tap still reads the board
+    heartbeats = [c for c in tap.record.to_board if isinstance(c.frame.message, Heartbeat)]
+    last_arrival = board_time_of(console, heartbeats[-1])
+    _wait_board_time(tap, last_arrival + HEARTBEAT_TIMEOUT_MS + 100)
+    after = [t for t in _telemetry(tap) if t.board_time_ms > last_arrival]
+    early = [t for t in after if t.board_time_ms <= last_arrival + HEARTBEAT_TIMEOUT_MS]
+    assert early and all(not t.status & Status.FAILSAFE_HEARTBEAT for t in early)
+    failsafe = next(t for t in after if t.status & Status.FAILSAFE_HEARTBEAT)
+    latency = failsafe.board_time_ms - last_arrival
+    print(f'\nbridge killed; its last heartbeat arrived at board time {last_arrival} ms; '
+          f'FAILSAFE_HEARTBEAT in telemetry after {latency} ms, servos '
+          f'{failsafe.servo_1, failsafe.servo_2}')
+    assert (failsafe.servo_1, failsafe.servo_2) == (0.0, 0.0)
+    assert latency <= HEARTBEAT_TIMEOUT_MS + CLOCK_RESOLUTION_MS + TELEMETRY_PERIOD_MS
+
+
+def test_a_host_of_another_version_gets_error_5_and_the_servos_stay_neutral(board, console):
+    fd = os.open(board.ports.link, os.O_RDWR | os.O_NOCTTY)
+    import tty
+    tty.setraw(fd)
+    decoder, encoder = StreamDecoder(), FrameEncoder()
+    frames: list = []
+    heartbeat_seqs: list[int] = []
+    try:
+        deadline = time.monotonic() + 5.0
+        while not any(isinstance(f.message, Heartbeat) for f in frames):
+            assert time.monotonic() < deadline, 'no fish heartbeat'
+            frames += decoder.feed(os.read(fd, 4096))
+        last_heartbeat = 0.0
+        end = time.monotonic() + 1.5
+        while time.monotonic() < end:
+            if time.monotonic() - last_heartbeat >= 0.2:
+                heartbeat_seqs.append(encoder.next_seq)
+                os.write(fd, encoder.encode(Heartbeat(version=2, role=Role.HOST)))
+                last_heartbeat = time.monotonic()
+            os.write(fd, encoder.encode(ServoCommand(0.5, -0.5)))
+            time.sleep(0.02)
+            os.set_blocking(fd, False)
+            try:
+                frames += decoder.feed(os.read(fd, 65536))
+            except BlockingIOError:
+                pass
+            os.set_blocking(fd, True)
+    finally:
+        os.close(fd)
+    errors = [f.message for f in frames if isinstance(f.message, ErrorReport)]
+    telemetry = [f.message for f in frames if isinstance(f.message, Telemetry)]
+    mismatched = [t for t in telemetry if t.status & Status.VERSION_MISMATCH]
+    print(f'\nversion 2 host: {len(heartbeat_seqs)} heartbeats, ERROR frames '
+          f'{[(e.code, e.ref_seq) for e in errors]}, {len(mismatched)} telemetry frames with '
+          f'VERSION_MISMATCH, compare writes after boot {console.compares[2:]}')
+    assert [e.code for e in errors] == [ErrorCode.VERSION_MISMATCH] * len(heartbeat_seqs)
+    assert [e.ref_seq for e in errors] == heartbeat_seqs
+    assert mismatched and all((t.servo_1, t.servo_2) == (0.0, 0.0) for t in mismatched)
+    # Only the two neutral compares of power-up: no command moved a servo.
+    assert [(ch, ticks) for _, ch, ticks in console.compares] == [
+        (ch, round(console.calibration[ch].neutral_us * console.ticks_per_us)) for ch in (0, 1)]
+
+
+def _damaged_frames() -> list[tuple[bytes, int]]:
+    """Return damaged runs, each with the ERROR code the board must answer it with."""
+    body = bytearray(encode_body(ServoCommand(1.2, -1.2), 0x4242))
+    body[-1] ^= 0x01   # one bit of the CRC: a frame that decodes but fails its check
+    bad_crc = b'\x00' + cobs.encode(bytes(body)) + b'\x00'
+    bad_cobs = b'\x00\x09\x10\x01\x00'                      # a code byte pointing past the end
+    short = b'\x00' + cobs.encode(b'\x10\x01') + b'\x00'    # 2 bytes: no header and CRC
+    return [(bad_crc, ErrorCode.BAD_CRC), (bad_cobs, ErrorCode.BAD_FRAME),
+            (short, ErrorCode.BAD_FRAME)]
+
+
+def test_corrupted_bytes_are_reported_and_no_damaged_command_is_applied(
+        board, console, tap, start_bridge, probe):
+    start_bridge(tap.link)
+    assert probe.spin_until(lambda: _connected(probe), 30.0), probe.last_diagnostics()
+    probe.spin_for(0.5, lambda i: (0.3, -0.3), GRAPH_RATE_HZ)
+    damage = _damaged_frames() * 4
+    for run, _ in damage:
+        tap.inject(run)
+        probe.spin_for(0.06, lambda i: (0.3, -0.3), GRAPH_RATE_HZ)
+    probe.spin_for(0.5, lambda i: (0.3, -0.3), GRAPH_RATE_HZ)
+    errors = [c.frame.message for c in tap.record.to_host
+              if isinstance(c.frame.message, ErrorReport)]
+    assert probe.spin_until(
+        lambda: probe.last_diagnostics().get('fish_errors') == str(len(damage)), 5.0), \
+        (probe.last_diagnostics().get('fish_errors'), errors)
+    angles = {round(console.angle(ch, ticks), 2) for _, ch, ticks in console.compares}
+    print(f'\n{len(damage)} damaged frames injected; ERROR frames '
+          f'{[e.code for e in errors]}; bridge fish_errors '
+          f'{probe.last_diagnostics()["fish_errors"]}; compare values seen (rad) {sorted(angles)}')
+    assert [e.code for e in errors] == [code for _, code in damage]
+    assert angles <= {0.0, 0.3, -0.3}   # never the damaged frame's +-1.2 rad
+    last = {ch: ticks for _, ch, ticks in console.compares}
+    assert console.angle(0, last[0]) == pytest.approx(0.3, abs=console.tick_rad(0))
