@@ -38,6 +38,8 @@ _NAMESPACE_PATTERN = re.compile(r'^(/[A-Za-z][A-Za-z0-9_]*)+$|^/$')
 ALWAYS, SIM, RECORD, APART = 'always', 'sim', 'record', 'apart'
 # Only with the emulated board: the firmware's ARM build in QEMU (`wirefish up --fish qemu`).
 QEMU = 'qemu'
+# Only with the live view (`wirefish up --view`): the Foxglove server and the dashboard.
+VIEW = 'view'
 # Which side of the radio link an entry runs on. The fish side is everything that
 # keeps the fish safe and swimming without shore; the shore side only tunes, records, drives.
 FISH, SHORE, ALL = 'fish', 'shore', 'all'
@@ -185,6 +187,9 @@ NODES: tuple[NodeEntry, ...] = (
     NodeEntry('wirefish_bringup', 'wirefish', 'wirefish_recorder', start_order=50, when=RECORD,
               arguments=('record', '-o', '{bag}', '--namespace', '{recorded}', '--resume'),
               role=SHORE, ros_args=False),
+    # `wirefish up --view`: the Foxglove WebSocket server over the graph and the dashboard.
+    NodeEntry('wirefish_view', 'view_node', 'view_node', start_order=60, when=VIEW,
+              role=SHORE, frames=True),
 )
 
 # The process that hosts every entry with a node_class in single-process mode.
@@ -282,19 +287,19 @@ def sim_tty_link(namespace: str) -> Path:
 
 
 def entries(*, sim: bool, record: bool = False, role: str = ALL,
-            qemu: bool = False) -> list[NodeEntry]:
+            qemu: bool = False, view: bool = False) -> list[NodeEntry]:
     """
     Return the registry entries of a graph, in start order.
 
     ``sim``: with the virtual fish; ``record``: with the recorder; ``role``: one side of the
     radio link (FISH, SHORE) or both on one machine (ALL). The link relay runs with the fish
     role only: with both sides on one host nothing crosses a radio. ``qemu``: with the
-    emulated board (the firmware in QEMU) as the fish.
+    emulated board (the firmware in QEMU) as the fish; ``view``: with the live view.
     """
     if role not in ROLES:
         raise ValueError(f'unknown role {role!r}: choose one of {", ".join(ROLES)}')
     active = {ALWAYS, *([SIM] if sim else []), *([QEMU] if qemu else []),
-              *([RECORD] if record else []),
+              *([RECORD] if record else []), *([VIEW] if view else []),
               *([APART] if role == FISH else [])}
     return sorted((e for e in NODES if e.when in active and role in (ALL, e.role)),
                   key=lambda e: e.start_order)
@@ -346,7 +351,8 @@ def expected_rates(*, sim: bool = True) -> tuple[dict[str, float], dict[str, flo
 def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
                port: str | None = None, params_file: Path | str | None = None,
                single_process: bool = False, bag: Path | None = None, role: str = ALL,
-               frame_prefix: str = '', qemu: bool = False) -> list[NodeSpec]:
+               frame_prefix: str = '', qemu: bool = False,
+               view: bool = False) -> list[NodeSpec]:
     """
     Return the processes of one fish's graph, in start order (the virtual fish first).
 
@@ -357,7 +363,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     compose`); ``bag`` adds the recorder, writing there; ``role`` starts one side of the radio
     link only (FISH or SHORE; ALL: both); ``frame_prefix`` goes to every node that writes frame
     ids (``fish_1``: ``fish_1/base_link``); ``qemu`` (with ``sim`` False): the fish is the
-    firmware on an emulated board, the bridge on its pty.
+    firmware on an emulated board, the bridge on its pty; ``view`` adds the live view.
     """
     namespace = validate_namespace(namespace)
     if qemu and (sim or port):
@@ -384,7 +390,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
         raise ValueError('the single-process mode hosts one whole fish (wirefish compose): '
                          'a role or a frame prefix needs one process per node')
     with_prefix = {'frame_prefix': frame_prefix} if frame_prefix else {}
-    for e in entries(sim=sim, record=bag is not None, role=role, qemu=qemu):
+    for e in entries(sim=sim, record=bag is not None, role=role, qemu=qemu, view=view):
         if single_process and e.node_class is not None:
             composed.append(e)
             continue

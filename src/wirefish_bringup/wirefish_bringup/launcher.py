@@ -74,6 +74,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--view', action='store_true',
                         help='also the live view: Foxglove WebSocket server and dashboard '
                         '(wirefish view; view_node parameters port, http_port)')
+    parser.add_argument('--view', action='store_true',
+                        help='also the live view: Foxglove WebSocket server and dashboard '
+                        '(wirefish view; view_node parameters port, http_port)')
     parser.add_argument('--allow-duplicate', action='store_true',
                         help='start even if nodes of the graph already run in this namespace '
                         '(e.g. a graph that just died is still discovered)')
@@ -230,7 +233,7 @@ def run(args: argparse.Namespace) -> int:
             specs = fish_graph(namespace, sim=sim, port=args.port,
                                params_file=args.params_file, single_process=args.single_process,
                                bag=bag_path, role=args.role, frame_prefix=args.frame_prefix,
-                               qemu=qemu)
+                               qemu=qemu, view=args.view)
             if qemu:
                 from wirefish_bringup.qemu_board import build_image
                 build_image()

@@ -36,6 +36,14 @@ _DROP_REPORTS = ((ErrorCode.BAD_CRC, ('crc_errors',)),
                  (ErrorCode.BAD_LENGTH, ('length_errors',)),
                  (ErrorCode.COMMAND_OUT_OF_RANGE, ('invalid_payload',)))
 
+
+def _whole_ms(seconds: float) -> int:
+    """Return a time difference in whole milliseconds, as the firmware's clock counts it."""
+    # Simulated time is a sum of 1 ms steps: a difference of two such sums is a whole number
+    # of ms plus rounding of ~1e-13 s, which must not move a timeout by a millisecond.
+    return round(seconds * 1000.0)
+
+
 _FAILSAFE_COMMAND = int(Status.FAILSAFE_COMMAND)
 _FAILSAFE_HEARTBEAT = int(Status.FAILSAFE_HEARTBEAT)
 _VERSION_MISMATCH = int(Status.VERSION_MISMATCH)
@@ -174,11 +182,11 @@ class VirtualFish:
         status = self.status & _KEPT_FLAGS
         if c.command_timeout_s is not None and (
                 self._last_command_time is None
-                or now - self._last_command_time > c.command_timeout_s):
+                or _whole_ms(now - self._last_command_time) > c.command_timeout_s * 1e3):
             status |= _FAILSAFE_COMMAND
         if c.heartbeat_timeout_s is not None and (
                 self._last_heartbeat_time is None
-                or now - self._last_heartbeat_time > c.heartbeat_timeout_s):
+                or _whole_ms(now - self._last_heartbeat_time) > c.heartbeat_timeout_s * 1e3):
             status |= _FAILSAFE_HEARTBEAT
         if not self._host_version_ok:
             status |= _VERSION_MISMATCH
