@@ -35,6 +35,7 @@ PACKAGES = sorted(p.parent for p in (WORKSPACE / 'src').glob('*/package.xml'))
 # packages installed from PyPI) where it has none.
 THIRD_PARTY = {
     'cobs': 'python3-cobs-pip',
+    'foxglove': 'python3-foxglove-sdk-pip',
     'hypothesis': 'python3-hypothesis',
     'matplotlib': 'python3-matplotlib',
     'mcap': 'python3-mcap-pip',

@@ -1,0 +1,1 @@
+"""The live view of the fish: a Foxglove WebSocket server over the graph and a dashboard."""

@@ -1,0 +1,419 @@
+"""
+view_node: a Foxglove WebSocket server over the fish's graph, and the dashboard's web server.
+
+Channels (protocol ``foxglove.sdk.v1``)
+    Every topic of the graph in the node's namespace, and ``/tf``, ``/tf_static`` and
+    ``/diagnostics``: one CDR channel each with its ``ros2msg`` schema, found by a discovery
+    tick (``discovery_period_s``). A topic is subscribed (raw bytes: nothing is decoded) only
+    while a client subscribes to its channel; its QoS follows its publishers' (best effort,
+    transient local). ``view/scene`` (foxglove.SceneUpdate): the fish (``scene``), at
+    ``scene_rate_hz``. ``view/retune`` (JSON): the retune goal's progress and result.
+Client publish
+    Accepted on ``cmd_vel`` (geometry_msgs/msg/Twist, CDR or JSON) within ``max_speed`` and
+    ``max_turn`` (`wirefish drive`'s limits); any other channel, or a message outside the
+    limits or malformed, is refused: a warning in the log and a status message to the clients.
+Services (JSON)
+    ``start``, ``stop`` (std_srvs/Trigger of cpg_node; stop also sends cmd_vel zero first, so
+    the planner rests the fish), ``retune_gait`` (sends the tuner's action goal; its progress
+    and result go out on ``view/retune``).
+The dashboard
+    ``http://address:http_port/``: the bundled page (``share/wirefish_view/dashboard``, built by
+    `make setup`) and ``/config.json`` (the WebSocket port and namespace); 0 serves none.
+Parameters: ``address`` (127.0.0.1; anything wider is logged as a warning), ``port``,
+``http_port``, ``max_speed``, ``max_turn``, ``scene_rate_hz``, ``trail_length``,
+``discovery_period_s``, ``frame_prefix``.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import Future as ConcurrentFuture
+from functools import partial
+import importlib
+import ipaddress
+import json
+import math
+import queue
+import threading
+import time
+from typing import Any
+
+import foxglove
+from foxglove.channels import SceneUpdateChannel
+from foxglove.websocket import (Capability, ChannelView, Client, ClientChannel, ServerListener,
+                                StatusLevel)
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rclpy.action import ActionClient
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from std_srvs.srv import Trigger
+from wirefish_common.frames import declare_frame_prefix, prefixed
+from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import declare, ParameterSpec
+from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_msgs.action import RetuneGait
+from wirefish_msgs.msg import BodyWave
+from wirefish_view.client_input import check_advertised, cmd_vel_from_client
+from wirefish_view.errors import RefusedInput, UnknownType
+from wirefish_view.scene import fish_scene, tail_segments
+from wirefish_view.schemas import ros2msg_schema
+from wirefish_view.web import DashboardServer
+
+GLOBAL_TOPICS = ('/tf', '/tf_static', '/diagnostics')
+SERVICE_WAIT_S = 5.0
+# view/retune: state sent | running (iteration, max_iterations, best_loss) | rejected | done
+# (success, message, applied, loss, iterations, from_library, rmse_theta_deg).
+RETUNE_PROGRESS_SCHEMA = json.dumps({
+    'type': 'object', 'properties': {
+        'state': {'enum': ['sent', 'running', 'rejected', 'done']},
+        'iteration': {'type': 'integer'}, 'max_iterations': {'type': 'integer'},
+        'best_loss': {'type': 'number'}, 'success': {'type': 'boolean'},
+        'message': {'type': 'string'}, 'applied': {'type': 'boolean'},
+        'loss': {'type': 'number'}, 'iterations': {'type': 'integer'},
+        'from_library': {'type': 'boolean'},
+        'rmse_theta_deg': {'type': 'array', 'items': {'type': 'number'}}}}).encode()
+REFUSAL_LOG_PERIOD_S = 2.0
+VIEW_PARAMETERS = (
+    ParameterSpec('address', '127.0.0.1', 'Address the servers bind (127.0.0.1: this machine '
+                  'only; 0.0.0.0 any: a warning is logged). Read at start'),
+    ParameterSpec('port', 8765, 'Foxglove WebSocket port (0: any free one). Read at start',
+                  0, 65535),
+    ParameterSpec('http_port', 8080, 'Dashboard HTTP port (0: any free one; -1: none). Read '
+                  'at start', -1, 65535),
+    ParameterSpec('max_speed', 0.4, 'Largest cmd_vel linear.x a client may send (m/s)',
+                  0.0, 2.0, low_exclusive=True),
+    ParameterSpec('max_turn', 0.6, 'Largest |cmd_vel angular.z| a client may send (rad/s)',
+                  0.0, 5.0, low_exclusive=True),
+    ParameterSpec('scene_rate_hz', 10.0, 'Scene updates a second (Hz)', 0.0, 100.0,
+                  low_exclusive=True),
+    ParameterSpec('trail_length', 600, 'Positions kept in the trail', 2, 100000),
+    ParameterSpec('discovery_period_s', 1.0, 'Seconds between looks for new topics', 0.0,
+                  60.0, low_exclusive=True),
+)
+
+
+def is_loopback(address: str) -> bool:
+    """Return whether ``address`` binds this machine only (127.0.0.0/8, ::1, localhost)."""
+    if address == 'localhost':
+        return True
+    try:
+        return ipaddress.ip_address(address).is_loopback
+    except ValueError:
+        return False
+
+
+def _qos_of(publishers: list) -> QoSProfile:
+    """Return a subscription QoS that matches every publisher of a topic."""
+    best_effort = any(p.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+                      for p in publishers)
+    latched = publishers and all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                                 for p in publishers)
+    if best_effort:
+        return SENSOR_DATA
+    return QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=(DurabilityPolicy.TRANSIENT_LOCAL if latched
+                                  else DurabilityPolicy.VOLATILE))
+
+
+class ViewNode(Node):
+    """The graph as Foxglove channels; cmd_vel, start/stop and retune from the clients."""
+
+    def __init__(self, **kwargs) -> None:
+        """Declare the parameters, start the servers, wire discovery, scene and services."""
+        super().__init__('view_node', **kwargs)
+        declare(self, VIEW_PARAMETERS)
+        self._values = {s.name: self.get_parameter(s.name).value for s in VIEW_PARAMETERS}
+        prefix = declare_frame_prefix(self)
+        self._frames = {f: prefixed(prefix, f) for f in ('odom', 'base_link', 'tail_base')}
+        namespace = self.get_namespace().rstrip('/')
+        self._namespace = namespace
+        self._cmd_vel_topic = f'{namespace}/cmd_vel'
+        self._channels: dict[str, foxglove.Channel] = {}
+        self._subscribers: dict[str, int] = {}  # topic -> clients subscribed
+        self._raw_subscriptions: dict[str, Any] = {}
+        self._requests: queue.Queue[tuple[str, str]] = queue.Queue()
+        self._allowed: dict[tuple[int, int], str] = {}  # (client, channel) -> encoding
+        self._refused_logged: dict[str, float] = {}
+        self._trail: list[tuple[float, float]] = []
+        self._segments: list[tuple[list[float], list[float]]] = []
+        self._geometry = (0.08, 0.1)
+        self._cmd_pub = self.create_publisher(Twist, 'cmd_vel', RELIABLE)
+        self._start_client = self.create_client(Trigger, 'start')
+        self._stop_client = self.create_client(Trigger, 'stop')
+        self._retune = ActionClient(self, RetuneGait, 'retune_gait')
+        self._retune_busy = threading.Event()
+        self.create_subscription(BodyWave, 'body_wave', self._on_body_wave, SENSOR_DATA)
+        self.create_subscription(Odometry, 'sim/ground_truth', self._on_odometry, RELIABLE)
+        self._start_servers()
+        self.create_timer(self._values['discovery_period_s'], self._discover)
+        self.create_timer(0.05, self._serve_requests)
+        self.create_timer(1.0 / self._values['scene_rate_hz'], self._publish_scene)
+        self._discover()
+
+    # --- servers --------------------------------------------------------------------------
+    def _start_servers(self) -> None:
+        address = self._values['address']
+        if not is_loopback(address):
+            self.get_logger().warn(
+                f'binding {address}: the view (and cmd_vel to the fish) is open to every '
+                'machine that reaches this one; use 127.0.0.1 unless that is meant')
+        self._fox_context = foxglove.Context()
+        self._scene = SceneUpdateChannel(f'{self._namespace}/view/scene',
+                                         context=self._fox_context)
+        self._retune_channel = foxglove.Channel(
+            f'{self._namespace}/view/retune', message_encoding='json', context=self._fox_context,
+            schema=foxglove.Schema(name='wirefish_view/RetuneProgress', encoding='jsonschema',
+                                   data=RETUNE_PROGRESS_SCHEMA))
+        services = [self._service('start', self._start_client),
+                    self._service('stop', self._stop_client),
+                    foxglove.Service(f'{self._namespace}/retune_gait', schema=_json_schema(
+                        'wirefish_msgs/action/RetuneGait'), handler=self._on_retune)]
+        self._server = foxglove.start_server(
+            name=f'wirefish {self._namespace or "/"}', host=address, port=self._values['port'],
+            capabilities=[Capability.ClientPublish, Capability.Services],
+            supported_encodings=['cdr', 'json'], server_listener=_Listener(self),
+            services=services,
+            context=self._fox_context)
+        self._web = None
+        if self._values['http_port'] >= 0:
+            self._web = DashboardServer(address, self._values['http_port'], {
+                'websocket_port': self._server.port, 'namespace': self._namespace,
+                'max_speed': self._values['max_speed'], 'max_turn': self._values['max_turn'],
+                'frames': self._frames})
+        self.get_logger().info(
+            f'Foxglove WebSocket ws://{address}:{self._server.port}'
+            + (f', dashboard http://{address}:{self._web.port}/' if self._web else ''))
+
+    def _service(self, name: str, client: Any) -> foxglove.Service:
+        return foxglove.Service(f'{self._namespace}/{name}',
+                                schema=_json_schema('std_srvs/srv/Trigger'),
+                                handler=partial(self._on_trigger, name, client))
+
+    def destroy_node(self) -> None:
+        """Stop the servers, then the node."""
+        self._server.stop()
+        if self._web is not None:
+            self._web.stop()
+        super().destroy_node()
+
+    # --- discovery and subscriptions (executor thread) -----------------------------------
+    def _wanted(self, topic: str) -> bool:
+        if topic in GLOBAL_TOPICS:
+            return True
+        inside = topic.startswith(f'{self._namespace}/')
+        return inside and '/_' not in topic and not topic.startswith(
+            f'{self._namespace}/view/')
+
+    def _discover(self) -> None:
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self._channels or not self._wanted(topic) or len(types) != 1:
+                continue
+            try:
+                schema = ros2msg_schema(types[0])
+            except UnknownType as error:
+                self.get_logger().warn(f'{topic} not offered: {error}', once=True)
+                continue
+            self._channels[topic] = foxglove.Channel(
+                topic, message_encoding='cdr', context=self._fox_context,
+                schema=foxglove.Schema(name=types[0], encoding='ros2msg',
+                                       data=schema.encode()))
+
+    def _serve_requests(self) -> None:
+        while True:
+            try:
+                kind, topic = self._requests.get_nowait()
+            except queue.Empty:
+                return
+            count = self._subscribers.get(topic, 0) + (1 if kind == 'subscribe' else -1)
+            self._subscribers[topic] = max(count, 0)
+            if count > 0 and topic not in self._raw_subscriptions and topic in self._channels:
+                publishers = self.get_publishers_info_by_topic(topic)
+                self._raw_subscriptions[topic] = self.create_subscription(
+                    _type_of(self._channels[topic]), topic,
+                    partial(self._forward, self._channels[topic]), _qos_of(publishers),
+                    raw=True)
+            elif count <= 0 and topic in self._raw_subscriptions:
+                self.destroy_subscription(self._raw_subscriptions.pop(topic))
+
+    def _forward(self, channel: foxglove.Channel, data: bytes) -> None:
+        channel.log(data, log_time=time.time_ns())
+
+    # --- the server's callbacks (its threads) ---------------------------------------------
+    def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+        """Subscribe to the ROS topic of a channel a client subscribed."""
+        self._requests.put(('subscribe', channel.topic))
+
+    def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
+        """Drop the ROS subscription once no client wants it."""
+        self._requests.put(('unsubscribe', channel.topic))
+
+    def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
+        """Accept a client's cmd_vel channel; refuse (log, status) any other."""
+        try:
+            check_advertised(channel.topic, channel.encoding, channel.schema_name,
+                             self._cmd_vel_topic)
+        except RefusedInput as error:
+            self._refuse(str(error))
+            return
+        self._allowed[(client.id, channel.id)] = channel.encoding
+
+    def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
+        """Forget a client's channel."""
+        self._allowed.pop((client.id, client_channel_id), None)
+
+    def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
+        """Publish a client's cmd_vel once validated; refuse anything else."""
+        encoding = self._allowed.get((client.id, client_channel_id))
+        if encoding is None:
+            self._refuse(f'client {client.id}: message on channel {client_channel_id} refused: '
+                         f'only {self._cmd_vel_topic} is accepted')
+            return
+        try:
+            command = cmd_vel_from_client(encoding, data, self._values['max_speed'],
+                                          self._values['max_turn'])
+        except RefusedInput as error:
+            self._refuse(str(error))
+            return
+        twist = Twist()
+        twist.linear.x, twist.angular.z = command.speed, command.turn
+        self._cmd_pub.publish(twist)
+
+    def _refuse(self, reason: str) -> None:
+        now = time.monotonic()
+        if now - self._refused_logged.get(reason, -math.inf) >= REFUSAL_LOG_PERIOD_S:
+            self._refused_logged[reason] = now
+            self.get_logger().warn(reason)
+        self._server.publish_status(reason, StatusLevel.Warning)
+
+    # --- services (the server's threads) --------------------------------------------------
+    def _on_trigger(self, name: str, client: Any, request: Any) -> bytes:
+        if name == 'stop':
+            self._cmd_pub.publish(Twist())  # the planner rests the fish at once
+        if not client.wait_for_service(timeout_sec=SERVICE_WAIT_S):
+            return _answer(False, f'{name}: cpg_node does not offer it')
+        done = threading.Event()
+        future = client.call_async(Trigger.Request())
+        future.add_done_callback(lambda _: done.set())
+        if not done.wait(SERVICE_WAIT_S):
+            return _answer(False, f'{name}: no answer in {SERVICE_WAIT_S:g} s')
+        result = future.result()
+        return _answer(result.success, result.message)
+
+    def _on_retune(self, request: Any) -> bytes:
+        try:
+            goal = _retune_goal(json.loads(request.payload or b'{}'))
+        except (ValueError, TypeError, AttributeError) as error:
+            return _answer(False, f'retune: {error}')
+        if self._retune_busy.is_set():
+            return _answer(False, 'retune: a fit is already running')
+        if not self._retune.wait_for_server(timeout_sec=SERVICE_WAIT_S):
+            return _answer(False, 'retune: tuner_node does not offer retune_gait')
+        self._retune_busy.set()
+        self._report_retune({'state': 'sent'})
+        sent = self._retune.send_goal_async(goal, feedback_callback=self._on_retune_feedback)
+        sent.add_done_callback(self._on_retune_answer)
+        return _answer(True, 'goal sent: progress on view/retune')
+
+    def _report_retune(self, report: dict) -> None:
+        self._retune_channel.log(json.dumps(report).encode(), log_time=time.time_ns())
+
+    def _on_retune_feedback(self, message: Any) -> None:
+        f = message.feedback
+        self._report_retune({'state': 'running', 'iteration': f.iteration,
+                             'max_iterations': f.max_iterations, 'best_loss': f.best_loss})
+
+    def _on_retune_answer(self, future: ConcurrentFuture) -> None:
+        handle = future.result()
+        if not handle.accepted:
+            self._retune_busy.clear()
+            self._report_retune({'state': 'rejected'})
+            return
+        handle.get_result_async().add_done_callback(self._on_retune_result)
+
+    def _on_retune_result(self, future: ConcurrentFuture) -> None:
+        r = future.result().result
+        self._retune_busy.clear()
+        self._report_retune({'state': 'done', 'success': r.success, 'message': r.message,
+                             'applied': r.applied, 'loss': r.loss,
+                             'iterations': r.iterations, 'from_library': r.from_library,
+                             'rmse_theta_deg': list(r.rmse_theta_deg)})
+
+    # --- the scene ------------------------------------------------------------------------
+    def _on_body_wave(self, msg: BodyWave) -> None:
+        self._segments = tail_segments(msg.q, msg.x, msg.y, *self._geometry)
+
+    def _on_odometry(self, msg: Odometry) -> None:
+        p = msg.pose.pose.position
+        if math.isfinite(p.x) and math.isfinite(p.y):
+            self._trail.append((p.x, p.y))
+            del self._trail[:-self._values['trail_length']]
+
+    def _publish_scene(self) -> None:
+        if self._segments:
+            self._scene.log(fish_scene(time.time_ns(), self._frames, self._segments,
+                                       self._trail))
+
+
+class _Listener(ServerListener):
+    """The server's callbacks, handed to the node."""
+
+    def __init__(self, node: ViewNode) -> None:
+        self._node = node
+
+    def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+        self._node.on_subscribe(client, channel)
+
+    def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
+        self._node.on_unsubscribe(client, channel)
+
+    def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
+        self._node.on_client_advertise(client, channel)
+
+    def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
+        self._node.on_client_unadvertise(client, client_channel_id)
+
+    def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
+        self._node.on_message_data(client, client_channel_id, data)
+
+
+def _type_of(channel: foxglove.Channel) -> type:
+    """Return the message class of a channel's schema name (``pkg/msg/Type``)."""
+    schema = channel.schema()
+    if schema is None:
+        raise UnknownType(f'{channel.topic} has no schema')
+    package, kind, name = schema.name.split('/')
+    return getattr(importlib.import_module(f'{package}.{kind}'), name)
+
+
+def _json_schema(name: str) -> Any:
+    schema = foxglove.Schema(name=name, encoding='jsonschema', data=b'{"type": "object"}')
+    message = foxglove.MessageSchema(encoding='json', schema=schema)
+    return foxglove.ServiceSchema(name, request=message, response=message)
+
+
+def _answer(success: bool, message: str) -> bytes:
+    return json.dumps({'success': success, 'message': message}).encode()
+
+
+def _retune_goal(fields: dict) -> Any:
+    """Return the RetuneGait goal of a JSON request; raise ValueError for a bad value."""
+    goal = RetuneGait.Goal()
+    wave = fields.get('wave', {})
+    for name in ('c1', 'c2', 'k', 'frequency_hz'):
+        if name in wave:
+            value = float(wave[name])
+            if not math.isfinite(value):
+                raise ValueError(f'wave.{name} must be finite')
+            setattr(goal.wave, name, value)
+    goal.apply = bool(fields.get('apply', False))
+    goal.max_iterations = int(fields.get('max_iterations', 0))
+    goal.swarm_size = int(fields.get('swarm_size', 0))
+    goal.use_library = bool(fields.get('use_library', True))
+    if not (0 <= goal.max_iterations < 2**32 and 0 <= goal.swarm_size < 2**32):
+        raise ValueError('max_iterations and swarm_size must fit a uint32')
+    return goal
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the view node until shutdown."""
+    run_node(ViewNode, args)

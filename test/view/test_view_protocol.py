@@ -1,0 +1,167 @@
+"""
+`wirefish up --sim --view` seen by a Foxglove WebSocket client of our own (foxglove.sdk.v1).
+
+One graph for the module. The claims: every topic of the registry is a channel with its type as
+schema; servo_cmd and imu/data arrive through the view at 95 % of what the graph publishes and
+decode (rosbags) to the same values; a client's cmd_vel drives the planner; a client message on
+any other topic is refused; a malformed frame leaves the server serving.
+"""
+
+import json
+import math
+import time
+
+from foxglove_client import FoxgloveClient
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from ros_utils import spin_until
+from rosbags.typesys import get_typestore, Stores
+from sensor_msgs.msg import Imu, JointState
+from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_msgs.msg import PlannerState
+
+pytestmark = pytest.mark.ros
+
+# The registry's topics and their types (README's table; /tf and /tf_static from tf_node).
+REGISTRY_TYPES = {
+    'servo_cmd': 'sensor_msgs/msg/JointState', 'servo_state': 'sensor_msgs/msg/JointState',
+    'imu/data': 'sensor_msgs/msg/Imu', 'attitude': 'geometry_msgs/msg/Vector3Stamped',
+    'battery': 'sensor_msgs/msg/BatteryState', 'body_wave': 'wirefish_msgs/msg/BodyWave',
+    'body_wave_markers': 'visualization_msgs/msg/MarkerArray',
+    'speed_estimate': 'wirefish_msgs/msg/SpeedEstimate',
+    'planner_state': 'wirefish_msgs/msg/PlannerState',
+    'cpg_params': 'wirefish_msgs/msg/CpgParams', 'target_wave': 'wirefish_msgs/msg/BodyWaveSpec',
+    'sim/ground_truth': 'nav_msgs/msg/Odometry', 'cmd_vel': 'geometry_msgs/msg/Twist',
+    '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray', '/tf': 'tf2_msgs/msg/TFMessage',
+    '/tf_static': 'tf2_msgs/msg/TFMessage'}
+WINDOW_S = 5.0
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+
+
+def _full(namespace: str, topic: str) -> str:
+    return topic if topic.startswith('/') else f'{namespace}/{topic}'
+
+
+def _stamp_ns(stamp) -> int:
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
+@pytest.fixture
+def client(view_graph):
+    c = FoxgloveClient(view_graph.ws_url)
+    yield c
+    c.close()
+
+
+@pytest.fixture
+def probe(graph_context):
+    node = rclpy.create_node('view_probe', context=graph_context)
+    executor = SingleThreadedExecutor(context=graph_context)
+    executor.add_node(node)
+    yield node, executor
+    executor.shutdown()
+    node.destroy_node()
+
+
+def test_every_registry_topic_is_a_channel_with_its_schema(view_graph, client):
+    namespace = view_graph.graph.namespace
+    wanted = {_full(namespace, t): kind for t, kind in REGISTRY_TYPES.items()}
+    assert client.wait(lambda: set(wanted) <= {c['topic'] for c in client.channels.values()},
+                       timeout_s=30.0), sorted(c['topic'] for c in client.channels.values())
+    for topic, kind in wanted.items():
+        channel = client.channel_of(topic)
+        assert (channel['encoding'], channel['schemaName'], channel['schemaEncoding']) == (
+            'cdr', kind, 'ros2msg'), topic
+    assert {f'{namespace}/{s}' for s in ('start', 'stop', 'retune_gait')} <= set(
+        client.services)
+
+
+@pytest.mark.parametrize('topic, message_type, kind', [
+    ('servo_cmd', JointState, 'sensor_msgs/msg/JointState'),
+    ('imu/data', Imu, 'sensor_msgs/msg/Imu')])
+def test_a_fast_stream_arrives_whole_and_decodes_to_what_was_published(
+        view_graph, client, probe, topic, message_type, kind):
+    node, executor = probe
+    name = _full(view_graph.graph.namespace, topic)
+    published: dict[int, object] = {}
+    node.create_subscription(message_type, name,
+                             lambda m: published.setdefault(_stamp_ns(m.header.stamp), m),
+                             SENSOR_DATA)
+    assert client.wait(lambda: client.channel_of(name) is not None, timeout_s=30.0)
+    subscription = client.subscribe(client.channel_of(name)['id'])
+    assert client.wait(lambda: len(client.messages.get(subscription, [])) > 50, 20.0)
+    spin_until(executor, lambda: False, timeout_s=WINDOW_S + 1.0)
+    with client.lock:
+        received = [TYPESTORE.deserialize_cdr(p, kind) for _, p in client.messages[subscription]]
+    viewed = {_stamp_ns(m.header.stamp): m for m in received}
+    # The window: stamps both sides saw the whole of (after the view's first, before the end).
+    start = max(min(viewed), min(published)) + 500_000_000
+    end = start + int(WINDOW_S * 1e9)
+    graph_stamps = [s for s in published if start <= s < end]
+    view_stamps = [s for s in viewed if start <= s < end]
+    print(f'{topic}: graph {len(graph_stamps) / WINDOW_S:.1f} Hz, '
+          f'view {len(view_stamps) / WINDOW_S:.1f} Hz')
+    assert len(view_stamps) >= 0.95 * len(graph_stamps) > 0
+    for stamp in set(view_stamps) & set(graph_stamps):
+        if kind.endswith('JointState'):
+            assert list(viewed[stamp].position) == list(published[stamp].position)
+            assert list(viewed[stamp].name) == list(published[stamp].name)
+        else:
+            v, p = viewed[stamp].orientation, published[stamp].orientation
+            assert (v.x, v.y, v.z, v.w) == (p.x, p.y, p.z, p.w)
+
+
+def test_a_client_cmd_vel_moves_the_planners_target_speed(view_graph, client, probe):
+    node, executor = probe
+    namespace = view_graph.graph.namespace
+    states: list[PlannerState] = []
+    node.create_subscription(PlannerState, f'{namespace}/planner_state', states.append,
+                             RELIABLE)
+    channel = client.advertise(f'{namespace}/cmd_vel', 'json', 'geometry_msgs/msg/Twist')
+    command = json.dumps({'linear': {'x': 0.2}, 'angular': {'z': 0.0}}).encode()
+
+    def driven() -> bool:
+        client.publish(channel, command)
+        return bool(states) and math.isclose(states[-1].target_speed, 0.2, abs_tol=1e-9)
+
+    assert spin_until(executor, driven, timeout_s=20.0), [s.target_speed for s in states[-3:]]
+    stop = json.dumps({'linear': {'x': 0.0}}).encode()
+    assert spin_until(executor, lambda: client.publish(channel, stop) or (
+        states[-1].target_speed == 0.0), timeout_s=20.0)
+
+
+def test_a_client_message_on_another_topic_is_refused(view_graph, client, probe):
+    node, executor = probe
+    namespace = view_graph.graph.namespace
+    target = f'{namespace}/servo_cmd'
+    channel = client.advertise(target, 'json', 'sensor_msgs/msg/JointState')
+    client.publish(channel, json.dumps({'position': [1.0, 1.0]}).encode())
+    assert client.wait(lambda: any('refused' in s['message'] for s in client.statuses), 10.0)
+
+    def writers() -> set[str]:
+        return {i.node_name for i in node.get_publishers_info_by_topic(target)}
+
+    assert spin_until(executor, lambda: 'cpg_node' in writers(), timeout_s=20.0)
+    spin_until(executor, lambda: False, timeout_s=1.0)
+    assert writers() == {'cpg_node'}  # the view never became a writer of it
+
+
+def test_a_malformed_frame_does_not_stop_the_server(view_graph, client):
+    name = _full(view_graph.graph.namespace, 'imu/data')
+    assert client.wait(lambda: client.channel_of(name) is not None, timeout_s=30.0)
+    subscription = client.subscribe(client.channel_of(name)['id'])
+    assert client.wait(lambda: len(client.messages.get(subscription, [])) > 10, 20.0)
+    for junk in (b'\xff\x00\x01garbage', b'\x01', b'\x02\x00'):
+        client.ws.send(junk)
+    client.ws.send('{"op": "subscribe", "subscriptions": [{"id": "x"}]}')
+    client.ws.send('not json at all {')
+    time.sleep(1.0)
+    second = FoxgloveClient(view_graph.ws_url)
+    try:
+        assert second.wait(lambda: second.server_info is not None
+                           and second.channel_of(name) is not None, 10.0)
+        again = second.subscribe(second.channel_of(name)['id'])
+        assert second.wait(lambda: len(second.messages.get(again, [])) > 10, 20.0)
+    finally:
+        second.close()
