@@ -46,6 +46,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize
 from wirefish_analysis.calibrate_drag import (calibrated_drag_coefficient, CALIBRATION_HZ,
                                               CALIBRATION_SPEED, least_squares_drag)
+from wirefish_common.progress import Progress
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.pso import minimise, PsoOptions
 from wirefish_cpg.table1_gait import locked_speed_estimate, table1_locked_at, tip_half_amplitude
@@ -190,24 +191,50 @@ def flat_range(x: np.ndarray, k: int, rise: float = 1.0) -> tuple[float, float, 
     return ends[0][0], ends[1][0], ends[0][1], ends[1][1]
 
 
+def steps_of_a_start(options: PsoOptions, polish_iterations: int) -> int:
+    """Return a start's progress steps: its swarm's evaluations, at most one per polish step."""
+    return options.swarm_size * (options.max_iterations + 1) + polish_iterations
+
+
 def identify(rng: np.random.Generator, options: PsoOptions = PsoOptions(max_iterations=60),
-             polish_iterations: int = 2000, starts: int = 1) -> Identification:
+             polish_iterations: int = 2000, starts: int = 1,
+             progress: Progress | None = None) -> Identification:
     """
     Search the six lengths ``starts`` times (PSO, then Nelder-Mead), then C_D; keep the best.
 
     Each start draws from its own child of ``rng`` (``Generator.spawn``), so a run is
-    reproducible from one seed.
+    reproducible from one seed. ``progress`` (``starts * steps_of_a_start`` steps) is told
+    after every swarm iteration and polish step; a start that stops early skips its rest.
     """
     def swarm_objective(positions: np.ndarray) -> np.ndarray:
         return np.array([profiled_objective(p) for p in positions])
 
+    per_start = steps_of_a_start(options, polish_iterations)
     found = []
-    for child in rng.spawn(starts):
-        swarm = minimise(swarm_objective, LOWER[:6], UPPER[:6], child, options)
+    for index, child in enumerate(rng.spawn(starts)):
+        first = index * per_start
+
+        def swarm_step(iteration: int, loss: float, _best: np.ndarray) -> None:
+            if progress is not None:
+                progress.step(first + options.swarm_size * (iteration + 1),
+                              f'search {index + 1}/{starts}, swarm: best {loss:.4g}')
+
+        polish_steps = [0]
+
+        def polish_step(_x: np.ndarray) -> None:
+            polish_steps[0] += 1
+            if progress is not None:
+                progress.step(first + options.swarm_size * (options.max_iterations + 1)
+                              + polish_steps[0], f'search {index + 1}/{starts}, polish')
+
+        swarm = minimise(swarm_objective, LOWER[:6], UPPER[:6], child, options,
+                         callback=swarm_step)
         polished = minimize(profiled_objective, swarm.best_position, method='Nelder-Mead',
-                            bounds=list(zip(LOWER[:6], UPPER[:6])),
+                            bounds=list(zip(LOWER[:6], UPPER[:6])), callback=polish_step,
                             options={'xatol': 1e-6, 'fatol': 1e-6,
                                      'maxiter': polish_iterations})
+        if progress is not None:
+            progress.step(first + per_start, f'search {index + 1}/{starts} done')
         best = polished.x if polished.fun < swarm.best_loss else swarm.best_position
         x = with_profiled_drag(best)
         found.append((x, objective(x)))
@@ -338,8 +365,10 @@ def main(argv: list[str] | None = None) -> int:
 def run(args: argparse.Namespace) -> int:
     """Run the identification with parsed options; return the exit code (0)."""
     options = PsoOptions(swarm_size=args.swarm, max_iterations=args.iterations)
+    progress = Progress('identify-geometry',
+                        args.starts * steps_of_a_start(options, args.polish_iterations))
     result = identify(np.random.default_rng(args.seed), options, args.polish_iterations,
-                      args.starts)
+                      args.starts, progress)
     text = report(result)
     print(f'geometry identification: seed {args.seed}, {args.starts} starts of {args.swarm} '
           f'particles x at most {args.iterations} iterations, then Nelder-Mead')

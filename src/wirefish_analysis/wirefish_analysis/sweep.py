@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import overload
 
 import numpy as np
+from wirefish_common.progress import Progress
 from wirefish_cpg.table1_gait import PAPER_GRID_AMPLITUDES_M, PAPER_GRID_FREQUENCIES_HZ
 
 FIG11_AMPLITUDE_M = 0.05
@@ -70,12 +71,24 @@ def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) ->
     return SweepPoint(frequency_hz, tip_amplitude_m, float(model), fish, geometry.body_length)
 
 
-def run_sweep(with_fish: bool = True) -> tuple[list[SweepPoint], list[SweepPoint]]:
-    """Return (the Fig 9/10 grid, the Fig 11 line)."""
-    grid = [sweep_point(f, a, with_fish)
-            for a in PAPER_GRID_AMPLITUDES_M for f in PAPER_GRID_FREQUENCIES_HZ]
-    line = [sweep_point(f, FIG11_AMPLITUDE_M, with_fish) for f in FIG11_FREQUENCIES_HZ]
-    return grid, line
+def run_sweep(with_fish: bool = True,
+              progress: Progress | None = None) -> tuple[list[SweepPoint], list[SweepPoint]]:
+    """Return (the Fig 9/10 grid, the Fig 11 line); ``progress`` is told after each point."""
+    wanted = [*((f, a) for a in PAPER_GRID_AMPLITUDES_M for f in PAPER_GRID_FREQUENCIES_HZ),
+              *((f, FIG11_AMPLITUDE_M) for f in FIG11_FREQUENCIES_HZ)]
+    points = []
+    for frequency, amplitude in wanted:
+        points.append(sweep_point(frequency, amplitude, with_fish))
+        if progress is not None:
+            progress.step(text=f'{frequency:g} Hz, {amplitude * 100:g} cm')
+    split = len(PAPER_GRID_AMPLITUDES_M) * len(PAPER_GRID_FREQUENCIES_HZ)
+    return points[:split], points[split:]
+
+
+def sweep_size() -> int:
+    """Return how many points a sweep computes (the grid's, then the Fig 11 line's)."""
+    return (len(PAPER_GRID_AMPLITUDES_M) * len(PAPER_GRID_FREQUENCIES_HZ)
+            + len(FIG11_FREQUENCIES_HZ))
 
 
 def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> list[Path]:
@@ -170,7 +183,9 @@ def table(grid: list[SweepPoint], line: list[SweepPoint]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish sweep`; print the table and the files written."""
-    grid, line = run_sweep(with_fish=not args.model_only)
+    label = 'sweep (eq 18)' if args.model_only else 'sweep (eq 18 and the virtual fish)'
+    grid, line = run_sweep(with_fish=not args.model_only,
+                           progress=Progress(label, sweep_size()))
     print(table(grid, line))
     for path in write_outputs(grid, line, args.out):
         print(f'wrote {path}')

@@ -15,9 +15,11 @@ import argparse
 from concurrent.futures import as_completed, ProcessPoolExecutor
 import os
 from pathlib import Path
+import signal
 import sys
 
-BAR_WIDTH = 30
+from wirefish_common.progress import Progress
+
 DEFAULT_FREQUENCIES = '0.5,1.0,1.5,2.0,2.5'
 DEFAULT_SCALES = '0.5,0.75,1.0,1.25,1.5'
 
@@ -77,15 +79,9 @@ def predicted_speed(params) -> float:
     return float(locked_speed_estimate(params, FishGeometry()).speed)
 
 
-def _progress(done: int, total: int, text: str) -> None:
-    if sys.stderr.isatty():
-        filled = int(round(BAR_WIDTH * done / total))
-        print(f'\r[{"#" * filled}{"." * (BAR_WIDTH - filled)}] {done}/{total} {text:<40}',
-              end='', file=sys.stderr, flush=True)
-        if done == total:
-            print(file=sys.stderr)
-    else:
-        print(f'{done}/{total} {text}', file=sys.stderr, flush=True)
+def _ignore_interrupts() -> None:
+    """Leave Ctrl-C to the parent (a worker's KeyboardInterrupt would print its traceback)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def build(args: argparse.Namespace) -> int:
@@ -96,15 +92,21 @@ def build(args: argparse.Namespace) -> int:
     points = [(args.c1, args.c2, args.k, f, s, args.seed)
               for f in args.frequencies for s in args.scales]
     rows, gaits = [], []
-    with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
+    progress = Progress('gaits build', len(points))
+    pool = ProcessPoolExecutor(max_workers=max(1, args.workers), initializer=_ignore_interrupts)
+    try:
         futures = [pool.submit(fit_point, point) for point in points]
-        for done, future in enumerate(as_completed(futures), start=1):
+        for future in as_completed(futures):
             frequency, scale, order, outcome = future.result()
-            _progress(done, len(points), f'f {frequency:g} Hz, scale {scale:g}: '
-                      f'{"fitted" if outcome.success else "refused"}')
+            progress.step(text=f'f {frequency:g} Hz, scale {scale:g}: '
+                          f'{"fitted" if outcome.success else "refused"}')
             rows.append((frequency, scale, outcome))
             if outcome.success:
                 gaits.append(gait_of(order, outcome, RetuneSettings()))
+    except KeyboardInterrupt:
+        pool.shutdown(wait=False, cancel_futures=True)  # the fits under way end by themselves
+        raise
+    pool.shutdown()
     if gaits:
         LibraryFile(args.library).add(gaits)
     print(grid_table(sorted(rows, key=lambda r: (r[0], r[1]))))

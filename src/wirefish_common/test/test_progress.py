@@ -52,7 +52,8 @@ def test_not_on_a_terminal_each_step_is_a_line_with_its_estimate():
         clock.now += 2.0
         progress.step(text=text)
     assert stream.getvalue().splitlines() == [
-        'fit: 1/3, about 4 s left | a', 'fit: 2/3, about 2 s left | b', 'fit: 3/3, done in 6 s | c']
+        'fit: 1/3, about 4 s left | a', 'fit: 2/3, about 2 s left | b',
+        'fit: 3/3, done in 6 s | c']
 
 
 def test_not_on_a_terminal_many_steps_give_at_most_one_line_per_twentieth():
