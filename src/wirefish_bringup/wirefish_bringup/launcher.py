@@ -74,9 +74,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--view', action='store_true',
                         help='also the live view: Foxglove WebSocket server and dashboard '
                         '(wirefish view; view_node parameters port, http_port)')
-    parser.add_argument('--view', action='store_true',
-                        help='also the live view: Foxglove WebSocket server and dashboard '
-                        '(wirefish view; view_node parameters port, http_port)')
     parser.add_argument('--allow-duplicate', action='store_true',
                         help='start even if nodes of the graph already run in this namespace '
                         '(e.g. a graph that just died is still discovered)')
