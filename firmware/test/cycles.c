@@ -4,8 +4,12 @@
  * Each figure is one wf_app_poll: one that finds one frame in the UART (nothing else due), and
  * one that sends the telemetry (with the IMU sample, failsafe and servo update of that poll),
  * timed with the x86 time-stamp counter (TSC ticks: cycles at the nominal clock; other CPUs:
- * nanoseconds from clock_gettime). Prints one JSON object: median, 99.9th percentile and
- * maximum of each over the runs (the maximum includes whatever the OS did meanwhile).
+ * nanoseconds from clock_gettime). The board's run is deterministic (same clock, same bytes),
+ * so it is repeated REPEATS times from reset and each poll keeps its fastest repeat: what the
+ * code costs, without the interrupts and preemption of a shared machine, which would have to
+ * hit the same poll in every repeat. "worst" is the largest of those over the runs, the
+ * worst-case input; "raw_max" the slowest single poll seen (the scheduler's figure). Prints
+ * one JSON object.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -34,7 +38,7 @@ static uint64_t counter_now(void)
 }
 #endif
 
-enum { RUNS = 20000 };
+enum { RUNS = 20000, REPEATS = 5 };
 
 static int by_value(const void *a, const void *b)
 {
@@ -42,12 +46,25 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void print_figure(const char *name, uint64_t *samples, size_t n, const char *tail)
+static void print_figure(const char *name, const uint64_t *best, uint64_t raw_max,
+                         const char *tail)
 {
-    qsort(samples, n, sizeof *samples, by_value);
-    printf("\"%s\": {\"median\": %llu, \"p999\": %llu, \"max\": %llu, \"runs\": %zu}%s", name,
-           (unsigned long long)samples[n / 2], (unsigned long long)samples[n * 999 / 1000],
-           (unsigned long long)samples[n - 1], n, tail);
+    static uint64_t sorted[RUNS];
+    memcpy(sorted, best, sizeof sorted);
+    qsort(sorted, RUNS, sizeof *sorted, by_value);
+    printf("\"%s\": {\"median\": %llu, \"worst\": %llu, \"raw_max\": %llu, \"runs\": %d}%s",
+           name, (unsigned long long)sorted[RUNS / 2], (unsigned long long)sorted[RUNS - 1],
+           (unsigned long long)raw_max, RUNS, tail);
+}
+
+static void keep(uint64_t *best, uint64_t *raw_max, size_t i, uint64_t ticks, int repeat)
+{
+    if (repeat == 0 || ticks < best[i]) {
+        best[i] = ticks;
+    }
+    if (ticks > *raw_max) {
+        *raw_max = ticks;
+    }
 }
 
 static size_t frame(uint8_t type, uint16_t seq, uint8_t *wire)
@@ -82,32 +99,37 @@ static uint64_t timed_poll(wf_app_t *app, uint32_t t, const uint8_t *in, size_t 
 
 int main(void)
 {
-    static uint64_t command[RUNS], telemetry_in[RUNS], telemetry_out[RUNS];
+    static uint64_t command[RUNS], frame_in[RUNS], telemetry_out[RUNS];
+    uint64_t command_max = 0, frame_in_max = 0, telemetry_max = 0;
     static wf_app_t app;
     wf_config_t config;
     wf_config_defaults(&config);
     config.imu_mode = WF_IMU_SYNTHETIC;
     config.heartbeat_timeout_ms = 0x7FFFFFFF;
     config.command_timeout_ms = 0x7FFFFFFF;
-    wf_host_reset();
-    wf_app_init(&app, &config);
     uint8_t wire[WF_MAX_WIRE];
-    uint16_t seq = 0;
-    timed_poll(&app, 0, wire, frame(WF_MSG_HEARTBEAT, seq++, wire));
-    uint32_t t = 1;
-    for (size_t i = 0; i < RUNS; i++) {
-        /* t % 10 == 1 and 3: no telemetry, heartbeat or IMU sample is due. */
-        command[i] = timed_poll(&app, t, wire, frame(WF_MSG_SERVO_CMD, seq++, wire));
-        /* The longest frame the decoder takes whole (62 bytes; the fish then ignores it). */
-        telemetry_in[i] = timed_poll(&app, t + 2, wire, frame(WF_MSG_TELEMETRY, seq++, wire));
-        t += 9; /* a poll that sends the telemetry (and the IMU sample of its 5 ms) */
-        telemetry_out[i] = timed_poll(&app, t, NULL, 0);
-        t += 1;
+    for (int repeat = 0; repeat < REPEATS; repeat++) {
+        wf_host_reset();
+        wf_app_init(&app, &config);
+        uint16_t seq = 0;
+        timed_poll(&app, 0, wire, frame(WF_MSG_HEARTBEAT, seq++, wire));
+        uint32_t t = 1;
+        for (size_t i = 0; i < RUNS; i++) {
+            /* t % 10 == 1 and 3: no telemetry, heartbeat or IMU sample is due. */
+            keep(command, &command_max, i,
+                 timed_poll(&app, t, wire, frame(WF_MSG_SERVO_CMD, seq++, wire)), repeat);
+            /* The longest frame the decoder takes whole (62 bytes; the fish then ignores it). */
+            keep(frame_in, &frame_in_max, i,
+                 timed_poll(&app, t + 2, wire, frame(WF_MSG_TELEMETRY, seq++, wire)), repeat);
+            t += 9; /* a poll that sends the telemetry (and the IMU sample of its 5 ms) */
+            keep(telemetry_out, &telemetry_max, i, timed_poll(&app, t, NULL, 0), repeat);
+            t += 1;
+        }
     }
-    printf("{\"counter\": \"%s\", ", COUNTER);
-    print_figure("servo_cmd_received", command, RUNS, ", ");
-    print_figure("longest_frame_received", telemetry_in, RUNS, ", ");
-    print_figure("telemetry_sent", telemetry_out, RUNS, "");
+    printf("{\"counter\": \"%s\", \"repeats\": %d, ", COUNTER, REPEATS);
+    print_figure("servo_cmd_received", command, command_max, ", ");
+    print_figure("longest_frame_received", frame_in, frame_in_max, ", ");
+    print_figure("telemetry_sent", telemetry_out, telemetry_max, "");
     printf(", \"commands_applied\": %u}\n", app.commands_applied);
     return app.commands_applied == RUNS ? 0 : 1;
 }

@@ -133,6 +133,8 @@ def run_all(quick: bool = False) -> dict:
     from wirefish_analysis import bench_radio_link
     # What crosses fish -> shore, two network namespaces (root only; else the reason).
     results['radio_link'] = _run('radio link', bench_radio_link.run, domain_id=DOMAIN)
+    from wirefish_analysis import bench_firmware  # cycles per frame, flash and RAM
+    results['firmware'] = _run('firmware cycles and size', bench_firmware.run)
     results['kinematics_cpu'] = [
         _run(f'kinematics {s} x {r} ({e})', bench_graph.kinematics_cpu, s, r, 10.0 * scale,
              DOMAIN, e)

@@ -1,5 +1,6 @@
 """Render benchmark results (the dict of `wirefish_analysis.bench`) as BENCHMARKS.md."""
 
+from wirefish_analysis.bench_firmware import row as firmware_row
 from wirefish_analysis.bench_radio_link import row as radio_row
 
 
@@ -243,6 +244,8 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     table += _library_rows(results)
     if 'radio_link' in results:
         table.append(radio_row(results['radio_link']))
+    if 'firmware' in results:
+        table.append(firmware_row(results['firmware']))
     table += _kinematics_rows(results)
     rec = results.get('recording', {})
     if 'error' in rec:
