@@ -140,6 +140,8 @@ def run_all(quick: bool = False) -> dict:
              DOMAIN, e)
         for s, r in ((50, 50.0), (500, 200.0)) for e in EXECUTORS]
     results['recording'] = _run('recording', recording, 60.0 * scale, DOMAIN)
+    from wirefish_analysis import bench_recorder  # the recorder before and after its mcap rewrite
+    results['recorder_cpu'] = _run('recorder CPU, old and new', bench_recorder.run, DOMAIN)
     results['fleet'] = []
     for mode in ('per-node', 'single'):
         one = _run(f'1 fish ({mode}, both executors, {ONE_FISH_REPEATS} alternated runs)',

@@ -2,6 +2,7 @@
 
 from wirefish_analysis.bench_firmware import row as firmware_row
 from wirefish_analysis.bench_radio_link import row as radio_row
+from wirefish_analysis.bench_recorder import row as recorder_row
 
 
 def _fmt(value, spec: str = '.3g') -> str:
@@ -254,13 +255,15 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         missing = rec.get('missing_from_sequences')
         table.append(('Recording, 60 s at default rates: messages in the bag, lost',
                       '0 lost', f'{rec["messages"]} messages; lost {missing} (numbers missing '
-                      "from the publishers' sequences; DDS lost count "
-                      f'{rec.get("lost_in_transport")}); {rec.get("skipped_ticks")} publisher '
+                      "from the publishers' sequences); "
+                      f'{rec.get("skipped_ticks")} publisher '
                       'ticks skipped (gaps in the header stamps: nothing sent, nothing lost)',
                       _verdict(rec, missing == 0),
                       "wirefish up --duration; the recorder counts each publisher's DDS "
                       'sequence numbers; skipped ticks from the stamps at the median period '
                       '(report.py)'))
+    if 'recorder_cpu' in results:
+        table.append(recorder_row(results['recorder_cpu']))
     table += _fleet_rows(results)
     return table
 
