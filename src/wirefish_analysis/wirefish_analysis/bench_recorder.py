@@ -133,7 +133,7 @@ def _cpu_per_message_us(write, flush, messages: list[tuple[Any, bytes]]) -> floa
 
 
 def _writer_costs(directory: Path) -> dict[str, float]:
-    """Return CPU us per message of each writer importable here (in its own subprocess)."""
+    """Return CPU us per message of the writers this path holds (the old one, or the others)."""
     from wirefish_bringup.bag_storage import add_topic
     from wirefish_bringup.bagfile import wirefish_typestore
 
@@ -160,11 +160,9 @@ def _writer_costs(directory: Path) -> dict[str, float]:
 
 
 def _foxglove_cost(directory: Path, typed: list[tuple[str, bytes]]) -> dict[str, float]:
-    try:
-        import foxglove
-        from foxglove.mcap import MCAPWriteOptions
-    except ImportError:
-        return {}
+    import foxglove
+    from foxglove.mcap import MCAPWriteOptions
+
     writer = foxglove.open_mcap(directory / 'foxglove.mcap',
                                 writer_options=MCAPWriteOptions(compression=None,
                                                                 profile='ros2'))
