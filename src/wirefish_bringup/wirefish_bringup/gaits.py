@@ -61,6 +61,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     plot.add_argument('--out', type=Path, default=Path('gaits_speed.png'), help='PNG file')
 
 
+def tuner_library_path(params_file: Path | None) -> Path:
+    """Return the gait library a graph's tuner uses: its file's library_path, or the default."""
+    import yaml
+    from wirefish_bringup.graph import default_params_file
+    from wirefish_cpg.gait_library import default_library_path
+
+    try:
+        blocks = yaml.safe_load(Path(params_file or default_params_file()).read_text())
+    except (OSError, yaml.YAMLError):
+        blocks = None
+    named: dict[bool, str] = {}  # the graph's /** block first: the tuner's own block overrides it
+    for key, block in (blocks.items() if isinstance(blocks, dict) else []):
+        values = block.get('ros__parameters') if isinstance(block, dict) else None
+        path = values.get('library_path') if isinstance(values, dict) else None
+        if isinstance(path, str) and path and (key == '/**' or str(key).endswith('tuner_node')):
+            named[key == '/**'] = path
+    chosen = named.get(False, named.get(True))
+    return Path(chosen) if chosen else default_library_path()
+
+
 def fit_point(point: tuple[float, float, float, float, float, int]):
     """Fit one grid point (c1, c2, k, frequency, scale, seed); return (f, s, outcome)."""
     from wirefish_cpg.retune_core import retune, RetuneOrder, RetuneSettings

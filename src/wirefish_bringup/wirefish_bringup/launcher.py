@@ -285,6 +285,9 @@ def run(args: argparse.Namespace) -> int:
                     print(f'{fish} on {link} -> {link.resolve()}')
             print(f'started {len(supervisor.processes)} processes in {namespace}; '
                   f'logs in {run_dir / "logs"}', flush=True)
+            if any('tuner_node' in spec.ros_nodes for spec in specs):
+                from wirefish_bringup.gaits import tuner_library_path
+                print(f'gait library: {tuner_library_path(args.params_file)}', flush=True)
             status = _wait_ready(node, executor, namespace, specs, supervisor,
                                  not args.no_status, stop_requested, role=args.role)
         if status and status.startswith('not up'):

@@ -2,6 +2,7 @@
 
 import math
 import os
+from pathlib import Path
 
 import pytest
 from wirefish_cpg.gait_library import (default_library_path, Gait, GaitLibrary, LibraryFile,
@@ -68,12 +69,33 @@ def test_a_bad_file_is_refused_with_the_reason(tmp_path, text, words):
         load_library(path)
 
 
-@pytest.mark.parametrize('environ, expected', [
-    ({'ROS_HOME': '/data/ros', 'HOME': '/home/u'}, '/data/ros/wirefish/gaits.yaml'),
-    ({'HOME': '/home/u'}, '/home/u/.ros/wirefish/gaits.yaml'),
-])
-def test_the_default_path_is_in_the_ros_home(environ, expected):
-    assert str(default_library_path(environ)) == expected
+def test_a_ros_home_of_ones_own_holds_the_library(tmp_path):
+    environ = {'ROS_HOME': '/data/ros', 'HOME': '/home/u'}
+    workspace = tmp_path / 'ws'
+    (workspace / 'src').mkdir(parents=True)
+    prefix = workspace / 'install' / 'wirefish_cpg'
+    assert default_library_path(environ, prefix) == Path('/data/ros/wirefish/gaits.yaml')
+
+
+@pytest.mark.parametrize('prefix', ['install/wirefish_cpg', 'install'])  # isolated, merged
+def test_each_workspace_has_its_library_in_its_out(tmp_path, prefix):
+    libraries = []
+    for clone in ('clone_a', 'clone_b'):
+        (tmp_path / clone / 'src').mkdir(parents=True)
+        libraries.append(default_library_path({'HOME': '/home/u'}, tmp_path / clone / prefix))
+    assert libraries == [tmp_path / 'clone_a' / 'out' / 'gaits.yaml',
+                         tmp_path / 'clone_b' / 'out' / 'gaits.yaml']
+
+
+def test_outside_a_workspace_the_library_is_the_users(tmp_path):
+    prefix = Path('/opt/ros/jazzy')
+    assert default_library_path({'HOME': '/home/u'}, prefix) == Path(
+        '/home/u/.ros/wirefish/gaits.yaml')
+
+
+def test_this_workspaces_library_is_found_from_the_ament_index():
+    root = Path(__file__).resolve().parents[3]
+    assert default_library_path({'HOME': '/home/u'}) == root / 'out' / 'gaits.yaml'
 
 
 def test_a_record_with_a_non_finite_loss_is_refused():

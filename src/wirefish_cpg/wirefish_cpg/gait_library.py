@@ -43,15 +43,49 @@ WAVE_FIELDS = ('c1', 'c2', 'k', 'frequency_hz')
 PARAMETER_FIELDS = ('frequency_hz', 'amplitude_1', 'amplitude_2', 'w12', 'w21', 'phi12',
                     'phi21', 'alpha')
 LIBRARY_FILE = Path('wirefish') / 'gaits.yaml'
+WORKSPACE_LIBRARY = Path('out') / 'gaits.yaml'  # in a colcon workspace
 TEMPORARY_SUFFIX = '.tmp'
 
 
-def default_library_path(environ: Mapping[str, str] | None = None) -> Path:
-    """Return ``$ROS_HOME/wirefish/gaits.yaml``, else ``~/.ros/wirefish/gaits.yaml``."""
+def default_library_path(environ: Mapping[str, str] | None = None,
+                         package_prefix: Path | None = None) -> Path:
+    """
+    Return where the gait library is when no ``library_path`` names it.
+
+    ``$ROS_HOME/wirefish/gaits.yaml`` when ROS_HOME is set (a ROS home of one's own: the tests
+    give each test one); else the workspace's ``out/gaits.yaml``, the colcon workspace this
+    package is installed in (``package_prefix``, found in the ament index when None), so two
+    clones never answer with or replace each other's fits; else (installed outside a
+    workspace) ``~/.ros/wirefish/gaits.yaml``.
+    """
     environ = os.environ if environ is None else environ
     ros_home = environ.get('ROS_HOME')
-    base = Path(ros_home) if ros_home else Path(environ.get('HOME', '~')).expanduser() / '.ros'
-    return base / LIBRARY_FILE
+    if ros_home:
+        return Path(ros_home) / LIBRARY_FILE
+    workspace = workspace_of(package_prefix if package_prefix is not None
+                             else _installed_prefix())
+    if workspace is not None:
+        return workspace / WORKSPACE_LIBRARY
+    return Path(environ.get('HOME', '~')).expanduser() / '.ros' / LIBRARY_FILE
+
+
+def workspace_of(prefix: Path | None) -> Path | None:
+    """Return the colcon workspace holding ``prefix`` (the parent of its install/ and src/)."""
+    for directory in ([prefix, *prefix.parents] if prefix is not None else []):
+        if directory.name == 'install' and (directory.parent / 'src').is_dir():
+            return directory.parent
+    return None
+
+
+def _installed_prefix() -> Path | None:
+    try:
+        from ament_index_python.packages import get_package_prefix, PackageNotFoundError
+    except ImportError:
+        return None
+    try:
+        return Path(get_package_prefix('wirefish_cpg'))
+    except PackageNotFoundError:
+        return None
 
 
 @dataclass(frozen=True)
