@@ -1,6 +1,8 @@
 """`wirefish gaits build | list | plot` on a library file of the test's own."""
 
+from pathlib import Path
 import subprocess
+import sys
 
 import pytest
 from wirefish_cpg.gait_library import load_library
@@ -53,6 +55,16 @@ def test_plot_writes_the_speed_png(built, python_module, tmp_path):
     result = gaits(python_module, library, 'plot', '--out', str(out))
     assert result.returncode == 0, result.stderr
     assert out.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+def test_plot_writes_into_out_by_default(built, tmp_path):
+    library, _ = built
+    result = subprocess.run([sys.executable, '-m', 'wirefish_bringup.cli', 'gaits', 'plot',
+                             '--library', str(library)], capture_output=True, text=True,
+                            timeout=300, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert [p.relative_to(tmp_path) for p in tmp_path.rglob('*.png')] == [
+        Path('out', 'gaits_speed.png')]
 
 
 def test_an_unreadable_library_is_one_line_not_a_traceback(python_module, tmp_path):

@@ -58,7 +58,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     build.add_argument('--seed', type=int, default=0, help='optimiser seed of every fit')
     build.add_argument('--workers', type=int, default=os.cpu_count() or 1,
                        help='processes (default: all cores)')
-    plot.add_argument('--out', type=Path, default=Path('gaits_speed.png'), help='PNG file')
+    plot.add_argument('--out', type=Path, default=Path('out', 'gaits_speed.png'),
+                      help='PNG file (default: %(default)s)')
 
 
 def tuner_library_path(params_file: Path | None) -> Path:
