@@ -41,6 +41,7 @@ def run_bootstrap(env: dict[str, str]) -> subprocess.CompletedProcess:
     ('cmake', 'apt-get install cmake'),
     ('c++', 'apt-get install g++'),
     ('make', 'apt-get install make'),
+    ('npm', 'apt-get install npm'),
 ])
 def test_missing_system_tool_gives_one_line_naming_the_package(tmp_path, tool, install_hint):
     env = dict(os.environ, PATH=path_without(tmp_path, tool),

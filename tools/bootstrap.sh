@@ -35,6 +35,7 @@ need cmake cmake
 need make make
 need c++ g++
 need git git
+need npm npm
 command -v "$PYTHON" >/dev/null 2>&1 \
   || die "'$PYTHON' not found: the ROS 2 Jazzy wheels need CPython 3.11 (apt-get install python3.11 python3.11-venv python3.11-dev)"
 "$PYTHON" -c 'import venv, ensurepip' >/dev/null 2>&1 \
@@ -83,6 +84,18 @@ else
   log "$VENV is up to date ($MODE road)"
 fi
 
+# --- the dashboard (wirefish view): npm ci and an esbuild bundle, so the page needs no network
+WEB="$ROOT/src/wirefish_view/web"
+web_key="$(cat "$WEB/package.json" "$WEB/package-lock.json" "$WEB"/src/* | sha256sum)"
+if [ "$(cat "$WEB/dist/.wirefish-stamp" 2>/dev/null)" != "$web_key" ]; then
+  log "dashboard: npm ci and bundle (src/wirefish_view/web)"
+  output="$(cd "$WEB" && npm ci --no-audit --no-fund 2>&1 && npm run build 2>&1)" \
+    || die "the dashboard did not build (npm ci / npm run build in $WEB):"$'\n'"$output"
+  echo "$web_key" > "$WEB/dist/.wirefish-stamp"
+else
+  log "dashboard is up to date"
+fi
+
 # --- colcon build --------------------------------------------------------------------------
 # With --symlink-install, edits to Python modules are live: only the file list, setup.py and the
 # non-Python files (package.xml, CMakeLists.txt, msg/srv, launch, config) need a new build.
@@ -106,7 +119,7 @@ else
   base_paths+=(interfaces)
 fi
 src_files="$(git ls-files -co --exclude-standard -- "${base_paths[@]}" | LC_ALL=C sort)"
-src_key="$( { echo "${base_paths[*]}"; echo "$src_files";
+src_key="$( { echo "${base_paths[*]}"; echo "$src_files"; ls "$WEB/dist";
   echo "$src_files" | grep -v -E '\.py$' | xargs -d '\n' -r sha256sum;
   echo "$src_files" | grep -E '(^|/)setup\.py$' | xargs -d '\n' -r sha256sum; } | sha256sum)"
 if [ "$(cat install/.wirefish-stamp 2>/dev/null)" != "$src_key" ]; then
