@@ -22,9 +22,11 @@ from wirefish_bringup.errors import QemuBoardError
 from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
                                     validate_namespace)
 from wirefish_bringup.input_checks import params_file_problem, serial_port_problem
+from wirefish_bringup.status_view import LiveStatus, TerminalBlock
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
+LIVE_REFRESH_S = 1.0  # how often the status is redrawn on a terminal
 STOP_GRACE_S = 10.0  # after a Ctrl-C during start-up, how long the nodes may take to be up
 DEVICE_TIMEOUT_S = 15.0
 # How long the processes may take to stop after the SIGINT, together: one fish's 6 stop well
@@ -103,15 +105,17 @@ def _registry_nodes(specs: list[NodeSpec], namespace: str) -> list[str]:
 
 def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], supervisor: Supervisor,
                 show_status: bool, stop_requested: list,
-                timeout_s: float = READY_TIMEOUT_S, role: str = ALL) -> str | None:
+                timeout_s: float = READY_TIMEOUT_S, role: str = ALL,
+                live_views: list | None = None) -> str | None:
     """
     Wait until every node of the graph is on the ROS graph; return the status table or None.
 
     A node is "up" once it is discoverable (its rclpy.init and constructor are done), so a
     Ctrl-C after "running:" always reaches nodes that handle it cleanly. Exits while waiting
-    are answered by the restart policies; a node given up on is no longer waited for.
+    are answered by the restart policies; a node given up on is no longer waited for. The
+    status that measured the table is appended to ``live_views`` (the live view goes on with it).
     """
-    from wirefish_bringup.monitor import discovered_nodes, measure_rates, settle_discovery
+    from wirefish_bringup.monitor import discovered_nodes, settle_discovery
 
     def expected() -> set[str]:
         return {name for key, spec in supervisor.specs.items() if key not in supervisor.given_up
@@ -140,16 +144,16 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
     # The shore watches what crosses the link only: measuring the fish's own streams would
     # pull them over the radio.
     watched = f'{namespace.rstrip("/")}/shore' if role == SHORE else namespace
-    rates = measure_rates(node, executor, watched, STATUS_WINDOW_S,
-                          should_stop=lambda: bool(stop_requested))
+    live = LiveStatus(node, watched)
+    measured_until = time.monotonic() + STATUS_WINDOW_S
+    while time.monotonic() < measured_until and not stop_requested:
+        time.sleep(0.25)
+        live.refresh()
     if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
         return None
-    lines = [f'nodes: {", ".join(sorted(expected()))}',
-             f'{"topic":<40} {"type":<38} {"rate":>9}']
-    for topic, (type_name, rate) in rates.items():
-        shown = f'{rate:7.1f} Hz' if rate > 0 else 'no msgs'  # idle, or latched only
-        lines.append(f'{topic:<40} {type_name:<38} {shown:>9}')
-    return '\n'.join(lines)
+    if live_views is not None:
+        live_views.append(live)
+    return '\n'.join([f'nodes: {", ".join(sorted(expected()))}', *live.lines()])
 
 
 def _report(lines: list[str]) -> None:
@@ -288,11 +292,16 @@ def run(args: argparse.Namespace) -> int:
             if any('tuner_node' in spec.ros_nodes for spec in specs):
                 from wirefish_bringup.gaits import tuner_library_path
                 print(f'gait library: {tuner_library_path(args.params_file)}', flush=True)
+            live_views: list = []
             status = _wait_ready(node, executor, namespace, specs, supervisor,
-                                 not args.no_status, stop_requested, role=args.role)
+                                 not args.no_status, stop_requested, role=args.role,
+                                 live_views=live_views)
         if status and status.startswith('not up'):
             raise RuntimeError(status)
-        if status:
+        # On a terminal the status is redrawn in place while the graph runs; else shown once.
+        live = live_views[0] if live_views and sys.stdout.isatty() else None
+        block = TerminalBlock(sys.stdout) if live is not None else None
+        if status and block is None:
             print(status)
         if stop_requested:
             pass  # Ctrl-C during start-up: straight to stopping
@@ -300,11 +309,19 @@ def run(args: argparse.Namespace) -> int:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
         else:
             print('running: Ctrl-C stops everything', flush=True)
-        started = time.monotonic()
+        started = drawn = time.monotonic()
         while not stop_requested:
-            _report(supervisor.supervise())
+            reports = supervisor.supervise()
+            if reports and block is not None:
+                block.forget()  # the reports stay; the status goes on below them
+            _report(reports)
             if args.duration is not None and time.monotonic() - started >= args.duration:
                 break
+            if live is not None and block is not None and (
+                    time.monotonic() - drawn >= LIVE_REFRESH_S or drawn == started):
+                live.refresh()
+                block.draw([*(status or '').splitlines()[:1], *live.lines()])
+                drawn = time.monotonic()
             time.sleep(0.1)
     except (RuntimeError, FileNotFoundError) as error:
         print(f'wirefish up: {error}', file=sys.stderr)
