@@ -17,7 +17,7 @@ const WANTED = ['servo_cmd', 'servo_state', 'body_wave', 'planner_state', 'speed
 
 const live = {
   connected: false, counts: {}, latest: {}, plots: {}, drive: { speed: 0, turn: 0 },
-  retune: null, refusals: [], errors: [],
+  retune: null, retuneLog: [], refusals: [], errors: [],
 };
 window.wirefish = live;
 
@@ -284,6 +284,7 @@ function wireControls() {
 
 function onRetune(m) {
   live.retune = m;
+  live.retuneLog.push(m);
   if (m.state === 'running') {
     $('retune-progress').max = Math.max(m.max_iterations, 1);
     $('retune-progress').value = m.iteration;

@@ -1,0 +1,148 @@
+"""
+The dashboard in a real browser: headless chromium (Debian's) driven by Selenium.
+
+The page is that of a running `wirefish up --sim --view`.
+
+One graph and one browser for the module. The claims: the plots update (values read back from
+the page); a drive key raises planner_state's target speed; a retune from the form shows its
+progress and applies; the stop button brings cmd_vel to zero and the fish to rest. The retune
+test saves the screenshot the README shows (docs/dashboard.png).
+"""
+
+import math
+from pathlib import Path
+import shutil
+import time
+
+from geometry_msgs.msg import Twist
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from ros_utils import spin_until
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+from sensor_msgs.msg import JointState
+from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
+from wirefish_msgs.msg import CpgParams, PlannerState
+
+pytestmark = pytest.mark.ros
+
+CHROMIUM, CHROMEDRIVER = shutil.which('chromium'), shutil.which('chromedriver')
+SCREENSHOT = Path(__file__).resolve().parents[2] / 'docs' / 'dashboard.png'
+REST_RAD = 0.05  # servo commands within this of neutral: the fish at rest
+
+
+@pytest.fixture(scope='module')
+def browser(view_graph):
+    """Yield a headless chromium on the dashboard page; quit it (and its driver) afterwards."""
+    assert CHROMIUM and CHROMEDRIVER, 'apt-get install chromium chromium-driver'
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for argument in ('--headless=new', '--no-sandbox', '--disable-gpu',
+                     '--disable-dev-shm-usage', '--window-size=1400,1100'):
+        options.add_argument(argument)
+    driver = webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
+    try:
+        driver.get(view_graph.http_url)
+        yield driver
+    finally:
+        driver.quit()
+
+
+def _live(browser, expression: str):
+    return browser.execute_script(f'return {expression};')
+
+
+def _wait_page(browser, expression: str, timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if _live(browser, expression):
+            return True
+        time.sleep(0.2)
+    return bool(_live(browser, expression))
+
+
+@pytest.fixture
+def probe(graph_context, view_graph):
+    """Yield a ROS listener of the graph: its latest planner_state, cmd_vel, servo_cmd."""
+    namespace = view_graph.graph.namespace
+    node = rclpy.create_node('dashboard_probe', context=graph_context)
+    executor = SingleThreadedExecutor(context=graph_context)
+    executor.add_node(node)
+    heard = {'planner_state': [], 'cmd_vel': [], 'servo_cmd': [], 'cpg_params': []}
+    for topic, kind, qos in (('planner_state', PlannerState, RELIABLE),
+                             ('cmd_vel', Twist, RELIABLE), ('servo_cmd', JointState, SENSOR_DATA),
+                             ('cpg_params', CpgParams, LATCHED)):
+        node.create_subscription(kind, f'{namespace}/{topic}', heard[topic].append, qos)
+    yield heard, executor
+    executor.shutdown()
+    node.destroy_node()
+
+
+def test_the_plots_update_with_the_graphs_values(browser):
+    assert _wait_page(browser, 'window.wirefish.connected', 20.0)
+    assert _wait_page(browser, 'window.wirefish.plots.servo.data[0].length > 100', 30.0)
+    assert _wait_page(browser, 'window.wirefish.plots.wave.data[0].length > 0', 30.0)
+    before = _live(browser, 'window.wirefish.plots.servo.data[0].slice(-1)[0]')
+    time.sleep(1.5)
+    servo = _live(browser, 'window.wirefish.plots.servo.data')
+    assert servo[0][-1] > before  # new samples were plotted
+    commanded = [v for v in servo[1] if v is not None]
+    assert max(commanded) - min(commanded) > 0.1  # the tail beats on the page
+    assert all(abs(v) <= math.pi / 2 for v in commanded)
+    assert _wait_page(browser, 'window.wirefish.plots.speed.data[0].length > 10', 10.0)
+    assert _wait_page(browser, "document.getElementById('v-mode').textContent !== '-'", 10.0)
+    assert 'V' in browser.find_element(By.ID, 'v-battery').text
+
+
+def test_a_drive_key_raises_the_planners_target_speed(browser, probe):
+    heard, executor = probe
+    body = browser.find_element(By.TAG_NAME, 'body')
+    body.send_keys('w')
+    body.send_keys('w')
+    assert _live(browser, 'window.wirefish.drive.speed') == pytest.approx(0.1)
+    assert spin_until(executor, lambda: bool(heard['planner_state']) and math.isclose(
+        heard['planner_state'][-1].target_speed, 0.1, abs_tol=1e-9), timeout_s=20.0)
+    assert _wait_page(browser, "document.getElementById('v-target-speed').textContent"
+                      " === '0.10'", 10.0)
+
+
+def test_a_retune_from_the_form_shows_progress_and_applies(browser, probe):
+    heard, executor = probe
+    spin_until(executor, lambda: bool(heard['cpg_params']), timeout_s=10.0)
+    form = browser.find_element(By.ID, 'retune-form')
+    iterations = form.find_element(By.NAME, 'max_iterations')
+    iterations.clear()
+    iterations.send_keys('12')
+    form.find_element(By.NAME, 'k').clear()
+    form.find_element(By.NAME, 'k').send_keys('6.0')
+    browser.find_element(By.ID, 'retune-submit').click()
+    assert _wait_page(browser, "window.wirefish.retuneLog.some(m => m.state === 'done')", 120.0)
+    log = _live(browser, 'window.wirefish.retuneLog')
+    running = [m for m in log if m['state'] == 'running']
+    assert running and running[-1]['max_iterations'] == 12
+    done = next(m for m in log if m['state'] == 'done')
+    assert done['success'] and done['applied'], done
+    assert 'done' in browser.find_element(By.ID, 'v-retune').text
+    assert _live(browser, "document.getElementById('retune-progress').value") > 0
+    SCREENSHOT.parent.mkdir(exist_ok=True)
+    browser.save_screenshot(str(SCREENSHOT))
+
+
+def test_the_stop_button_zeroes_cmd_vel_and_rests_the_fish(browser, probe):
+    heard, executor = probe
+    browser.find_element(By.ID, 'stop').click()
+    assert spin_until(executor, lambda: bool(heard['cmd_vel']) and (
+        heard['cmd_vel'][-1].linear.x == 0.0 and heard['cmd_vel'][-1].angular.z == 0.0),
+        timeout_s=10.0)
+    assert spin_until(executor, lambda: bool(heard['planner_state']) and (
+        heard['planner_state'][-1].target_speed == 0.0), timeout_s=10.0)
+
+    def at_rest() -> bool:
+        recent = heard['servo_cmd'][-100:]
+        return len(recent) == 100 and all(abs(p) < REST_RAD for m in recent
+                                          for p in m.position)
+
+    assert spin_until(executor, at_rest, timeout_s=30.0)
+    assert _live(browser, 'window.wirefish.drive.speed') == 0.0
