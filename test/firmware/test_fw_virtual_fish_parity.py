@@ -19,7 +19,8 @@ from mpu6050_model import Mpu6050Model, sensor_from_flu, specific_force_at_rest
 import numpy as np
 import pytest
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import (Heartbeat, ProtocolMessage, Role, ServoCommand, Telemetry)
+from wirefish_bridge.protocol import (Heartbeat, ProtocolMessage, Role, ServoCommand, Status,
+                                      Telemetry)
 from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
 
 LIMIT = np.float32(1.57079625)  # the board's limit: the binary32 just below the fish's pi/2
@@ -32,12 +33,12 @@ class Scenario:
     """A host's behaviour over a run (times in ms)."""
 
     name: str
-    duration_ms: int = 3300
+    duration_ms: int = 2600
     version: int = 1
     version_until_ms: int = 0         # announce ``version`` before this, 1 after
-    commands_until_ms: int = 1000
-    heartbeats_until_ms: int = 1300
-    resume_at_ms: int = 3000          # both start again here
+    commands_until_ms: int = 600
+    heartbeats_until_ms: int = 800
+    resume_at_ms: int = 2400          # both start again here
     damage: float = 0.0               # share of chunks damaged
     low_battery: bool = False
     near_timeouts: bool = False       # gaps of 490..510 ms (commands), 1490..1510 (heartbeats)
@@ -45,11 +46,11 @@ class Scenario:
 
 SCENARIOS = [
     Scenario('nominal'),
-    Scenario('version_mismatch', version=2, version_until_ms=700),
+    Scenario('version_mismatch', version=2, version_until_ms=400),
     Scenario('damaged_stream', damage=0.25),
     Scenario('low_battery', low_battery=True, duration_ms=800),
-    Scenario('gaps_at_the_timeouts', near_timeouts=True, duration_ms=8000,
-             commands_until_ms=8000, heartbeats_until_ms=8000),
+    Scenario('gaps_at_the_timeouts', near_timeouts=True, duration_ms=6000,
+             commands_until_ms=6000, heartbeats_until_ms=6000),
 ]
 
 
@@ -122,6 +123,7 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     board.reset(i2c=mpu.transfer, adc_raw=ADC_6_0_V if scenario.low_battery else ADC_8_2_V)
     fish_frames, board_frames = StreamDecoder(), StreamDecoder()
     seen: set[str] = set()
+    statuses: set[int] = set()
     for k, chunk in enumerate(host_stream(scenario, rng)):
         fish.receive(chunk)
         fish.step(0.001)
@@ -141,7 +143,17 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
         assert [(f.kind, f.seq, firmware_view(f.message)) for f in board_out] == fish_view, \
             f'at {k + 1} ms'
         assert (state.status, tuple(state.target)) == (fish.status, target), f'at {k + 1} ms'
+        statuses.add(state.status)
     assert fish_frames.stats.resyncs == board_frames.stats.resyncs == 0
     assert {'Telemetry', 'Heartbeat'} <= seen
     if scenario.version != 1 or scenario.damage:
         assert 'ErrorReport' in seen
+    # The run went through what it is for: swimming, each timeout, the mismatch, low battery.
+    neutral = Status.FAILSAFE_COMMAND | Status.FAILSAFE_HEARTBEAT
+    assert any(not s & neutral for s in statuses)
+    if scenario.duration_ms > 2000:
+        assert any(s & neutral == Status.FAILSAFE_COMMAND for s in statuses)
+        assert any(s & Status.FAILSAFE_HEARTBEAT for s in statuses)
+    if scenario.version != 1:
+        assert any(s & Status.VERSION_MISMATCH for s in statuses)
+    assert all(bool(s & Status.LOW_BATTERY) == scenario.low_battery for s in statuses)
