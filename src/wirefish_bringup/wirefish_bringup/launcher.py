@@ -161,9 +161,21 @@ def _report(lines: list[str]) -> None:
         print(f'wirefish up: {line}', file=sys.stderr, flush=True)
 
 
+_PROBES: list = []  # the launcher's own nodes on the graph: never torn down (_graph_probe)
+
+
 @contextmanager
 def _graph_probe(namespace: str) -> Iterator[tuple]:
-    """Yield (node, executor) of the launcher's own look at the ROS graph, then close them."""
+    """
+    Yield (node, executor) of the launcher's own look at the ROS graph; never destroyed.
+
+    Destroying a node is DDS work that can block the calling thread for good: eight graphs
+    starting at once left `wirefish up` in ``Node.destroy_node`` -> ``Publisher.destroy`` of
+    this probe (py-spy), its SIGINT and SIGTERM caught and never acted on, nothing stopped. So
+    the launcher makes no DDS call on its way out: the probe lives as long as the process, and
+    ``run`` leaves through ``os._exit`` once everything it started is stopped and reported
+    (the operating system closes the probe's sockets and shared memory).
+    """
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
@@ -172,12 +184,8 @@ def _graph_probe(namespace: str) -> Iterator[tuple]:
     node = rclpy.create_node('wirefish_status', namespace=namespace)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
-    try:
-        yield node, executor
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
+    _PROBES.append((node, executor))
+    yield node, executor
 
 
 def _finish_bag(bag_path: Path) -> None:
@@ -214,7 +222,16 @@ def _finish_bag(bag_path: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run `wirefish up`; return the process exit code."""
+    """Run `wirefish up`; return its exit code, or exit with it if the graph was probed."""
+    code = _run(args)
+    if _PROBES:  # no DDS teardown on the way out (see _graph_probe)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
+
+
+def _run(args: argparse.Namespace) -> int:
     stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
     run_dir = (args.out / f'run_{stamp}').resolve()
     bag_path = run_dir / 'bag' if args.duration else None
