@@ -47,10 +47,11 @@ class Console:
 
     def __init__(self, path: str) -> None:
         self._fd = _open_raw(path)
-        self.zeros: list[int] = []                      # board ms of each 0x00 received
+        self.zeros: list[int] = []                      # board ms of each frame's end
         self.compares: list[tuple[int, int, int]] = []  # (board ms, channel, ticks)
         self.ticks_per_us: int | None = None
         self.lines_dropped = 0                          # "Z" lines the board had no room for
+        self.rx_lost = 0                                # USART1 bytes lost to a full ring
         self.calibration: dict[int, Calibration] = {}
         self.malformed: list[str] = []
         self._stop = threading.Event()
@@ -79,9 +80,9 @@ class Console:
                 self.zeros.append(numbers[0])
             elif fields[0] == 'P' and len(numbers) == 3:
                 self.compares.append((numbers[0], numbers[1], numbers[2]))
-            elif fields[0] == 'C' and len(numbers) == 3:
+            elif fields[0] == 'C' and len(numbers) == 4:
                 self.ticks_per_us = numbers[0]
-                self.lines_dropped = numbers[2]
+                self.lines_dropped, self.rx_lost = numbers[2], numbers[3]
             elif fields[0] == 'K' and len(numbers) == 5:
                 self.calibration[numbers[0]] = Calibration(
                     numbers[1] / 1000.0, numbers[2] / 1000.0, numbers[3], numbers[4] / 1e6)
@@ -95,7 +96,7 @@ class Console:
         return self.ticks_per_us is not None and len(self.calibration) == 2
 
     def angle(self, channel: int, ticks: int) -> float:
-        """Return the angle (rad) a compare value of ``channel`` stands for."""
+        """Return the servo angle, in rad, that a compare value of ``channel`` stands for."""
         cal = self.calibration[channel]
         assert self.ticks_per_us is not None
         return (ticks / self.ticks_per_us - cal.neutral_us) / (cal.direction * cal.us_per_rad)
@@ -117,7 +118,7 @@ class Crossing:
 
     time: float
     frame: DecodedFrame
-    zero_index: int = -1   # host -> board: index of its closing 0x00 among those forwarded
+    zero_index: int = -1   # host -> board: index of its closing 0x00 among frame ends forwarded
     dropped: bool = False
 
 
@@ -150,7 +151,8 @@ class Tap:
         self.record = TapRecord()
         self.host_decoder = StreamDecoder()    # every byte the bridge wrote, as written
         self.board_decoder = StreamDecoder()   # every byte the board wrote
-        self.zeros_forwarded = 0
+        self.zeros_forwarded = 0   # 0x00 bytes forwarded that end a frame (follow a non-zero)
+        self._last_forwarded = 0
         self.drop_servo_cmd = False
         self._host_pending = b''
         self._lock = threading.Lock()
@@ -176,7 +178,10 @@ class Tap:
     def _forward(self, data: bytes) -> None:
         """Queue ``data`` for the board (hold the lock)."""
         self._to_board.append(data)
-        self.zeros_forwarded += data.count(0)
+        for byte in data:
+            if byte == 0 and self._last_forwarded != 0:
+                self.zeros_forwarded += 1
+            self._last_forwarded = byte
         self._queued.notify()
 
     def _run(self) -> None:
@@ -203,7 +208,7 @@ class Tap:
             with self._lock:
                 if not drop:
                     self._forward(run + b'\x00')
-                if frame is not None:
+                if frame is not None:   # a decoded frame is a non-empty run: it ends a frame
                     self.record.to_board.append(
                         Crossing(now, frame, -1 if drop else self.zeros_forwarded - 1, drop))
 

@@ -1,6 +1,7 @@
 """
-Fixtures of the in-the-loop tests: the firmware's ARM build on an emulated board (QEMU), its
-debug console, a tap on its link, bridge_node processes and a ROS probe.
+Fixtures of the in-the-loop tests: the firmware's ARM build on an emulated board (QEMU).
+
+Its debug console, a tap on its link, bridge_node processes and a ROS probe.
 
 The emulator image is built once (make -C firmware qemu). A machine without the ARM toolchain
 or QEMU fails here with the line that says what to install (`make setup` installs both as

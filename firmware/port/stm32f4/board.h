@@ -21,6 +21,8 @@ enum {
 void board_clock_init(void);
 void board_systick_init(void);
 void board_uart_init(void);
+/* USART1 overruns: bytes lost because the receive ring stayed full too long. */
+uint32_t board_uart_rx_overflows(void);
 void board_i2c_init(void);
 void board_adc_init(void);
 

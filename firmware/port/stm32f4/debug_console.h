@@ -1,10 +1,12 @@
 /*
  * The QEMU build's debug console on USART2 (QEMU's second -serial): one text line per event,
  * read by the in-the-loop tests, unseen by the core.
- *   "Z <ms>"              a 0x00 byte (frame delimiter) arrived on USART1, board time
+ *   "Z <ms>"              a 0x00 byte that ends a frame (follows a non-zero byte) arrived on
+ *                         USART1, board time
  *   "P <ms> <ch> <ticks>" servo channel ch's compare register changed; the value read back
- *   "C <ticks_per_us> <period_ticks> <dropped>" the PWM timer's set-up and the count of
- *                         "Z" lines lost for want of room, once a second
+ *   "C <ticks_per_us> <period_ticks> <dropped> <rx_lost>" the PWM timer's set-up, the
+ *                         count of "Z" lines lost for want of room and of USART1 bytes
+ *                         lost to a full receive ring, once a second
  *   "K <servo> <neutral_ns> <ns_per_rad> <direction> <limit_urad>" the servo calibration
  *                         (pulse widths in ns, the limit in microradians), once a second
  * Every build but the QEMU one compiles the calls away.

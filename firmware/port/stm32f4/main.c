@@ -28,5 +28,9 @@ int main(void)
     for (;;) {
         wf_app_poll(&app);
         debug_console_poll();
+        /* Sleep until the next interrupt: SysTick (1 ms) or a received byte. A byte that came
+         * during the poll was queued by its interrupt and is read at the next tick. The core
+         * needs nothing faster (its schedule is in ms); an emulator then idles too. */
+        __asm volatile("wfi");
     }
 }
