@@ -41,6 +41,25 @@ command -v "$PYTHON" >/dev/null 2>&1 \
 "$PYTHON" -c 'import venv, ensurepip' >/dev/null 2>&1 \
   || die "'$PYTHON' cannot create virtual environments: install python3-venv for it"
 
+# --- the firmware's ARM toolchain and emulator (make -C firmware arm/qemu, test/firmware_qemu)
+# Installed with apt where it can be (root); elsewhere one line says what to install. The
+# Python/ROS workspace does not need them, so nothing here stops the setup.
+arm_missing=()
+[[ "$(arm-none-eabi-gcc -print-file-name=libc_nano.a 2>/dev/null)" == /* ]] \
+  || arm_missing+=(gcc-arm-none-eabi libnewlib-arm-none-eabi)
+command -v qemu-system-arm >/dev/null 2>&1 || arm_missing+=(qemu-system-arm)
+if [ ${#arm_missing[@]} -gt 0 ]; then
+  apt_install=(apt-get install -y --no-install-recommends -o DPkg::Lock::Timeout=300)
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    log "installing ${arm_missing[*]} (the firmware's ARM build and its emulator)"
+    { "${apt_install[@]}" "${arm_missing[@]}" >/dev/null 2>&1 \
+      || { apt-get update >/dev/null 2>&1 && "${apt_install[@]}" "${arm_missing[@]}" >/dev/null 2>&1; }; } \
+      || log "apt-get could not install ${arm_missing[*]}: the firmware tests will fail until it is installed"
+  else
+    log "the firmware's ARM build and its emulator need: apt-get install ${arm_missing[*]} (as root; not needed for the Python/ROS workspace)"
+  fi
+fi
+
 # --- virtual environment -------------------------------------------------------------------
 req_files=(requirements/python.txt)
 [ "$MODE" = wheels ] && req_files+=(requirements/ros-jazzy.txt requirements/constraints.txt)
