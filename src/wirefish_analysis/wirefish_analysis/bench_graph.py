@@ -153,19 +153,26 @@ def kinematics_cpu(stations: int, rate_hz: float, duration_s: float, domain_id: 
 
 
 def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = False,
-          executor: str | None = None) -> dict:
+          executor: str | None = None, one_simulator: bool = True) -> dict:
     """
     ``fish`` whole graphs (namespaces /bench_fish_N) at default rates: rates and CPU.
 
     ``single_process`` runs each fish's four ROS nodes in one process (`wirefish compose`).
-    CPU: the total, and the onboard part (every process but the virtual fish's), per fish.
+    ``one_simulator``: every virtual fish in one fish_sim (``fleet.fleet_simulator``, as
+    `wirefish up --fleet`), else one fish_sim per fish (before). CPU: the total, the onboard
+    part (every process but the virtual fish's) per fish, and the virtual fish's.
     """
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import Imu, JointState
+    from wirefish_bringup.fleet import fleet_simulator, SIMULATOR
 
     specs: list[NodeSpec] = []
     for i in range(1, fish + 1):
         specs += fish_graph(f'/bench_fish_{i}', sim=True, single_process=single_process)
+    if one_simulator:
+        params = str(next(s.params_file for s in specs if s.name == SIMULATOR))
+        specs = [fleet_simulator('/', [f'bench_fish_{i}' for i in range(1, fish + 1)], params),
+                 *(s for s in specs if s.name != SIMULATOR)]
     counts = {('servo_cmd', i): 0 for i in range(1, fish + 1)}
     counts.update({('imu/data', i): 0 for i in range(1, fish + 1)})
     with processes(specs, domain_id, executor=executor) as supervisor, \
@@ -197,7 +204,8 @@ def fleet(fish: int, duration_s: float, domain_id: int, single_process: bool = F
     servo = [counts[('servo_cmd', i)] / elapsed for i in range(1, fish + 1)]
     imu = [counts[('imu/data', i)] / elapsed for i in range(1, fish + 1)]
     return {'fish': fish, 'single_process': single_process, 'executor': executor,
-            'processes': len(specs),
+            'one_simulator': one_simulator, 'processes': len(specs),
+            'simulator_cpu_percent': sum(cpu[key] for key in procs if key not in onboard),
             'servo_cmd_hz_min': min(servo), 'servo_cmd_hz_median': float(np.median(servo)),
             'imu_hz_min': min(imu), 'imu_hz_median': float(np.median(imu)),
             'cpu_percent_total': sum(cpu.values()),
