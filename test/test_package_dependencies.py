@@ -45,6 +45,7 @@ THIRD_PARTY = {
     'pytest': 'python3-pytest',
     'rosbags': 'python3-rosbags-pip',
     'scipy': 'python3-scipy',
+    'selenium': 'python3-selenium',
     'serial': 'python3-serial',
     'yaml': 'python3-yaml',
 }

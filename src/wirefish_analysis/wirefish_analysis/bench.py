@@ -59,13 +59,11 @@ def recording(duration_s: float, domain_id: int) -> dict:
     stats = write_report(bag, bag.parent / 'report')
     # The supervisor names each log after its registry entry (wirefish_recorder.log).
     recorder_log = next((bag.parent / 'logs').glob('*recorder*.log')).read_text()
-    transport = re.search(r'lost in transport: (\d+)', recorder_log)
     missing = re.search(r"missing from the publishers' sequences: (\d+)", recorder_log)
     return {'duration_s': duration_s,
             'topics': {s.topic: {'count': s.count, 'rate_hz': s.rate_hz, 'drops': s.drops}
                        for s in stats},
             'messages': sum(s.count for s in stats),
-            'lost_in_transport': int(transport.group(1)) if transport else None,
             'missing_from_sequences': int(missing.group(1)) if missing else None,
             'skipped_ticks': sum(max(s.drops, 0) for s in stats)}
 
@@ -142,6 +140,8 @@ def run_all(quick: bool = False) -> dict:
     results['recording'] = _run('recording', recording, 60.0 * scale, DOMAIN)
     from wirefish_analysis import bench_recorder  # the recorder before and after its mcap rewrite
     results['recorder_cpu'] = _run('recorder CPU, old and new', bench_recorder.run, DOMAIN)
+    from wirefish_analysis import bench_view  # the view server with one browser connected
+    results['view_cpu'] = _run('view server with one browser', bench_view.run, DOMAIN)
     results['fleet'] = []
     for mode in ('per-node', 'single'):
         one = _run(f'1 fish ({mode}, both executors, {ONE_FISH_REPEATS} alternated runs)',

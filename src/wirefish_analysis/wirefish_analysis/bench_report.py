@@ -3,6 +3,7 @@
 from wirefish_analysis.bench_firmware import row as firmware_row
 from wirefish_analysis.bench_radio_link import row as radio_row
 from wirefish_analysis.bench_recorder import row as recorder_row
+from wirefish_analysis.bench_view import row as view_row
 
 
 def _fmt(value, spec: str = '.3g') -> str:
@@ -264,6 +265,8 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                       '(report.py)'))
     if 'recorder_cpu' in results:
         table.append(recorder_row(results['recorder_cpu']))
+    if 'view_cpu' in results:
+        table.append(view_row(results['view_cpu']))
     table += _fleet_rows(results)
     return table
 
