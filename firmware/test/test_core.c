@@ -347,6 +347,46 @@ static void test_battery_below_threshold_sets_low_battery(void)
     CHECK(snap().status & WF_STATUS_LOW_BATTERY);
 }
 
+/* A minimal MPU6050 for the sanitizer build (the register-level model is the Python one). */
+static uint8_t mpu_regs[128];
+
+static bool tiny_mpu(void *context, uint8_t address7, const uint8_t *tx, size_t tx_len,
+                     uint8_t *rx, size_t rx_len)
+{
+    (void)context;
+    if (address7 != 0x68 || tx_len == 0) {
+        return false;
+    }
+    uint8_t reg = tx[0] & 0x7F;
+    for (size_t i = 1; i < tx_len; i++) {
+        mpu_regs[reg] = tx[i];
+        reg = (uint8_t)((reg + 1) & 0x7F);
+    }
+    for (size_t i = 0; i < rx_len; i++) {
+        rx[i] = mpu_regs[reg];
+        reg = (uint8_t)((reg + 1) & 0x7F);
+    }
+    return true;
+}
+
+static void test_imu_sample_reaches_the_telemetry(void)
+{
+    memset(mpu_regs, 0, sizeof mpu_regs);
+    mpu_regs[0x75] = 0x68;
+    mpu_regs[0x3B + 4] = 0x20; /* accel z = 0x2000 = 8192 counts: 1 g at +-4 g */
+    mpu_regs[0x43 + 4] = 0x01; /* gyro z = 256 counts */
+    fresh_board();
+    wf_host_set_i2c_device(tiny_mpu, NULL);
+    run_until(0, 1000);
+    const wf_host_snapshot_t s = raw_snap();
+    CHECK(!(s.status & WF_STATUS_IMU_FAULT) && mpu_regs[0x6B] == 0x01);
+    CHECK(fabsf(s.accel[2] - 9.80665f) < 1e-5f && s.gyro[2] > 0.0f);
+    CHECK(s.yaw > 0.0f && fabsf(s.roll) < 1e-6f && fabsf(s.pitch) < 1e-6f);
+    wf_host_set_i2c_device(NULL, NULL); /* the sensor drops off the bus */
+    run_until(1001, 1010);
+    CHECK(raw_snap().status & WF_STATUS_IMU_FAULT);
+}
+
 int main(void)
 {
     test_crc_check_value();
@@ -368,6 +408,7 @@ int main(void)
     test_invalid_config_falls_back_to_defaults();
     test_imu_absent_sets_imu_fault();
     test_battery_below_threshold_sets_low_battery();
-    printf("test_core: 19 tests, %d checks passed\n", checks);
+    test_imu_sample_reaches_the_telemetry();
+    printf("test_core: 20 tests, %d checks passed\n", checks);
     return 0;
 }
