@@ -198,6 +198,19 @@ class _FishLink:
         return f'fish_sim{f" {self.name}" if self.name else ""}'
 
 
+# The most simulated time one pass of the loop integrates (s): five of its slowest ticks. A
+# process behind real time (a starved CPU) drops the rest instead of working through it:
+# catching up on 1 ms physics steps and their telemetry frames kept it behind, and deaf to a
+# stop, for as long as the load lasted.
+MAX_STEP_S = 0.05
+
+
+def loop_step(elapsed_s: float) -> tuple[float, float]:
+    """Return (simulated time to integrate now, time dropped) for ``elapsed_s`` of wall time."""
+    step = min(max(elapsed_s, 0.0), MAX_STEP_S)
+    return step, max(elapsed_s, 0.0) - step
+
+
 def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     """Run the virtual fish until SIGINT/SIGTERM; return the exit code."""
     # However many SIGINT/SIGTERM arrive: one stop, exit 0 (see wirefish_common.shutdown).
@@ -223,6 +236,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     stalls = Schedule(args.stall_every, args.stall_for)
     reopens = Schedule(args.reopen_every, args.reopen_delay, args.reopen_count)
     tick_s = max(0.0005, min(0.01, 1.0 / args.telemetry_hz / 2.0))
+    dropped_s = 0.0
     try:
         for link in links:
             print(link.device.open_pair(), flush=True)
@@ -238,9 +252,11 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
                 data = link.device.read()
                 if data and not stalled:
                     fish.receive(data)
-            fleet.step(now - last)
+            step_s, dropped = loop_step(now - last)
+            dropped_s += dropped
+            fleet.step(step_s)
             for fish in fleet.fish if disturbance.active else ():
-                disturb(fish.state, disturbance, now - last, fish.config.yaw_time_constant_s,
+                disturb(fish.state, disturbance, step_s, fish.config.yaw_time_constant_s,
                         fish.total_mass)
             last = now
             for fish, link in zip(fleet.fish, links):
@@ -249,7 +265,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
                     link.device.write(link.faults.apply(output))
             if ground_truth is not None and now >= next_truth:
                 ground_truth.publish(fleet.fish)
-                next_truth += 1.0 / args.ground_truth_hz
+                next_truth = max(next_truth + 1.0 / args.ground_truth_hz, now)  # no backlog
             # One wake-up per tick for every fish, whatever the host writes in between.
             next_tick = max(next_tick + tick_s, now)
             time.sleep(max(0.0, next_tick - time.monotonic()))
@@ -259,6 +275,9 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
             link.device.remove_link()
         if ground_truth is not None:
             ground_truth.close()
+    if dropped_s > 0.0:
+        print(f'fish_sim: ran behind real time; {dropped_s:.2f} s of simulated time dropped',
+              file=sys.stderr, flush=True)
     return 0
 
 
