@@ -1,0 +1,131 @@
+"""
+SIGINT a whole `wirefish up` graph many times in a row; say how fast every process stopped.
+
+    tools/wfenv python tools/sigint_soak.py --runs 50 [--graphs 8] [--domain 90]
+
+Each round starts ``--graphs`` virtual-fish graphs at once (each its own namespace on one ROS
+domain, the way eight users of one machine would), waits until each says "running:", sends one
+SIGINT to each launcher (Ctrl-C), and watches every process of each graph until it is gone.
+Per round: the slowest process's stop time after the SIGINT, the launchers' exit codes and the
+codes they report for their processes. A process killed by the launcher's escalation (SIGTERM,
+SIGKILL after its deadline) shows as a code other than 0. Prints one line per round and a
+summary; exit code 0 only if every process of every round exited 0 within ``--bound`` s and
+none was left.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import psutil
+
+START_TIMEOUT_S = 180.0
+WATCH_S = 30.0
+
+
+def _start(index: int, domain: int, out: Path) -> subprocess.Popen:
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+               PYTHONUNBUFFERED='1')
+    return subprocess.Popen(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+         '--namespace', f'/soak_{index}', '--out', str(out)],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        start_new_session=True)
+
+
+def _wait_running(launcher: subprocess.Popen) -> list[str]:
+    seen: list[str] = []
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while time.monotonic() < deadline:
+        line = launcher.stdout.readline()
+        if not line:
+            break
+        seen.append(line)
+        if line.startswith('running:'):
+            return seen
+    raise RuntimeError('wirefish up did not start:\n' + ''.join(seen))
+
+
+def _gone(proc: psutil.Process) -> bool:
+    try:
+        return not proc.is_running() or proc.status() == psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return True
+
+
+def one_round(graphs: int, domain: int, out: Path) -> dict:
+    """Start ``graphs`` graphs, SIGINT them, watch them stop; return the round's figures."""
+    launchers = [_start(k, domain, out / f'g{k}') for k in range(graphs)]
+    try:
+        for launcher in launchers:
+            _wait_running(launcher)
+        children = {launcher.pid: psutil.Process(launcher.pid).children(recursive=True)
+                    for launcher in launchers}
+        sent = time.monotonic()
+        for launcher in launchers:
+            launcher.send_signal(signal.SIGINT)
+        stopped_at: dict[int, float] = {}
+        watched = [p for procs in children.values() for p in procs]
+        while len(stopped_at) < len(watched) and time.monotonic() - sent < WATCH_S:
+            for proc in watched:
+                if proc.pid not in stopped_at and _gone(proc):
+                    stopped_at[proc.pid] = time.monotonic() - sent
+            time.sleep(0.02)
+        codes, reported = [], []
+        for launcher in launchers:
+            codes.append(launcher.wait(timeout=WATCH_S))
+            rest = launcher.stdout.read()
+            line = next((x for x in rest.splitlines() if x.startswith('stopped')), '')
+            reported += [item.split('=')[1] for item in line.split(': ', 1)[-1].split(', ')
+                         if '=' in item]
+        left = [p.pid for p in watched if not _gone(p)]
+        return {'processes': len(watched), 'slowest_s': max(stopped_at.values(), default=0.0),
+                'launcher_codes': codes, 'reported': reported, 'left': left}
+    finally:
+        for launcher in launchers:
+            if launcher.poll() is None:
+                launcher.kill()
+                launcher.wait()
+            launcher.stdout.close()
+
+
+def main() -> int:
+    """Run the rounds; print one line each and a summary."""
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument('--runs', type=int, default=50, help='rounds (default %(default)s)')
+    parser.add_argument('--graphs', type=int, default=1,
+                        help='graphs started and stopped at once per round (default %(default)s)')
+    parser.add_argument('--domain', type=int, default=90, help='ROS domain (default %(default)s)')
+    parser.add_argument('--bound', type=float, default=3.0,
+                        help='seconds every process must stop within (default %(default)s)')
+    args = parser.parse_args()
+    slowest, bad = [], 0
+    with tempfile.TemporaryDirectory(prefix='wirefish_soak_') as tmp:
+        for run in range(args.runs):
+            figures = one_round(args.graphs, args.domain, Path(tmp) / f'r{run}')
+            clean = (set(figures['launcher_codes']) == {0} and set(figures['reported']) == {'0'}
+                     and len(figures['reported']) == figures['processes'] and not figures['left']
+                     and figures['slowest_s'] <= args.bound)
+            bad += not clean
+            slowest.append(figures['slowest_s'])
+            print(f'round {run + 1}: {figures["processes"]} processes, slowest stop '
+                  f'{figures["slowest_s"]:.2f} s, launchers {figures["launcher_codes"]}, '
+                  f'reported codes {sorted(set(figures["reported"]))}, left {figures["left"]}, '
+                  f'load {os.getloadavg()[0]:.1f}{"" if clean else "  <-- NOT CLEAN"}',
+                  flush=True)
+    print(f'{args.runs} rounds of {args.graphs} graph(s): {args.runs - bad} clean; slowest stop '
+          f'median {statistics.median(slowest):.2f} s, max {max(slowest):.2f} s '
+          f'(bound {args.bound:g} s)')
+    return 0 if bad == 0 else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())
