@@ -19,6 +19,7 @@ LONGEST_MODULES = (
     'test/fleet/test_fleet.py',
     'test/bringup/test_recorder_sigkill.py',
     'test/e2e/test_restart.py',
+    'test/bringup/test_loaded_recording.py',
 )
 
 
