@@ -28,5 +28,8 @@ def test_square_mission_is_recorded_and_reported(planner_graph, tmp_path):
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     assert (out / 'bag' / 'metadata.yaml').exists()
     assert 'turn gain' in proc.stdout  # identified from the recorded planner_state, or why not
+    assert 'the fish comes to rest first' in proc.stdout
+    assert re.search(r'mission square: \d+/\d+, about .* left \| leg 1/8', proc.stderr)
+    assert '[wirefish_recorder]' not in proc.stdout + proc.stderr  # no line per recorded topic
     # Four 1.6 m sides and four quarter turns of radius 0.67 m: about 10.6 m of path.
     assert 9.0 < float(closure[2]) < 12.0
