@@ -20,6 +20,8 @@ enum {
  * does not model the RCC: every flag reads 0). */
 void board_clock_init(void);
 void board_systick_init(void);
+/* The QEMU build: QEMU's virtual clock in ns (TIM2's counter, wraps every 4.3 s). */
+uint32_t board_virtual_ns(void);
 void board_uart_init(void);
 /* USART1 overruns: bytes lost because the receive ring stayed full too long. */
 uint32_t board_uart_rx_overflows(void);

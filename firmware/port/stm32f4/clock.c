@@ -9,10 +9,44 @@
 
 static volatile uint32_t millis;
 
+#if WF_PORT_QEMU
+/* QEMU's SysTick loses periods when the host runs its timer late (a loaded machine): counting
+ * interrupts, the board clock fell 25-40 % behind the wall. Its TIM2 counter is computed from
+ * QEMU's virtual clock instead (1 ns per count with PSC 0, 32 bits: wraps every 4.3 s), so the
+ * SysTick handler adds the nanoseconds that really passed: late ticks lose no time. */
+static uint32_t last_count;
+static uint32_t leftover_ns;
+
+static void virtual_clock_init(void)
+{
+    RCC_APB1ENR |= RCC_APB1ENR_TIM2;
+    TIM_PSC(TIM2_BASE) = 0u;
+    TIM_ARR(TIM2_BASE) = 0xFFFFFFFFu;
+    TIM_CR1(TIM2_BASE) = TIM_CR1_CEN;
+    last_count = TIM_CNT(TIM2_BASE);
+}
+
+void wf_systick_handler(void)
+{
+    const uint32_t count = TIM_CNT(TIM2_BASE);
+    const uint64_t ns = (uint64_t)leftover_ns + (uint32_t)(count - last_count);
+    last_count = count;
+    millis = millis + (uint32_t)(ns / 1000000u);   /* the only writer */
+    leftover_ns = (uint32_t)(ns % 1000000u);
+}
+
+uint32_t board_virtual_ns(void)
+{
+    return TIM_CNT(TIM2_BASE);
+}
+#else
+static void virtual_clock_init(void) {}
+
 void wf_systick_handler(void)
 {
     millis = millis + 1u;   /* the only writer; a 32-bit load elsewhere is atomic */
 }
+#endif
 
 uint32_t wf_hal_millis(void)
 {
@@ -45,6 +79,7 @@ void board_clock_init(void)
 
 void board_systick_init(void)
 {
+    virtual_clock_init();
     SYST_RVR = BOARD_SYSCLK_HZ / 1000u - 1u;
     SYST_CVR = 0u;
     SYST_CSR = SYST_CSR_CLKSOURCE | SYST_CSR_TICKINT | SYST_CSR_ENABLE;

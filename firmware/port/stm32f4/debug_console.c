@@ -90,10 +90,11 @@ void debug_console_poll(void)
     uint32_t now = wf_hal_millis();
     if (now - last_config_ms >= 1000u) {
         last_config_ms = now;
-        const int32_t timer[4] = {(int32_t)wf_hal_pwm_ticks_per_us(),
+        const int32_t timer[5] = {(int32_t)wf_hal_pwm_ticks_per_us(),
                                   (int32_t)board_pwm_period(), (int32_t)lines_dropped,
-                                  (int32_t)board_uart_rx_overflows()};
-        debug_console_line('C', timer, 4u);
+                                  (int32_t)board_uart_rx_overflows(),
+                                  (int32_t)board_virtual_ns()};
+        debug_console_line('C', timer, 5u);
         for (unsigned i = 0u; i < WF_SERVO_COUNT; i++) {
             const wf_servo_cal_t *cal = &config->servo_cal[i];
             const int32_t servo[5] = {(int32_t)i, (int32_t)(cal->neutral_us * 1000.0f + 0.5f),

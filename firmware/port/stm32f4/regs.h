@@ -40,6 +40,7 @@
 #define RCC_AHB1ENR_GPIOA (1u << 0)
 #define RCC_AHB1ENR_GPIOB (1u << 1)
 #define RCC_AHB1ENR_GPIOC (1u << 2)
+#define RCC_APB1ENR_TIM2 (1u << 0)
 #define RCC_APB1ENR_TIM3 (1u << 1)
 #define RCC_APB1ENR_USART2 (1u << 17)
 #define RCC_APB1ENR_I2C1 (1u << 21)
@@ -87,6 +88,7 @@
 #define USART2_IRQN 38u
 
 /* --- General-purpose timer TIM3 (RM0090 18.4) ------------------------------------------- */
+#define TIM2_BASE 0x40000000u
 #define TIM3_BASE 0x40000400u
 #define TIM_CR1(base) WF_REG((base) + 0x00u)
 #define TIM_EGR(base) WF_REG((base) + 0x14u)
@@ -96,6 +98,7 @@
 #define TIM_ARR(base) WF_REG((base) + 0x2Cu)
 #define TIM_CCR1(base) WF_REG((base) + 0x34u)
 #define TIM_CCR2(base) WF_REG((base) + 0x38u)
+#define TIM_CNT(base) WF_REG((base) + 0x24u)
 #define TIM_CR1_CEN (1u << 0)
 #define TIM_CR1_ARPE (1u << 7)
 #define TIM_EGR_UG (1u << 0)
