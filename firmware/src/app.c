@@ -165,8 +165,9 @@ static void on_frame(wf_app_t *app, const wf_msg_t *msg)
     }
 }
 
-/* One ERROR per kind of dropped run that a chunk saw (ref_seq 0: a dropped frame's seq is not
- * to be trusted), in code order, after the chunk's frames. */
+/* One ERROR per kind of dropped run seen since that kind's last ERROR (ref_seq 0: a dropped
+ * frame's seq is not to be trusted), in code order, after the chunk's frames; at most one per
+ * kind per WF_ERROR_MIN_INTERVAL_MS (drops in between go in the next). */
 static void report_drops(wf_app_t *app)
 {
     const wf_decoder_stats_t *s = &app->decoder.stats;
@@ -179,8 +180,9 @@ static void report_drops(wf_app_t *app)
         WF_ERR_COMMAND_OUT_OF_RANGE,
     };
     for (unsigned i = 0; i < WF_REPORTED_KINDS; i++) {
-        if (counts[i] != app->reported[i]) {
+        if (counts[i] != app->reported[i] && due(app->now_ms, app->report_due_ms[i])) {
             app->reported[i] = counts[i];
+            app->report_due_ms[i] = app->now_ms + WF_ERROR_MIN_INTERVAL_MS;
             send_error(app, codes[i], 0);
         }
     }
@@ -189,7 +191,6 @@ static void report_drops(wf_app_t *app)
 static void receive(wf_app_t *app)
 {
     uint8_t chunk[RX_CHUNK];
-    bool any = false;
     for (unsigned c = 0; c < RX_CHUNKS_PER_POLL; c++) {
         const size_t n = wf_hal_uart_read(chunk, sizeof chunk);
         for (size_t i = 0; i < n; i++) {
@@ -198,14 +199,11 @@ static void receive(wf_app_t *app)
                 on_frame(app, &msg);
             }
         }
-        any = any || n > 0;
         if (n < sizeof chunk) {
             break;
         }
     }
-    if (any) {
-        report_drops(app);
-    }
+    report_drops(app);
 }
 
 /* --- sensors ---------------------------------------------------------------------------- */
@@ -316,6 +314,9 @@ void wf_app_init(wf_app_t *app, const wf_config_t *config)
     app->next_heartbeat_ms = app->now_ms; /* identification: from power-up, unprompted */
     app->next_imu_ms = app->now_ms;
     app->next_imu_probe_ms = app->now_ms;
+    for (unsigned i = 0; i < WF_REPORTED_KINDS; i++) {
+        app->report_due_ms[i] = app->now_ms;
+    }
     (void)wf_hal_pwm_init(app->config.servo_frame_hz); /* the rate was validated above */
     for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
         app->compare[i] = wf_servo_compare(&app->config.servo_cal[i], 0.0f,

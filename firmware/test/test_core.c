@@ -252,6 +252,28 @@ static void test_unknown_type_answers_error_3(void)
     CHECK(board_output(out, 64) == 1 && out[0].version_or_code == WF_ERR_UNKNOWN_TYPE);
 }
 
+static void test_a_flood_of_garbage_leaves_room_for_the_telemetry(void)
+{
+    fresh_board();
+    send_heartbeat(0, 1);
+    wf_host_msg_t out[512];
+    board_output(out, 512);
+    const uint8_t garbage[12] = {0x07, 0x01, 0x00, 0x02, 0x05, 0x00, 0x55, 0x00,
+                                 0x03, 0x10, 0x00, 0x00}; /* bad COBS and short runs */
+    for (uint32_t t = 1; t <= 1000; t++) {
+        wf_host_board_step(t, garbage, sizeof garbage, NULL, 0);
+    }
+    const size_t n = board_output(out, 512);
+    size_t errors = 0, telemetry = 0;
+    for (size_t i = 0; i < n; i++) {
+        errors += out[i].type == WF_MSG_ERROR;
+        telemetry += out[i].type == WF_MSG_TELEMETRY;
+    }
+    CHECK(telemetry == 100);
+    CHECK(errors == 50); /* one BAD_FRAME per 20 ms, not one per chunk (1000) */
+    CHECK(snap().decoder[2] == 3000 && snap().decoder[3] == 1000); /* COBS, short */
+}
+
 /* --- failsafe --------------------------------------------------------------------------- */
 static void test_command_timeout_goes_neutral_after_500_ms(void)
 {
@@ -400,6 +422,7 @@ int main(void)
     test_other_version_answers_error_5_and_stays_neutral();
     test_bad_crc_answers_one_error_and_applies_nothing();
     test_unknown_type_answers_error_3();
+    test_a_flood_of_garbage_leaves_room_for_the_telemetry();
     test_command_timeout_goes_neutral_after_500_ms();
     test_heartbeat_timeout_goes_neutral_after_1500_ms();
     test_failsafe_holds_across_the_clock_wrap();
@@ -409,6 +432,6 @@ int main(void)
     test_imu_absent_sets_imu_fault();
     test_battery_below_threshold_sets_low_battery();
     test_imu_sample_reaches_the_telemetry();
-    printf("test_core: 20 tests, %d checks passed\n", checks);
+    printf("test_core: 21 tests, %d checks passed\n", checks);
     return 0;
 }

@@ -35,8 +35,11 @@ typedef struct {
     float low_battery_v;           /* LOW_BATTERY below this */
 } wf_config_t;
 
-/* The decoder's drop counters that an ERROR reports, one per code (ERROR codes 1-4, 6). */
-enum { WF_REPORTED_KINDS = 5 };
+/* The decoder's drop counters that an ERROR reports, one per code (ERROR codes 1-4, 6), and
+ * the shortest time between two ERRORs of one kind: 5 kinds of 11 bytes each every 20 ms take
+ * at most 2.75 kB/s, so a flood of garbage never crowds the telemetry (6.2 kB/s) off 115200
+ * baud. */
+enum { WF_REPORTED_KINDS = 5, WF_ERROR_MIN_INTERVAL_MS = 20 };
 
 typedef struct {
     wf_config_t config;
@@ -75,6 +78,7 @@ typedef struct {
 
     /* counters */
     uint32_t reported[WF_REPORTED_KINDS];
+    uint32_t report_due_ms[WF_REPORTED_KINDS];
     uint32_t commands_applied;
     uint32_t commands_ignored;     /* SERVO_CMD while the host's version differs */
     uint32_t frames_sent;

@@ -26,10 +26,12 @@ from wirefish_sim.fish_dynamics import (GRAVITY, surge_acceleration, wrap_angle,
                                         yaw_acceleration)
 from wirefish_sim.servo_model import Servo, ServoParameters
 
-# The decoder's drops that an ERROR reports: one ERROR per kind that a received chunk saw,
-# with ref_seq 0 (a dropped frame's seq is not to be trusted). The C firmware has the same
-# rule (firmware/src/app.c, report_drops); test/firmware/test_fw_virtual_fish_parity.py holds
-# the two equal.
+# The decoder's drops that an ERROR reports: one ERROR per kind seen since that kind's last
+# one, with ref_seq 0 (a dropped frame's seq is not to be trusted), at most one per kind per
+# _ERROR_MIN_INTERVAL_MS (a flood of garbage must not crowd the telemetry off the link). The C
+# firmware has the same rule (firmware/src/app.c, report_drops);
+# test/firmware/test_fw_virtual_fish_parity.py holds the two equal.
+_ERROR_MIN_INTERVAL_MS = 20
 _DROP_REPORTS = ((ErrorCode.BAD_CRC, ('crc_errors',)),
                  (ErrorCode.BAD_FRAME, ('cobs_errors', 'short_frames', 'overflows')),
                  (ErrorCode.UNKNOWN_TYPE, ('unknown_type',)),
@@ -138,6 +140,7 @@ class VirtualFish:
         self._next_heartbeat = 0.0
         self._remainder = 0.0
         self._drops_reported = [0] * len(_DROP_REPORTS)
+        self._drop_report_due_ms = [0] * len(_DROP_REPORTS)
         self._last_momentum: tuple[float, float] | None = None  # K1, K2 of the last step
         noise = c.imu_noise
         self._gyro_bias = self.rng.normal(0.0, noise.gyro_bias_rad_s, 3)
@@ -157,11 +160,12 @@ class VirtualFish:
             elif isinstance(message, ServoCommand):
                 if self._host_version_ok:
                     self.command(message.servo_1, message.servo_2)
-        stats = self.decoder.stats
+        stats, now_ms = self.decoder.stats, _whole_ms(self.state.time_s)
         for i, (code, counters) in enumerate(_DROP_REPORTS):
             count = sum(getattr(stats, name) for name in counters)
-            if count != self._drops_reported[i]:
+            if count != self._drops_reported[i] and now_ms >= self._drop_report_due_ms[i]:
                 self._drops_reported[i] = count
+                self._drop_report_due_ms[i] = now_ms + _ERROR_MIN_INTERVAL_MS
                 self._outbox.append(self.encoder.encode(ErrorReport(code, 0)))
 
     def command(self, servo_1: float, servo_2: float) -> None:
