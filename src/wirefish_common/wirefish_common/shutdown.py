@@ -75,6 +75,9 @@ class SignalShutdown:
             signal.signal(signum, lambda _signum, _frame: None)
         atexit.register(ignore_stop_signals)
         threading.Thread(target=self._watch, name='signals', daemon=True).start()
+        from wirefish_common.startup_signals import received
+        if received:  # a Ctrl-C while the process was importing: a stop request like any
+            sender.send(b'\0')
 
     def attach(self, node: Any) -> None:
         """Give ``node`` the guard condition that shuts rclpy down once a signal came."""

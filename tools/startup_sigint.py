@@ -1,0 +1,84 @@
+"""
+SIGINT (once or twice) each node executable at a random moment of its start-up; count the clean.
+
+    tools/wfenv python tools/startup_sigint.py --runs 50 [--within 3.0] [--domain 92]
+
+For every run and node: start it as `ros2 run` would (the installed executable, the default
+params file, a namespace of its own), wait a random time in [0, ``--within``) s, send SIGINT
+(and, every other run, a second one 50 ms later), and wait for its exit. Clean: exit code 0
+and no "Traceback"/"KeyboardInterrupt" in its output. Prints the unclean ones with the delay
+and the end of their output, and a summary per node; exit code 0 only if all were clean.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+from ament_index_python.packages import get_package_prefix, get_package_share_directory
+import numpy as np
+
+NODES = (('wirefish_cpg', 'cpg_node'), ('wirefish_cpg', 'tuner_node'),
+         ('wirefish_kinematics', 'kinematics_node'), ('wirefish_planner', 'planner_node'),
+         ('wirefish_bridge', 'bridge_node'))
+EXIT_TIMEOUT_S = 30.0
+
+
+def _command(package: str, name: str, namespace: str) -> list[str]:
+    params = Path(get_package_share_directory('wirefish_bringup'), 'config', 'wirefish.yaml')
+    return [str(Path(get_package_prefix(package), 'lib', package, name)), '--ros-args', '-r',
+            f'__ns:={namespace}', '--params-file', str(params)]
+
+
+def main() -> int:
+    """Run every node ``--runs`` times; print the unclean runs and a summary."""
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument('--runs', type=int, default=50, help='runs per node (default %(default)s)')
+    parser.add_argument('--within', type=float, default=3.0,
+                        help='the SIGINT comes within this many seconds of the start '
+                             '(default %(default)s)')
+    parser.add_argument('--domain', type=int, default=92, help='ROS domain (default %(default)s)')
+    parser.add_argument('--seed', type=int, default=0, help='seed of the delays')
+    args = parser.parse_args()
+    rng = np.random.default_rng(args.seed)
+    env = dict(os.environ, ROS_DOMAIN_ID=str(args.domain),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+    unclean = 0
+    for package, name in NODES:
+        clean = 0
+        for run in range(args.runs):
+            delay = float(rng.uniform(0.0, args.within))
+            twice = run % 2 == 1
+            proc = subprocess.Popen(_command(package, name, f'/startup_{run}'), env=env,
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            time.sleep(delay)
+            proc.send_signal(signal.SIGINT)
+            if twice:
+                time.sleep(0.05)
+                if proc.poll() is None:
+                    proc.send_signal(signal.SIGINT)
+            try:
+                output, _ = proc.communicate(timeout=EXIT_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                output, _ = proc.communicate()
+            ok = proc.returncode == 0 and 'Traceback' not in output \
+                and 'KeyboardInterrupt' not in output
+            clean += ok
+            if not ok:
+                print(f'{name} run {run + 1}: SIGINT{" x2" if twice else ""} at {delay:.2f} s -> '
+                      f'exit {proc.returncode}\n    ' + '\n    '.join(output.splitlines()[-4:]),
+                      flush=True)
+        unclean += args.runs - clean
+        print(f'{name}: {clean}/{args.runs} clean (SIGINT within {args.within:g} s of the '
+              f'start, every other run twice; load {os.getloadavg()[0]:.1f})', flush=True)
+    return 0 if unclean == 0 else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())
