@@ -21,9 +21,11 @@ ARCHITECTURE = ROOT / 'docs' / 'ARCHITECTURE.md'
 CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
 REFERENCE = ROOT / 'docs' / 'REFERENCE.md'
 FAULTS = ROOT / 'docs' / 'FAULTS.md'
+SIM_README = SRC / 'wirefish_sim' / 'README.md'
 DOCS = (ARCHITECTURE, CONTRACTS)
 # Every document a user reads: its cited files and its relative links must exist.
-USER_DOCS = (README, ARCHITECTURE, CONTRACTS, REFERENCE, FAULTS)
+USER_DOCS = (README, ARCHITECTURE, CONTRACTS, REFERENCE, FAULTS,
+             *sorted(SRC.glob('*/README.md')))
 # A topic, service or action name given as a literal where a node or tool creates it.
 _CREATED = re.compile(
     r'(?:create_(?:publisher|subscription|service)|ActionServer|ActionClient)'
@@ -192,3 +194,39 @@ def test_every_relative_link_leads_to_a_file(doc):
 ])
 def test_a_wrong_citation_is_found(dotted, problem):
     assert _dotted_problem(dotted) == problem
+
+
+def documented_flags(text: str, heading: str) -> set[str]:
+    """Return the --flags in the first column of the flag tables under ``## <heading>...``."""
+    flags: set[str] = set()
+    for section in re.split(r'(?m)^## ', text)[1:]:
+        if section.startswith(heading):
+            rows = [line.split('|')[1] for line in section.splitlines()
+                    if line.startswith('| `--')]
+            flags |= {flag for row in rows for flag in re.findall(r'`(--[a-z-]+)', row)}
+    return flags
+
+
+def _fish_sim_flags() -> set[str]:
+    from wirefish_sim.fish_sim import build_parser
+
+    return {a.option_strings[-1] for a in build_parser()._actions
+            if a.option_strings and a.dest != 'help'}
+
+
+def test_the_sim_readme_documents_exactly_fish_sims_flags():
+    flags, documented = _fish_sim_flags(), documented_flags(_text(SIM_README), 'fish_sim')
+    assert documented == flags, (f'not flags of fish_sim: {sorted(documented - flags)}; '
+                                 f'undocumented: {sorted(flags - documented)}')
+
+
+@pytest.mark.parametrize('readme', sorted(SRC.glob('*/README.md')),
+                         ids=[p.parent.name for p in sorted(SRC.glob('*/README.md'))])
+def test_no_readme_documents_a_flag_fish_sim_lacks(readme):
+    stale = sorted(documented_flags(_text(readme), 'fish_sim') - _fish_sim_flags())
+    assert not stale, f'{readme.relative_to(ROOT)} documents fish_sim flags it lacks: {stale}'
+
+
+def test_a_stale_flag_is_found():
+    text = '## fish_sim (virtual fish)\n| `--speed-time-constant` | 0.75 s | |\n## Other\n'
+    assert documented_flags(text, 'fish_sim') == {'--speed-time-constant'}

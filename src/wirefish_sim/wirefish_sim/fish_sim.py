@@ -57,10 +57,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help='name of each fish (with several --link; default fish_1 ... fish_N): '
                    'the namespace of its sim/ground_truth and the prefix of its frames')
     p.add_argument('--ros', action='store_true', help='publish sim/ground_truth')
-    p.add_argument('--ground-truth-hz', type=float, default=50.0)
+    p.add_argument('--ground-truth-hz', type=float, default=50.0,
+                   help='rate of sim/ground_truth (Hz)')
     p.add_argument('--seed', type=int, default=0, help='seed of IMU noise and faults')
-    p.add_argument('--telemetry-hz', type=float, default=100.0)
-    p.add_argument('--heartbeat-hz', type=float, default=2.0)
+    p.add_argument('--telemetry-hz', type=float, default=100.0,
+                   help='firmware: telemetry frames per second')
+    p.add_argument('--heartbeat-hz', type=float, default=2.0,
+                   help='firmware: heartbeats per second')
     p.add_argument('--command-timeout', type=float, default=0.5,
                    help='firmware: neutral after this long without SERVO_CMD (s)')
     p.add_argument('--heartbeat-timeout', type=float, default=1.5,
@@ -69,7 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
                    default=ServoParameters.rate_limit_rad_s, help='slew limit (rad/s)')
     p.add_argument('--servo-lag', type=float, default=ServoParameters.time_constant_s,
                    help='first-order lag (s)')
-    p.add_argument('--servo-update-hz', type=float, default=ServoParameters.update_hz)
+    p.add_argument('--servo-update-hz', type=float, default=ServoParameters.update_hz,
+                   help='servo set-point refresh rate (Hz)')
     p.add_argument('--servo-limit', type=float, default=ServoParameters.limit_rad, help='+-rad')
     p.add_argument('--imu-noise-scale', type=float, default=1.0,
                    help='factor on IMU noise and bias (0 = perfect IMU)')
