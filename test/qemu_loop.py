@@ -80,7 +80,7 @@ class Console:
                 self.zeros.append(numbers[0])
             elif fields[0] == 'P' and len(numbers) == 3:
                 self.compares.append((numbers[0], numbers[1], numbers[2]))
-            elif fields[0] == 'C' and len(numbers) == 4:
+            elif fields[0] == 'C' and len(numbers) == 5:
                 self.ticks_per_us = numbers[0]
                 self.lines_dropped, self.rx_lost = numbers[2], numbers[3]
             elif fields[0] == 'K' and len(numbers) == 5:

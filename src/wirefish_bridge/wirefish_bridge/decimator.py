@@ -11,12 +11,18 @@ from __future__ import annotations
 
 
 class Decimator:
-    """Says which samples of a stream to publish: one per ``1 / rate_hz`` s, and any change."""
+    """
+    Says which samples of a stream to publish: one per ``1 / rate_hz`` s, and any change.
+
+    The samples due are on a fixed schedule, one period after the last one due: a frame that
+    arrives late (a jittery link, a board in an emulator) does not push every later one back,
+    so the stream keeps its rate on average.
+    """
 
     def __init__(self, rate_hz: float) -> None:
         """Publish at most ``rate_hz`` (> 0) samples a second, plus every change."""
         self.rate_hz = rate_hz
-        self._last_time: float | None = None
+        self._next_time: float | None = None
         self._last_state: object = None
 
     @property
@@ -32,11 +38,16 @@ class Decimator:
 
     def due(self, now: float, state: object = None) -> bool:
         """Return whether the sample at ``now`` (s, monotonic) with ``state`` is published."""
-        changed = self._last_time is not None and state != self._last_state
+        period = 1.0 / self._rate_hz
+        changed = self._next_time is not None and state != self._last_state
         # Within a hundredth of a period counts as on time: 100 Hz frames against 10 Hz must
         # give every tenth frame, not every eleventh when a frame comes a little early.
-        if (self._last_time is None or changed
-                or now - self._last_time >= 0.99 / self._rate_hz):
-            self._last_time, self._last_state = now, state
+        if (self._next_time is None or changed
+                or now >= self._next_time - 0.01 * period):
+            on_schedule = (self._next_time is not None and not changed
+                           and now - self._next_time < period)
+            # After a gap of more than a period (or a change) the schedule starts again at now.
+            self._next_time = (self._next_time if on_schedule else now) + period
+            self._last_state = state
             return True
         return False
