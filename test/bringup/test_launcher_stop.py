@@ -17,7 +17,7 @@ import time
 from e2e_utils import descendants
 import pytest
 
-HANGING_TEARDOWN = '''
+HANGING_TEARDOWN = """
 import sys
 import threading
 
@@ -31,7 +31,7 @@ def destroy_node_that_never_returns(self):
 rclpy.node.Node.destroy_node = destroy_node_that_never_returns
 from wirefish_bringup.cli import main  # noqa: E402
 sys.exit(main(sys.argv[1:]))
-'''
+"""
 START_TIMEOUT_S = 90.0
 STOP_TIMEOUT_S = 30.0
 
