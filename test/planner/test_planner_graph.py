@@ -39,6 +39,10 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
+def _rate(servo: list, start: float, end: float) -> float:
+    return sum(1 for r in servo if start <= r[0] < end) / (end - start)
+
+
 def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, float]:
     driver.command = command
     start = driver.now()
@@ -46,11 +50,6 @@ def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, 
     return start, driver.now()
 
 
-# Seen failing once under a loaded full run (2026-12-01 closing note), passing alone: one rerun
-# so a shared machine does not sink CI; a real regression fails both runs. (A later full run
-# failed both on the servo check, 0.5-0.8 mrad over the bound: a real CPG step at frequency
-# changes, fixed in CpgIntegrator.set_parameters.)
-@pytest.mark.flaky(reruns=1)
 @pytest.mark.ros
 def test_drive_the_virtual_fish(driver):
     rec = driver.recording
@@ -59,7 +58,7 @@ def test_drive_the_virtual_fish(driver):
         assert time.monotonic() < deadline, 'no ground truth / planner_state from the graph'
         time.sleep(0.1)
     # No cmd_vel ever received: the planner rests the fish (cpg_node starts with Table 1, and
-    # the planner reaches its parameter service only once discovery is done).
+    # the planner's cpg_command reaches it only once discovery is done).
     rest_deadline = time.monotonic() + 20.0
     while True:
         time.sleep(1.0)
@@ -79,7 +78,9 @@ def test_drive_the_virtual_fish(driver):
         results[setpoint] = speed
         print(f'speed setpoint {setpoint:.2f} m/s: ground truth mean {speed:.4f} m/s '
               f'({100 * (speed / setpoint - 1):+.1f} %), predicted '
-              f'{rec.state[-1][1].predicted_speed:.4f} at {rec.state[-1][1].tail_beat_hz:.2f} Hz')
+              f'{rec.state[-1][1].predicted_speed:.4f} at {rec.state[-1][1].tail_beat_hz:.2f} Hz '
+              f'(the CPG runs v = {rec.state[-1][1].cpg_frequency_hz:.3f} Hz); servo_cmd '
+              f'{_rate(rec.servo, start, end):.0f} Hz heard')
 
     # Above the fastest feasible gait: clamped, the reason in planner_state and /diagnostics.
     start, end = _hold(driver, (0.6, 0.0), 2.5)
