@@ -19,6 +19,7 @@ LONGEST_MODULES = (
     'test/fleet/test_fleet.py',
     'test/bringup/test_recorder_sigkill.py',
     'test/e2e/test_restart.py',
+    'test/firmware_qemu/test_link_in_the_loop.py',
     'test/bringup/test_loaded_recording.py',
 )
 
