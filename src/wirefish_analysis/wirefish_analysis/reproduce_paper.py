@@ -28,6 +28,7 @@ import sys
 from typing import Any
 
 import numpy as np
+from wirefish_common.plotting import legend_beside
 from wirefish_cpg.oscillator import CpgParameters, NetworkArrays, simulate
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait, FitResult
@@ -167,9 +168,9 @@ def _plot(out_dir: Path, fits: dict[str, FitResult], problem: WaveFitProblem,
         ax.semilogy(fit.pso.loss_history, 'o-', ms=2, label=f'{mode} ({unit})')
     ax.set(xlabel='iteration', ylabel='best loss, eq 24 (m s)',
            title='Fig 6(a): convergence of the loss')
-    ax.legend(fontsize=8)
+    legend_beside(ax)
     fig.tight_layout()
-    fig.savefig(out_dir / 'fig6a.png', dpi=110)
+    fig.savefig(out_dir / 'fig6a.png', dpi=110, bbox_inches='tight')
     plt.close(fig)
 
     literal = fits['literal']
@@ -183,10 +184,10 @@ def _plot(out_dir: Path, fits: dict[str, FitResult], problem: WaveFitProblem,
         ax.set_ylabel(labels[k])
     for ax in axes[-1]:
         ax.set_xlabel('iteration')
-    axes[0, 0].legend(fontsize=8)
+    legend_beside(axes[0, 1])
     fig.suptitle('Fig 6(b): the six CPG parameters of the best particle (literal mode)')
     fig.tight_layout()
-    fig.savefig(out_dir / 'fig6b.png', dpi=110)
+    fig.savefig(out_dir / 'fig6b.png', dpi=110, bbox_inches='tight')
     plt.close(fig)
 
     t, angles, _, _ = simulate(NetworkArrays.from_parameters(literal.params),
@@ -198,9 +199,9 @@ def _plot(out_dir: Path, fits: dict[str, FitResult], problem: WaveFitProblem,
                label='[$t_s$, $t_o$]')
     ax.set(xlabel='t (s)', ylabel='CPG output (rad)',
            title='Fig 7(a): CPG outputs from rest (eq 1, literal fit, v = 1 Hz)')
-    ax.legend(loc='upper right', fontsize=8)
+    legend_beside(ax)
     fig.tight_layout()
-    fig.savefig(out_dir / 'fig7a.png', dpi=110)
+    fig.savefig(out_dir / 'fig7a.png', dpi=110, bbox_inches='tight')
     plt.close(fig)
 
     times = problem.window_times()
@@ -215,9 +216,9 @@ def _plot(out_dir: Path, fits: dict[str, FitResult], problem: WaveFitProblem,
         ax.plot(times, theta[:, i], '-', color=color, label=f'predicted $\\theta_{i + 1}$')
     ax.set(xlabel='t (s), the window [$t_s$, $t_o$]', ylabel='swing angle (deg)',
            title='Fig 7(b, c): expected and predicted swing angles (literal fit)')
-    ax.legend(fontsize=8, ncol=2)
+    legend_beside(ax)
     fig.tight_layout()
-    fig.savefig(out_dir / 'fig7bc.png', dpi=110)
+    fig.savefig(out_dir / 'fig7bc.png', dpi=110, bbox_inches='tight')
     plt.close(fig)
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import overload
 
 import numpy as np
+from wirefish_common.plotting import legend_beside
 from wirefish_common.progress import Progress
 from wirefish_cpg.table1_gait import PAPER_GRID_AMPLITUDES_M, PAPER_GRID_FREQUENCIES_HZ
 
@@ -124,15 +125,16 @@ def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> 
             if frequency <= 3.0:
                 value = speed if quantity == 'speed' else speed / (frequency * 0.53)
                 ax.plot(frequency, value, 'k*', markersize=12)
-        ax.plot([], [], 'k--', label='virtual fish (dashed)')
+        if grid and grid[0].fish_speed is not None:  # --model-only draws no virtual fish
+            ax.plot([], [], 'k--', label='virtual fish (dashed)')
         ax.plot([], [], 'k*', label='paper (stated in text)')
         ax.set(xlabel='tail-beat frequency (Hz)',
                ylabel='steady speed (m/s)' if quantity == 'speed' else 'Sw = U / (f L)',
                title='Speed over the paper grid (Fig 9)' if quantity == 'speed'
                else 'Swimming number (Fig 10)')
-        ax.legend(fontsize=8)
+        legend_beside(ax)
         fig.tight_layout()
-        fig.savefig(out / figure, dpi=110)
+        fig.savefig(out / figure, dpi=110, bbox_inches='tight')
         plt.close(fig)
         paths.append(out / figure)
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -144,9 +146,9 @@ def write_outputs(grid: list[SweepPoint], line: list[SweepPoint], out: Path) -> 
     ax.plot(6.5, 0.54, 'k*', markersize=12, label='paper: 0.54 m/s at 6.5 Hz')
     ax.set(xlabel='tail-beat frequency (Hz)', ylabel='steady speed (m/s)',
            title='5 cm tail-tip amplitude (Fig 11)')
-    ax.legend(fontsize=8)
+    legend_beside(ax)
     fig.tight_layout()
-    fig.savefig(out / 'fig11_speed_5cm.png', dpi=110)
+    fig.savefig(out / 'fig11_speed_5cm.png', dpi=110, bbox_inches='tight')
     plt.close(fig)
     paths.append(out / 'fig11_speed_5cm.png')
     return paths

@@ -16,6 +16,9 @@ import sys
 import numpy as np
 
 from wirefish_bringup.bagfile import read_bag
+from wirefish_common.plotting import legend_beside, moving_mean
+
+SPEED_MEAN_S = 1.0  # the ground truth's mean in the speed plot: a few tail beats
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -72,10 +75,6 @@ def _stamp(msg) -> float:
 
 def write_report(bag_path: Path, out_dir: Path) -> list[TopicStats]:
     """Write the PNGs and summary.txt of ``bag_path`` into ``out_dir``; return the stats."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
-
     from wirefish_bringup.bag_storage import recording_custom_data
     from wirefish_bringup.sequence_gaps import loss_line
 
@@ -98,62 +97,107 @@ def write_report(bag_path: Path, out_dir: Path) -> list[TopicStats]:
     if servo:
         msgs = _series(bag, servo)
         t = np.array([_stamp(m) for _, m in msgs]) - t0
-        pos = np.array([list(m.position) for _, m in msgs])
-        fig, ax = plt.subplots(figsize=(8, 3.5))
-        for i in range(pos.shape[1]):
-            ax.plot(t, pos[:, i], label=f'servo_{i + 1}')
-        ax.set(xlabel='time (s)', ylabel='angle (rad)', title='CPG outputs (servo_cmd)')
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(out_dir / 'cpg_outputs.png', dpi=110)
-        plt.close(fig)
+        _save(cpg_figure(t, np.array([list(m.position) for _, m in msgs])),
+              out_dir / 'cpg_outputs.png')
     wave = find('/body_wave')
     if wave and _series(bag, wave):
-        msg = _series(bag, wave)[-1][1]
-        fig, ax = plt.subplots(figsize=(7, 3.5))
-        ax.plot(msg.x, msg.y, '-', label='tail (kinematics)')
-        if len(msg.y_desired):
-            ax.plot(msg.x, msg.y_desired, ':', label='desired (eq 23)')
-        ax.set(xlabel='x in tail_base (m)', ylabel='y (m)', title='Body wave, last snapshot')
-        ax.axis('equal')
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(out_dir / 'body_wave.png', dpi=110)
-        plt.close(fig)
+        _save(body_wave_figure(_series(bag, wave)[-1][1]), out_dir / 'body_wave.png')
     speed = find('/speed_estimate')
     truth = find('/sim/ground_truth')
     if speed or truth:
-        fig, ax = plt.subplots(figsize=(8, 3.5))
-        if speed:
-            msgs = _series(bag, speed)
-            ax.plot([_stamp(m) - t0 for _, m in msgs], [m.speed for _, m in msgs], '.-',
-                    label='Lighthill estimate (eq 18)')
-        if truth:
-            msgs = _series(bag, truth)
-            ax.plot([_stamp(m) - t0 for _, m in msgs], [m.twist.twist.linear.x for _, m in msgs],
-                    label='virtual fish (ground truth)')
-        ax.set(xlabel='time (s)', ylabel='surge speed (m/s)', title='Swimming speed')
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(out_dir / 'speed.png', dpi=110)
-        plt.close(fig)
+        estimate = [(_stamp(m) - t0, m.speed) for _, m in _series(bag, speed)] if speed else []
+        fish = ([(_stamp(m) - t0, m.twist.twist.linear.x) for _, m in _series(bag, truth)]
+                if truth else [])
+        _save(speed_figure(estimate, fish), out_dir / 'speed.png')
     attitude = find('/attitude')
     if attitude:
         msgs = _series(bag, attitude)
         t = np.array([_stamp(m) for _, m in msgs]) - t0
-        fig, ax = plt.subplots(figsize=(8, 3.5))
-        for name in ('x', 'y', 'z'):
-            ax.plot(t, np.degrees([getattr(m.vector, name) for _, m in msgs]),
-                    label={'x': 'roll', 'y': 'pitch', 'z': 'yaw'}[name])
-        ax.set(xlabel='time (s)', ylabel='angle (deg)', title='IMU attitude')
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(out_dir / 'attitude.png', dpi=110)
-        plt.close(fig)
+        angles = np.array([(m.vector.x, m.vector.y, m.vector.z) for _, m in msgs])
+        _save(attitude_figure(t, angles), out_dir / 'attitude.png')
     # What the recorder itself counted: messages missing from the publishers' sequences.
     loss = loss_line(recording_custom_data(bag_path))
     (out_dir / 'summary.txt').write_text(summary_table(stats, bag) + '\n' + loss + '\n')
     return stats
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _save(fig, path: Path) -> None:
+    fig.savefig(path, dpi=110, bbox_inches='tight')  # the legends sit beside the axes
+    _pyplot().close(fig)
+
+
+def cpg_figure(t: np.ndarray, positions: np.ndarray):
+    """Return the CPG outputs (servo_cmd) over time, one curve per servo, legend beside."""
+    fig, ax = _pyplot().subplots(figsize=(8, 3.5))
+    for i in range(positions.shape[1] if positions.ndim == 2 else 0):
+        ax.plot(t, positions[:, i], lw=0.8, label=f'servo_{i + 1}')
+    ax.set(xlabel='time (s)', ylabel='angle (rad)', title='CPG outputs (servo_cmd)')
+    legend_beside(ax)
+    fig.tight_layout()
+    return fig
+
+
+def body_wave_figure(msg):
+    """Return the last body-wave snapshot with the desired wave, legend beside."""
+    fig, ax = _pyplot().subplots(figsize=(7, 3.5))
+    ax.plot(msg.x, msg.y, '-', label='tail (kinematics)')
+    if len(msg.y_desired):
+        ax.plot(msg.x, msg.y_desired, ':', label='desired (eq 23)')
+    ax.set(xlabel='x in tail_base (m)', ylabel='y (m)', title='Body wave, last snapshot')
+    ax.axis('equal')
+    legend_beside(ax)
+    fig.tight_layout()
+    return fig
+
+
+def speed_figure(estimate: list[tuple[float, float]], truth: list[tuple[float, float]]):
+    """
+    Return the speed estimate (one a tail beat) beside the ground truth's mean.
+
+    The ground truth beats with the tail: drawn raw in light grey, and as its mean over one
+    second, which compares with an estimate that is a mean over a beat.
+    """
+    fig, ax = _pyplot().subplots(figsize=(8, 3.5))
+    if truth:
+        t, u = np.array(truth).T
+        ax.plot(t, u, color='0.8', lw=0.6, label='virtual fish, raw (ground truth)')
+        ax.plot(t, moving_mean(t, u, SPEED_MEAN_S), color='tab:blue', lw=1.4,
+                label=f'virtual fish, {SPEED_MEAN_S:g} s mean')
+    if estimate:
+        t, u = np.array(estimate).T
+        ax.plot(t, u, '.-', color='tab:orange', label='Lighthill estimate (eq 18, per beat)')
+    ax.set(xlabel='time (s)', ylabel='surge speed (m/s)', title='Swimming speed')
+    legend_beside(ax)
+    fig.tight_layout()
+    return fig
+
+
+def attitude_figure(t: np.ndarray, angles: np.ndarray):
+    """
+    Return roll, pitch and yaw (deg) each on its own axis, yaw unwrapped.
+
+    One axis for all three let a yaw of -140 deg flatten roll and pitch to a line; unwrapped,
+    a yaw through +-180 deg is a turn, not a jump.
+    """
+    fig, axes = _pyplot().subplots(3, 1, figsize=(8, 6), sharex=True)
+    values = np.degrees(np.array(angles, dtype=float).reshape(-1, 3))
+    if len(values):
+        values[:, 2] = np.degrees(np.unwrap(np.radians(values[:, 2])))
+    for ax, column, name in zip(axes, range(3), ('roll', 'pitch', 'yaw (unwrapped)')):
+        ax.plot(t, values[:, column], lw=0.8)
+        ax.set_ylabel(f'{name} (deg)')
+        ax.grid(True, alpha=0.3)
+    axes[0].set_title('IMU attitude')
+    axes[-1].set_xlabel('time (s)')
+    fig.tight_layout()
+    return fig
 
 
 def summary_table(stats: list[TopicStats], bag) -> str:

@@ -22,6 +22,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from wirefish_common.plotting import legend_beside, moving_mean
 from wirefish_planner.mission_plan import Mission
 from wirefish_planner.yaw_control import identify_turn_gain
 
@@ -115,13 +116,7 @@ def summarise(track: Track, mission: Mission, settle_s: float = 2.0) -> MissionS
 
 def _smooth(t: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Return the SMOOTH_S moving mean of ``values`` (over what there is, at the ends)."""
-    if len(t) < 3:
-        return values
-    step = float(np.median(np.diff(t)))
-    width = min(len(t), max(1, int(round(SMOOTH_S / step)) if step > 0.0 else 1))
-    kernel = np.ones(width)
-    return (np.convolve(values, kernel, mode='same')
-            / np.convolve(np.ones(len(values)), kernel, mode='same'))
+    return moving_mean(t, values, SMOOTH_S)
 
 
 def plot_mission(track: Track, mission: Mission, summary: MissionSummary,
@@ -157,7 +152,7 @@ def plot_mission(track: Track, mission: Mission, summary: MissionSummary,
     ax_path.set_ylabel('y (m, to its left)')
     ax_path.set_aspect('equal', adjustable='datalim')
     ax_path.grid(True, alpha=0.3)
-    ax_path.legend(loc='best', fontsize=8)
+    legend_beside(ax_path)
     for ax, values, target, label in ((ax_speed, track.speed, speed_set, 'speed (m/s)'),
                                       (ax_rate, track.yaw_rate, rate_set, 'yaw rate (rad/s)')):
         ax.plot(track.t, values, color='0.75', lw=0.6, label='ground truth')
@@ -166,11 +161,11 @@ def plot_mission(track: Track, mission: Mission, summary: MissionSummary,
         ax.plot(track.t, target, 'k--', lw=1.0, label='cmd_vel setpoint')
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
-        ax.legend(loc='best', fontsize=8)
+        legend_beside(ax)
     ax_rate.set_xlabel('time from the first leg (s)')
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches='tight')  # the legends sit beside the axes
     plt.close(fig)
     return path
 
