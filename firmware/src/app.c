@@ -52,9 +52,15 @@ void wf_config_defaults(wf_config_t *config)
     config->low_battery_v = 6.6f;
 }
 
-static bool positive_finite(float value)
+static bool in_range(float value, float low, float high)
 {
-    return value > 0.0f && value < 1e30f;
+    return value > low && value <= high; /* false for NaN */
+}
+
+/* The servo frame's length (us): no pulse is longer. */
+static float frame_us(const wf_config_t *c)
+{
+    return 1e6f / (float)c->servo_frame_hz;
 }
 
 bool wf_config_valid(const wf_config_t *c)
@@ -62,15 +68,19 @@ bool wf_config_valid(const wf_config_t *c)
     bool ok = c->command_timeout_ms > 0 && c->heartbeat_timeout_ms > 0 &&
               c->telemetry_period_ms > 0 && c->heartbeat_period_ms > 0 &&
               c->imu_period_ms > 0 && c->command_timeout_ms < 0x80000000u &&
-              c->heartbeat_timeout_ms < 0x80000000u && c->servo_frame_hz >= 50 &&
-              c->servo_frame_hz <= 333 && positive_finite(c->servo_limit_rad) &&
+              c->heartbeat_timeout_ms < 0x80000000u && c->telemetry_period_ms < 0x80000000u &&
+              c->heartbeat_period_ms < 0x80000000u && c->imu_period_ms < 0x80000000u &&
+              c->servo_frame_hz >= 50 && c->servo_frame_hz <= 333 &&
+              in_range(c->servo_limit_rad, 0.0f, 3.14159265f) &&
               wf_mpu6050_axes_valid(c->imu_axes) &&
               (c->imu_mode == WF_IMU_MPU6050 || c->imu_mode == WF_IMU_SYNTHETIC) &&
-              positive_finite(c->attitude_tau_s) && positive_finite(c->battery_v_per_count) &&
-              c->low_battery_v >= 0.0f && c->low_battery_v < 1e30f;
+              in_range(c->attitude_tau_s, 0.0f, 1000.0f) &&
+              in_range(c->battery_v_per_count, 0.0f, 1.0f) &&
+              in_range(c->low_battery_v, -1.0f, 100.0f);
     for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
         const wf_servo_cal_t *cal = &c->servo_cal[i];
-        ok = ok && positive_finite(cal->neutral_us) && positive_finite(cal->us_per_rad) &&
+        ok = ok && in_range(cal->neutral_us, 0.0f, 20000.0f) &&
+             in_range(cal->us_per_rad, 0.0f, 100000.0f) &&
              (cal->direction == 1 || cal->direction == -1);
     }
     return ok;
@@ -280,8 +290,8 @@ static void update_outputs(wf_app_t *app)
             status |= WF_STATUS_SERVO_CLAMPED;
         }
         app->target[i] = wf_servo_clamp(wanted, c->servo_limit_rad);
-        const uint32_t compare =
-            wf_servo_compare(&c->servo_cal[i], app->target[i], wf_hal_pwm_ticks_per_us());
+        const uint32_t compare = wf_servo_compare(&c->servo_cal[i], app->target[i],
+                                                  wf_hal_pwm_ticks_per_us(), frame_us(c));
         if (compare != app->compare[i]) {
             app->compare[i] = compare;
             wf_hal_pwm_set_compare(i, compare);
@@ -320,7 +330,7 @@ void wf_app_init(wf_app_t *app, const wf_config_t *config)
     (void)wf_hal_pwm_init(app->config.servo_frame_hz); /* the rate was validated above */
     for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
         app->compare[i] = wf_servo_compare(&app->config.servo_cal[i], 0.0f,
-                                           wf_hal_pwm_ticks_per_us());
+                                           wf_hal_pwm_ticks_per_us(), frame_us(&app->config));
         wf_hal_pwm_set_compare(i, app->compare[i]);
     }
     app->status = WF_STATUS_FAILSAFE_COMMAND | WF_STATUS_FAILSAFE_HEARTBEAT;

@@ -11,13 +11,18 @@ float wf_servo_clamp(float angle, float limit)
     return angle;
 }
 
-float wf_servo_pulse_us(const wf_servo_cal_t *cal, float angle)
+float wf_servo_pulse_us(const wf_servo_cal_t *cal, float angle, float max_us)
 {
     const float pulse = cal->neutral_us + (float)cal->direction * cal->us_per_rad * angle;
-    return pulse > 0.0f ? pulse : 0.0f;
+    if (!(pulse > 0.0f)) {
+        return 0.0f;
+    }
+    return pulse < max_us ? pulse : max_us;
 }
 
-uint32_t wf_servo_compare(const wf_servo_cal_t *cal, float angle, uint32_t ticks_per_us)
+uint32_t wf_servo_compare(const wf_servo_cal_t *cal, float angle, uint32_t ticks_per_us,
+                          float max_us)
 {
-    return (uint32_t)(wf_servo_pulse_us(cal, angle) * (float)ticks_per_us + 0.5f);
+    /* Bounded by the frame (<= 20000 us) times the tick rate: always within a u32. */
+    return (uint32_t)(wf_servo_pulse_us(cal, angle, max_us) * (float)ticks_per_us + 0.5f);
 }

@@ -349,6 +349,28 @@ static void test_invalid_config_falls_back_to_defaults(void)
     wf_host_reset();
     wf_host_board_init(&c);
     CHECK(snap().config_rejected && wf_host_pwm_frame_hz() == 50);
+    wf_config_defaults(&c);
+    c.servo_cal[0].us_per_rad = 1e30f;
+    CHECK(!wf_config_valid(&c));
+    c.servo_cal[0].us_per_rad = NAN;
+    CHECK(!wf_config_valid(&c));
+    wf_config_defaults(&c);
+    c.imu_axes[1] = 1; /* a mirror: y = x? not a rotation */
+    CHECK(!wf_config_valid(&c));
+}
+
+static void test_a_pulse_never_outlasts_its_frame(void)
+{
+    wf_config_t c;
+    wf_config_defaults(&c);
+    c.servo_frame_hz = 333; /* a 3003 us frame */
+    c.servo_cal[0].us_per_rad = 20000.0f;
+    wf_host_reset();
+    wf_host_board_init(&c);
+    host_seq = 0;
+    send_heartbeat(0, 1);
+    send_command(1, 1.5f, -1.5f);
+    CHECK(wf_host_compare(0) == 3003 && wf_host_compare(1) == 545);
 }
 
 static void test_imu_absent_sets_imu_fault(void)
@@ -429,9 +451,10 @@ int main(void)
     test_beyond_the_limit_is_clamped_and_flagged();
     test_calibration_neutral_gain_and_direction();
     test_invalid_config_falls_back_to_defaults();
+    test_a_pulse_never_outlasts_its_frame();
     test_imu_absent_sets_imu_fault();
     test_battery_below_threshold_sets_low_battery();
     test_imu_sample_reaches_the_telemetry();
-    printf("test_core: 21 tests, %d checks passed\n", checks);
+    printf("test_core: 22 tests, %d checks passed\n", checks);
     return 0;
 }

@@ -86,8 +86,10 @@ typedef struct {
     uint32_t tx_bytes_dropped;     /* bytes the UART's transmit queue had no room for */
 } wf_app_t;
 
-/* True when every value of config is in range (timeouts and periods > 0, frame rate 50..333,
- * finite positive limit and gains, direction +-1, axes a rotation, a known IMU mode). */
+/* True when every value of config is in range: timeouts and periods 1..2^31-1 ms, frame rate
+ * 50..333 Hz, limit (0, pi], neutral (0, 20000] us, gain (0, 1e5] us/rad, direction +-1,
+ * axes a rotation, a known IMU mode, tau (0, 1000] s, (0, 1] V per count, low battery
+ * (-1, 100] V. */
 bool wf_config_valid(const wf_config_t *config);
 
 #endif /* WF_APP_STATE_H */

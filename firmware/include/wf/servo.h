@@ -15,10 +15,12 @@ typedef struct {
 /* Returns angle clamped to [-limit, limit] (the mechanical end stops). */
 float wf_servo_clamp(float angle, float limit);
 
-/* Returns the pulse width (us) of angle (already clamped), never below 0. */
-float wf_servo_pulse_us(const wf_servo_cal_t *cal, float angle);
+/* Returns the pulse width (us) of angle (already clamped), within [0, max_us] (a pulse
+ * cannot outlast its frame). */
+float wf_servo_pulse_us(const wf_servo_cal_t *cal, float angle, float max_us);
 
 /* Returns the compare value: the pulse in timer ticks, rounded to the nearest tick. */
-uint32_t wf_servo_compare(const wf_servo_cal_t *cal, float angle, uint32_t ticks_per_us);
+uint32_t wf_servo_compare(const wf_servo_cal_t *cal, float angle, uint32_t ticks_per_us,
+                          float max_us);
 
 #endif /* WF_SERVO_H */

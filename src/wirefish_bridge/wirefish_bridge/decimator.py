@@ -44,10 +44,11 @@ class Decimator:
         # give every tenth frame, not every eleventh when a frame comes a little early.
         if (self._next_time is None or changed
                 or now >= self._next_time - 0.01 * period):
-            on_schedule = (self._next_time is not None and not changed
-                           and now - self._next_time < period)
             # After a gap of more than a period (or a change) the schedule starts again at now.
-            self._next_time = (self._next_time if on_schedule else now) + period
+            start = now
+            if self._next_time is not None and not changed and now - self._next_time < period:
+                start = self._next_time
+            self._next_time = start + period
             self._last_state = state
             return True
         return False

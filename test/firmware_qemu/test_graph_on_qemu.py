@@ -1,0 +1,182 @@
+"""
+The whole graph on the emulated board: `wirefish up --fish qemu`, as a user starts it.
+
+The bridge's streams at their registry rates, a QEMU restarted under the running graph, and
+Ctrl-C leaving no QEMU behind. The emulated board has no physics: sim/ground_truth is absent.
+"""
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+from e2e_utils import descendants
+import psutil
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import qos_profile_sensor_data
+from ros_utils import spin_until, stop_process
+from sensor_msgs.msg import JointState
+from wirefish_bringup.graph import entry
+from wirefish_bringup.monitor import measure_rates
+
+pytestmark = pytest.mark.ros
+
+NAMESPACE = '/qemu_graph'
+BRIDGE = entry('bridge_node')
+RATE_TOLERANCE = 0.10
+WINDOW_S = 30.0
+
+
+@dataclass
+class QemuGraph:
+    """A `wirefish up --fish qemu` process and the QEMU processes seen under it."""
+
+    launcher: subprocess.Popen
+    domain_id: int
+    qemu_pids: set[int]
+
+    def qemu_processes(self) -> list[psutil.Process]:
+        found = [p for p in descendants(self.launcher.pid) if _is_qemu(p)]
+        self.qemu_pids.update(p.pid for p in found)
+        return found
+
+    def process(self, name: str) -> psutil.Process:
+        return next(p for p in descendants(self.launcher.pid)
+                    if name in ' '.join(_cmdline(p)))
+
+
+def _cmdline(process: psutil.Process) -> list[str]:
+    try:
+        return process.cmdline()
+    except psutil.Error:
+        return []
+
+
+def _is_qemu(process: psutil.Process) -> bool:
+    line = _cmdline(process)
+    return bool(line) and os.path.basename(line[0]) == 'qemu-system-arm'
+
+
+@pytest.fixture(scope='module')
+def qemu_graph(tmp_path_factory) -> Iterator[QemuGraph]:
+    """Yield a running `wirefish up --fish qemu` on a domain of its own."""
+    domain_id = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21')) + 19
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+    launcher = subprocess.Popen(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--fish', 'qemu', '--no-status',
+         '--namespace', NAMESPACE, '--out', str(tmp_path_factory.mktemp('qemu_run'))],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        start_new_session=True)
+    seen = []
+    graph = QemuGraph(launcher, domain_id, set())
+    try:
+        deadline = time.monotonic() + 90.0
+        while time.monotonic() < deadline:
+            line = launcher.stdout.readline()
+            if not line:
+                break
+            seen.append(line)
+            if line.startswith('running:'):
+                break
+        assert seen and seen[-1].startswith('running:'), ''.join(seen)
+        graph.qemu_processes()
+        yield graph
+    finally:
+        children = descendants(launcher.pid)
+        stop_process(launcher, timeout_s=20.0)
+        for child in children:
+            if child.is_running():
+                child.kill()
+        launcher.stdout.close()
+
+
+@pytest.fixture
+def graph_node(qemu_graph: QemuGraph, monkeypatch: pytest.MonkeyPatch):
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    context = Context()
+    rclpy.init(context=context, domain_id=qemu_graph.domain_id)
+    node = rclpy.create_node('qemu_graph_probe', context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    yield node, executor
+    executor.shutdown()
+    node.destroy_node()
+    rclpy.try_shutdown(context=context)
+
+
+def _full(topic: str) -> str:
+    return topic if topic.startswith('/') else f'{NAMESPACE}/{topic}'
+
+
+def test_every_bridge_stream_at_its_rate_for_30_s(qemu_graph, graph_node):
+    node, executor = graph_node
+    wanted = [_full(t) for t in [*BRIDGE.rates_hz, *BRIDGE.min_rates_hz]]
+    assert spin_until(executor, lambda: all(node.count_publishers(t) > 0 for t in wanted),
+                      timeout_s=30.0), 'bridge topics missing'
+    assert node.count_publishers(_full('sim/ground_truth')) == 0   # no physics on the board
+    rates = measure_rates(node, executor, NAMESPACE, window_s=WINDOW_S)
+    shown = {t: round(rates[_full(t)][1], 1) for t in [*BRIDGE.rates_hz, *BRIDGE.min_rates_hz]}
+    print(f'\nwirefish up --fish qemu, {WINDOW_S:g} s: {shown} (nominal {dict(BRIDGE.rates_hz)},'
+          f' at least {dict(BRIDGE.min_rates_hz)})')
+    for topic, nominal in BRIDGE.rates_hz.items():
+        assert rates[_full(topic)][1] == pytest.approx(nominal, rel=RATE_TOLERANCE), topic
+    for topic, minimum in BRIDGE.min_rates_hz.items():
+        assert rates[_full(topic)][1] >= minimum, topic
+
+
+def test_qemu_restarted_under_the_running_graph_the_link_comes_back(qemu_graph, graph_node):
+    node, executor = graph_node
+    received: list[float] = []
+    node.create_subscription(JointState, _full('servo_state'),
+                             lambda _msg: received.append(time.monotonic()),
+                             qos_profile_sensor_data)
+    assert spin_until(executor, lambda: bool(received), timeout_s=20.0)
+    bridge = qemu_graph.process('bridge_node')
+    old = qemu_graph.qemu_processes()
+    assert len(old) == 1
+    killed_at = time.monotonic()
+    old[0].kill()   # the emulator dies; the graph's supervisor starts a new one
+    assert spin_until(executor, lambda: any(p.pid != old[0].pid
+                                            for p in qemu_graph.qemu_processes()), 30.0)
+    assert spin_until(executor, lambda: received[-1] > killed_at + 0.5 and any(
+        t > killed_at for t in received[-50:]) and _resumed(received, killed_at), 60.0)
+    back = next(t for t in received if t > killed_at and _gap_before(received, t) > 0.2)
+    print(f'\nQEMU killed; servo_state back {back - killed_at:.2f} s later, the same '
+          f'bridge_node (pid {bridge.pid}) and launcher')
+    assert bridge.is_running() and qemu_graph.process('bridge_node').pid == bridge.pid
+    assert qemu_graph.launcher.poll() is None
+
+
+def _gap_before(times: list[float], t: float) -> float:
+    index = times.index(t)
+    return t - times[index - 1] if index else float('inf')
+
+
+def _resumed(times: list[float], since: float) -> bool:
+    """Return True once servo_state flows again after a silence that began after ``since``."""
+    after = [t for t in times if t > since]
+    return any(_gap_before(times, t) > 0.2 for t in after) and len(after) > 20
+
+
+def test_ctrl_c_stops_the_graph_and_leaves_no_qemu(qemu_graph):
+    qemu_graph.qemu_processes()
+    assert qemu_graph.qemu_pids
+    os.kill(qemu_graph.launcher.pid, signal.SIGINT)   # what a terminal's Ctrl-C sends
+    code = qemu_graph.launcher.wait(timeout=40.0)
+    left = [pid for pid in qemu_graph.qemu_pids if psutil.pid_exists(pid)
+            and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE]
+    output = qemu_graph.launcher.stdout.read()
+    print(f'\nCtrl-C: wirefish up exited with {code}; QEMU processes seen '
+          f'{sorted(qemu_graph.qemu_pids)}, still running {left}')
+    assert not left
+    assert not [p for p in psutil.process_iter() if _is_qemu(p)
+                and Path(f'/proc/{p.pid}').exists() and p.ppid() == qemu_graph.launcher.pid]
+    assert code in (0, 1), output   # 1: the killed QEMU's restart is reported as unclean
