@@ -6,6 +6,7 @@ from pathlib import Path
 import subprocess
 import sys
 
+from mcap.reader import make_reader
 from mcap.records import Channel, DataEnd, Message
 from mcap.stream_reader import StreamReader
 from wirefish_bringup.bag_storage import READ_ERRORS, storage_files
@@ -24,12 +25,20 @@ def reindex_bag(bag_path: Path, env: dict[str, str] | None = None) -> str:
 
 def assert_bag_readable(bag_path: Path) -> dict[str, int]:
     """
-    Assert that rosbags opens the bag and decodes every message; return messages per topic.
+    Assert that rosbags and mcap's reader open the bag; return messages per topic.
 
-    metadata.yaml must count exactly what the files hold (what `ros2 bag info` would show).
+    rosbags decodes every message; mcap's indexed reader (summary, chunk indexes) must find the
+    same messages; metadata.yaml must count exactly what the files hold (what `ros2 bag info`
+    would show).
     """
     bag = read_bag(Path(bag_path))  # decodes every message: a damaged one raises here
     counts = {topic: len(messages) for topic, messages in bag.messages.items()}
+    indexed: dict[str, int] = {topic: 0 for topic in counts}
+    for path in storage_files(Path(bag_path)):
+        with path.open('rb') as file:
+            for _, channel, _ in make_reader(file).iter_messages():
+                indexed[channel.topic] = indexed.get(channel.topic, 0) + 1
+    assert indexed == counts, f"mcap's reader finds {indexed}, rosbags {counts}"
     info = yaml.safe_load((Path(bag_path) / 'metadata.yaml').read_text())
     listed = {entry['topic_metadata']['name']: entry['message_count']
               for entry in info['rosbag2_bagfile_information']['topics_with_message_count']}
