@@ -79,16 +79,17 @@ def one_round(graphs: int, domain: int, out: Path) -> dict:
                 if proc.pid not in stopped_at and _gone(proc):
                     stopped_at[proc.pid] = time.monotonic() - sent
             time.sleep(0.02)
-        codes, reported = [], []
+        codes, reported, said = [], [], []
         for launcher in launchers:
             codes.append(launcher.wait(timeout=WATCH_S))
             rest = launcher.stdout.read()
+            said += [x for x in rest.splitlines() if x.startswith('wirefish up:')]
             line = next((x for x in rest.splitlines() if x.startswith('stopped')), '')
             reported += [item.split('=')[1] for item in line.split(': ', 1)[-1].split(', ')
                          if '=' in item]
         left = [p.pid for p in watched if not _gone(p)]
         return {'processes': len(watched), 'slowest_s': max(stopped_at.values(), default=0.0),
-                'launcher_codes': codes, 'reported': reported, 'left': left}
+                'launcher_codes': codes, 'reported': reported, 'left': left, 'said': said}
     finally:
         for launcher in launchers:
             if launcher.poll() is None:
@@ -121,6 +122,8 @@ def main() -> int:
                   f'reported codes {sorted(set(figures["reported"]))}, left {figures["left"]}, '
                   f'load {os.getloadavg()[0]:.1f}{"" if clean else "  <-- NOT CLEAN"}',
                   flush=True)
+            if not clean:  # what the launcher said: who overran, the end of its log (stacks)
+                print('    ' + '\n    '.join(figures['said'][-60:]), flush=True)
     print(f'{args.runs} rounds of {args.graphs} graph(s): {args.runs - bad} clean; slowest stop '
           f'median {statistics.median(slowest):.2f} s, max {max(slowest):.2f} s '
           f'(bound {args.bound:g} s)')
