@@ -10,6 +10,7 @@ payload). A reader thread sorts what arrives; the test reads it under ``lock``.
 from __future__ import annotations
 
 import json
+import socket
 import struct
 import threading
 import time
@@ -119,3 +120,10 @@ class FoxgloveClient:
         """Close the connection and wait for the reader."""
         self.ws.close()
         self._reader.join(5.0)
+
+
+def free_port() -> int:
+    """Return a TCP port that nothing on this machine listens on now."""
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        return probe.getsockname()[1]

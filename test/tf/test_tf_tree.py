@@ -21,11 +21,12 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until, stop_process
+from sensor_msgs.msg import Imu
 from tf2_msgs.msg import TFMessage
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
 from wirefish_kinematics.body_wave import body_positions
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_msgs.msg import BodyWave
+from wirefish_msgs.msg import BodyWave, SpeedEstimate
 from wirefish_tf.tf_node import TF_QOS, TF_STATIC_QOS
 
 pytestmark = pytest.mark.ros
@@ -204,3 +205,43 @@ def test_a_fleets_frames_are_prefixed_and_distinct(fleet):
         assert {p for c in mine for p in parents[c]} <= {f'{fish}/{f}' for f in FRAMES}
     assert {child: ps for child, ps in parents.items() if len(ps) != 1} == {}
     assert _roots(parents) == {'fish_1/odom', 'fish_2/odom'}
+
+
+def test_the_real_fish_is_dead_reckoned_from_imu_yaw_and_the_speed_estimate(spawn, ros_context):
+    spawn([str(TF_NODE), '--ros-args', '-r', '__ns:=/reckoned', '-p',
+           'odom_source:=dead_reckoning'])
+    node = rclpy.create_node('reckoning_probe', context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    try:
+        record = TfRecord(node)
+        imu = node.create_publisher(Imu, '/reckoned/imu/data', SENSOR_DATA)
+        speed = node.create_publisher(SpeedEstimate, '/reckoned/speed_estimate', RELIABLE)
+        assert spin_until(executor, lambda: imu.get_subscription_count() > 0
+                          and speed.get_subscription_count() > 0, timeout_s=20.0)
+        estimate = SpeedEstimate(speed=0.2)
+        # Heading +y (yaw pi/2), 0.2 m/s: 100 IMU samples 10 ms apart are 0.198 m of travel.
+        for i in range(101):
+            speed.publish(estimate)
+            sample = Imu()
+            sample.header.stamp.sec, sample.header.stamp.nanosec = 100, 0
+            sample.header.stamp.sec += (i * 10_000_000) // 1_000_000_000
+            sample.header.stamp.nanosec = (i * 10_000_000) % 1_000_000_000
+            sample.orientation.z = sample.orientation.w = math.sqrt(0.5)
+            imu.publish(sample)
+            spin_until(executor, lambda: False, timeout_s=0.02)
+        # Best effort: a loaded tf_node may drop samples, which costs nothing (dt comes from
+        # the stamps) unless they are the last ones; half of the run must be in.
+        assert spin_until(executor, lambda: any(
+            _stamp_ns(t.header.stamp) >= 100_500_000_000 for t in record.transforms),
+            timeout_s=10.0)
+        spin_until(executor, lambda: False, timeout_s=1.0)
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+    last = max(record.transforms, key=lambda t: _stamp_ns(t.header.stamp))
+    travelled = 0.2 * (_stamp_ns(last.header.stamp) - 100_000_000_000) * 1e-9
+    p = last.transform.translation
+    assert (last.header.frame_id, last.child_frame_id) == ('odom', 'base_link')
+    # The first samples may precede the first speed estimate: at most that much short.
+    assert abs(p.x) < 1e-9 and travelled - 0.05 <= p.y <= travelled + 1e-9

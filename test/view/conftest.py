@@ -8,6 +8,7 @@ import socket
 import time
 
 from e2e_utils import descendants, RunningGraph, start_graph
+from foxglove_client import free_port
 import pytest
 from ros_utils import stop_process
 from wirefish_bringup.graph import default_params_file
@@ -28,13 +29,6 @@ class ViewGraph:
     @property
     def http_url(self) -> str:
         return f'http://127.0.0.1:{self.http_port}/'
-
-
-def free_port() -> int:
-    """Return a TCP port that nothing on this machine listens on now."""
-    with socket.socket() as probe:
-        probe.bind(('127.0.0.1', 0))
-        return probe.getsockname()[1]
 
 
 def _wait_listening(port: int, timeout_s: float) -> bool:

@@ -147,6 +147,19 @@ def test_a_client_message_on_another_topic_is_refused(view_graph, client, probe)
     assert writers() == {'cpg_node'}  # the view never became a writer of it
 
 
+def test_the_scene_places_the_fish_by_its_frames(view_graph, client):
+    name = f'{view_graph.graph.namespace}/view/scene'
+    assert client.wait(lambda: client.channel_of(name) is not None, timeout_s=30.0)
+    assert client.channel_of(name)['schemaName'] == 'foxglove.SceneUpdate'
+    subscription = client.subscribe(client.channel_of(name)['id'])
+    # The head in base_link, the tail in tail_base, and once the fish has moved, its trail.
+    assert client.wait(lambda: any(b'odom' in p for _, p in
+                                   client.messages.get(subscription, [])), 20.0)
+    with client.lock:
+        last = client.messages[subscription][-1][1]
+    assert b'base_link' in last and b'tail_base' in last and b'trail' in last
+
+
 def test_a_malformed_frame_does_not_stop_the_server(view_graph, client):
     name = _full(view_graph.graph.namespace, 'imu/data')
     assert client.wait(lambda: client.channel_of(name) is not None, timeout_s=30.0)

@@ -7,7 +7,9 @@ Channels (protocol ``foxglove.sdk.v1``)
     tick (``discovery_period_s``). A topic is subscribed (raw bytes: nothing is decoded) only
     while a client subscribes to its channel; its QoS follows its publishers' (best effort,
     transient local). ``view/scene`` (foxglove.SceneUpdate): the fish (``scene``), at
-    ``scene_rate_hz``. ``view/retune`` (JSON): the retune goal's progress and result.
+    ``scene_rate_hz`` while a client watches it (body_wave and /tf decoded only then; the
+    trail is this fish's odom -> base_link from then on). ``view/retune`` (JSON): the retune
+    goal's progress and result.
 Client publish
     Accepted on ``cmd_vel`` (geometry_msgs/msg/Twist, CDR or JSON) within ``max_speed`` and
     ``max_turn`` (`wirefish drive`'s limits); any other channel, or a message outside the
@@ -21,7 +23,7 @@ The dashboard
     `make setup`) and ``/config.json`` (the WebSocket port and namespace); 0 serves none.
 Parameters: ``address`` (127.0.0.1; anything wider is logged as a warning), ``port``,
 ``http_port``, ``max_speed``, ``max_turn``, ``scene_rate_hz``, ``trail_length``,
-``discovery_period_s``, ``frame_prefix``.
+``discovery_period_s``, ``frame_prefix``, l1 and l2 (the graph's geometry block).
 """
 
 from __future__ import annotations
@@ -42,15 +44,16 @@ from foxglove.channels import SceneUpdateChannel
 from foxglove.websocket import (Capability, ChannelView, Client, ClientChannel, ServerListener,
                                 StatusLevel)
 from geometry_msgs.msg import Twist
-from nav_msgs.msg import Odometry
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_srvs.srv import Trigger
+from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, ParameterSpec
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_kinematics.node_parameters import geometry_parameters
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
 from wirefish_view.client_input import check_advertised, cmd_vel_from_client
@@ -60,6 +63,10 @@ from wirefish_view.schemas import ros2msg_schema
 from wirefish_view.web import DashboardServer
 
 GLOBAL_TOPICS = ('/tf', '/tf_static', '/diagnostics')
+# tf2_ros's listener profile (matches tf_node's broadcaster).
+TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+# The arcs of the scene: the graph's geometry block (/**), as the kinematics reads it.
+TAIL_GEOMETRY = geometry_parameters(('l1', 'l2'))
 SERVICE_WAIT_S = 5.0
 # view/retune: state sent | running (iteration, max_iterations, best_loss) | rejected | done
 # (success, message, applied, loss, iterations, from_library, rmse_theta_deg).
@@ -121,8 +128,9 @@ class ViewNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, start the servers, wire discovery, scene and services."""
         super().__init__('view_node', **kwargs)
-        declare(self, VIEW_PARAMETERS)
-        self._values = {s.name: self.get_parameter(s.name).value for s in VIEW_PARAMETERS}
+        declare(self, VIEW_PARAMETERS + TAIL_GEOMETRY)
+        self._values = {s.name: self.get_parameter(s.name).value
+                        for s in VIEW_PARAMETERS + TAIL_GEOMETRY}
         prefix = declare_frame_prefix(self)
         self._frames = {f: prefixed(prefix, f) for f in ('odom', 'base_link', 'tail_base')}
         namespace = self.get_namespace().rstrip('/')
@@ -136,14 +144,12 @@ class ViewNode(Node):
         self._refused_logged: dict[str, float] = {}
         self._trail: list[tuple[float, float]] = []
         self._segments: list[tuple[list[float], list[float]]] = []
-        self._geometry = (0.08, 0.1)
+        self._scene_inputs: list[Any] = []  # body_wave and /tf, while the scene is watched
         self._cmd_pub = self.create_publisher(Twist, 'cmd_vel', RELIABLE)
         self._start_client = self.create_client(Trigger, 'start')
         self._stop_client = self.create_client(Trigger, 'stop')
         self._retune = ActionClient(self, RetuneGait, 'retune_gait')
         self._retune_busy = threading.Event()
-        self.create_subscription(BodyWave, 'body_wave', self._on_body_wave, SENSOR_DATA)
-        self.create_subscription(Odometry, 'sim/ground_truth', self._on_odometry, RELIABLE)
         self._start_servers()
         self.create_timer(self._values['discovery_period_s'], self._discover)
         self.create_timer(0.05, self._serve_requests)
@@ -226,7 +232,9 @@ class ViewNode(Node):
                 return
             count = self._subscribers.get(topic, 0) + (1 if kind == 'subscribe' else -1)
             self._subscribers[topic] = max(count, 0)
-            if count > 0 and topic not in self._raw_subscriptions and topic in self._channels:
+            if topic == self._scene.topic():
+                self._watch_scene(count > 0)
+            elif count > 0 and topic not in self._raw_subscriptions and topic in self._channels:
                 publishers = self.get_publishers_info_by_topic(topic)
                 self._raw_subscriptions[topic] = self.create_subscription(
                     _type_of(self._channels[topic]), topic,
@@ -338,15 +346,32 @@ class ViewNode(Node):
                              'iterations': r.iterations, 'from_library': r.from_library,
                              'rmse_theta_deg': list(r.rmse_theta_deg)})
 
-    # --- the scene ------------------------------------------------------------------------
-    def _on_body_wave(self, msg: BodyWave) -> None:
-        self._segments = tail_segments(msg.q, msg.x, msg.y, *self._geometry)
+    # --- the scene (decoded inputs only while a client watches it) ------------------------
+    def _watch_scene(self, watched: bool) -> None:
+        if watched and not self._scene_inputs:
+            self._scene_inputs = [
+                self.create_subscription(BodyWave, 'body_wave', self._on_body_wave,
+                                         SENSOR_DATA),
+                self.create_subscription(TFMessage, '/tf', self._on_tf, TF_QOS)]
+        elif not watched:
+            for subscription in self._scene_inputs:
+                self.destroy_subscription(subscription)
+            self._scene_inputs, self._segments = [], []
 
-    def _on_odometry(self, msg: Odometry) -> None:
-        p = msg.pose.pose.position
-        if math.isfinite(p.x) and math.isfinite(p.y):
-            self._trail.append((p.x, p.y))
-            del self._trail[:-self._values['trail_length']]
+    def _on_body_wave(self, msg: BodyWave) -> None:
+        self._segments = tail_segments(msg.q, msg.x, msg.y, self._values['l1'],
+                                       self._values['l2'])
+
+    def _on_tf(self, msg: TFMessage) -> None:
+        """Extend the trail with this fish's odom -> base_link (virtual or dead-reckoned)."""
+        for t in msg.transforms:
+            if (t.header.frame_id, t.child_frame_id) != (self._frames['odom'],
+                                                         self._frames['base_link']):
+                continue
+            p = t.transform.translation
+            if math.isfinite(p.x) and math.isfinite(p.y):
+                self._trail.append((p.x, p.y))
+                del self._trail[:-self._values['trail_length']]
 
     def _publish_scene(self) -> None:
         if self._segments:
