@@ -116,6 +116,18 @@ def _full(topic: str) -> str:
     return topic if topic.startswith('/') else f'{NAMESPACE}/{topic}'
 
 
+def test_without_a_firmware_tree_wirefish_up_fails_with_one_line(tmp_path):
+    env = dict(os.environ, WIREFISH_FIRMWARE_DIR=str(tmp_path / 'nowhere'))
+    result = subprocess.run(
+        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--fish', 'qemu', '--no-status',
+         '--namespace', '/qemu_missing', '--out', str(tmp_path)],
+        env=env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 1, result.stdout + result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and 'no firmware source tree' in lines[0], result.stderr
+    assert 'started' not in result.stdout   # nothing was started
+
+
 def test_every_bridge_stream_at_its_rate_for_30_s(qemu_graph, graph_node):
     node, executor = graph_node
     wanted = [_full(t) for t in [*BRIDGE.rates_hz, *BRIDGE.min_rates_hz]]
