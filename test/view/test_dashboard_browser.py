@@ -92,6 +92,7 @@ def test_the_plots_update_with_the_graphs_values(browser):
     assert max(commanded) - min(commanded) > 0.1  # the tail beats on the page
     assert all(abs(v) <= math.pi / 2 for v in commanded)
     assert _wait_page(browser, 'window.wirefish.plots.speed.data[0].length > 10', 10.0)
+    assert _wait_page(browser, 'window.wirefish.latest.odom !== undefined', 10.0)  # from /tf
     assert _wait_page(browser, "document.getElementById('v-mode').textContent !== '-'", 10.0)
     assert 'V' in browser.find_element(By.ID, 'v-battery').text
 

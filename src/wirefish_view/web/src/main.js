@@ -13,7 +13,7 @@ const DRIVE_HZ = 10; // cmd_vel rate while driving (the planner's timeout is 0.5
 const SPEED_STEP = 0.05; // m/s, as `wirefish drive`
 const TURN_STEP = 0.1; // rad/s
 const WANTED = ['servo_cmd', 'servo_state', 'body_wave', 'planner_state', 'speed_estimate',
-  'sim/ground_truth', 'battery', 'cmd_vel', '/diagnostics', '/tf_static', 'view/retune'];
+  'sim/ground_truth', 'battery', 'cmd_vel', '/diagnostics', '/tf', '/tf_static', 'view/retune'];
 
 const live = {
   connected: false, counts: {}, latest: {}, plots: {}, drive: { speed: 0, turn: 0 },
@@ -145,13 +145,23 @@ function onMessage(topic, m) {
       $('v-note').textContent = m.note || m.clamp_reason || '';
       break;
     case 'speed_estimate': live.latest.speed_estimate = m.speed; break;
+    case '/tf':
+      // This fish's odom -> base_link: the virtual fish's ground truth or the real fish's
+      // dead reckoning (tf_node), so the top view works on both.
+      for (const t of m.transforms) {
+        if (t.header.frame_id !== live.config.frames.odom
+            || t.child_frame_id !== live.config.frames.base_link) continue;
+        const p = t.transform.translation; const q = t.transform.rotation;
+        const yaw = Math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
+        fish.pose = { x: p.x, y: p.y, yaw };
+        const last = fish.trail[fish.trail.length - 1];
+        if (!last || Math.hypot(last[0] - p.x, last[1] - p.y) > 0.005) fish.trail.push([p.x, p.y]);
+        if (fish.trail.length > 3000) fish.trail.shift();
+        live.latest.odom = { x: p.x, y: p.y, yaw };
+      }
+      break;
     case 'sim/ground_truth': {
-      const p = m.pose.pose.position; const q = m.pose.pose.orientation;
-      const yaw = Math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
-      fish.pose = { x: p.x, y: p.y, yaw };
-      const last = fish.trail[fish.trail.length - 1];
-      if (!last || Math.hypot(last[0] - p.x, last[1] - p.y) > 0.005) fish.trail.push([p.x, p.y]);
-      if (fish.trail.length > 3000) fish.trail.shift();
+      const p = m.pose.pose.position;
       speed.push(stampS(m.header.stamp), [live.latest.speed_estimate ?? NaN, m.twist.twist.linear.x]);
       live.latest.ground_truth = { x: p.x, y: p.y, speed: m.twist.twist.linear.x };
       break;
@@ -172,7 +182,7 @@ function onMessage(topic, m) {
     }
     case '/tf_static':
       for (const t of m.transforms) {
-        if (t.child_frame_id.endsWith('tail_base')) fish.tailBase = t.transform.translation.x;
+        if (t.child_frame_id === live.config.frames.tail_base) fish.tailBase = t.transform.translation.x;
       }
       break;
     case 'view/retune': onRetune(m); break;
