@@ -21,6 +21,8 @@ LONGEST_MODULES = (
     'test/e2e/test_restart.py',
     'test/firmware_qemu/test_link_in_the_loop.py',
     'test/bringup/test_loaded_recording.py',
+    'test/view/test_dashboard_browser.py',
+    'test/view/test_view_protocol.py',
 )
 
 
