@@ -19,6 +19,7 @@ The one ``main()`` of every wirefish node: signals, rclpy, the node, its executo
 from __future__ import annotations
 
 from collections.abc import Callable
+import faulthandler
 import os
 import sys
 from typing import NoReturn, TypeVar
@@ -32,6 +33,8 @@ from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import ignore_stop_signals, SignalShutdown
 
 NodeT = TypeVar('NodeT', bound=Node)
+# The longest a node's teardown (destroy_node, executor, context) may take after its spin ends.
+TEARDOWN_S = 2.0
 
 
 def create_node_or_exit(node_class: Callable[[], NodeT]) -> NodeT:
@@ -76,6 +79,11 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         pass
     finally:
         signals.attach_executor(None)
+        # A DDS teardown that never returns (seen once in 41 stops of a loaded graph: tf_node's
+        # main thread in rclpy's EventHandler.__exit__ under destroy_node, held until the
+        # launcher's SIGKILL) ends the process after TEARDOWN_S with its threads' stacks and
+        # exit code 1: faulthandler's own C thread needs no GIL, which that call may hold.
+        faulthandler.dump_traceback_later(TEARDOWN_S, exit=True)
         # The node's own threads (serial reader, publish loop) are joined by destroy_node
         # before the executor goes: a task they hand over meets a live executor.
         executor.remove_node(node)
