@@ -26,6 +26,7 @@ SUBCOMMANDS = {
                 'timed cmd_vel legs, recorded, with a trajectory report'),
     'report': ('wirefish_bringup.report', 'plots and a summary table from a recorded bag'),
     'bag': ('wirefish_bringup.bag_command', 'reindex a killed recording; bag info'),
+    'play': ('wirefish_bringup.play_command', "publish a bag's messages again (ros2 bag play)"),
     'topic': ('wirefish_bringup.topic_command',
               'list topics, echo one, show its rate (ros2 topic)'),
     'param': ('wirefish_bringup.param_command',

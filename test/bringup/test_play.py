@@ -1,0 +1,98 @@
+"""`wirefish play`: a bag written by rosbags plays into a subscriber, every message in order."""
+
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+from wirefish_bringup.play_command import remapped
+
+CLI = [sys.executable, '-m', 'wirefish_bringup.cli']
+COUNT = 40
+
+
+def write_bag(path):
+    """Write a bag: COUNT std_msgs/String on /recorded/chatter 20 ms apart, one latched."""
+    from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness,
+                                    QosReliability, QosTime)
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import get_typestore, Stores
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    string = store.types['std_msgs/msg/String']
+    forever = QosTime(2**31 - 1, 0)
+
+    def qos(durability):
+        return Qos(QosHistory.KEEP_LAST, 1, QosReliability.RELIABLE, durability, forever,
+                   forever, QosLiveliness.AUTOMATIC, forever, False)
+
+    with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        chatter = writer.add_connection('/recorded/chatter', 'std_msgs/msg/String',
+                                        typestore=store,
+                                        offered_qos_profiles=[qos(QosDurability.VOLATILE)])
+        state = writer.add_connection('/recorded/state', 'std_msgs/msg/String',
+                                      typestore=store,
+                                      offered_qos_profiles=[qos(QosDurability.TRANSIENT_LOCAL)])
+        start = 1_000_000_000_000
+        writer.write(state, start, store.serialize_cdr(string(data='latched'), string.__msgtype__))
+        for i in range(COUNT):
+            writer.write(chatter, start + i * 20_000_000,
+                         store.serialize_cdr(string(data=f'message {i}'), string.__msgtype__))
+
+
+@pytest.mark.parametrize('topic, remaps, expected', [
+    ('/wirefish/imu/data', [('/wirefish', '/replay')], '/replay/imu/data'),
+    ('/wirefishy/imu', [('/wirefish', '/replay')], '/wirefishy/imu'),  # whole tokens only
+    ('/diagnostics', [('/wirefish', '/replay')], '/diagnostics'),
+])
+def test_a_remap_replaces_a_whole_prefix(topic, remaps, expected):
+    assert remapped(topic, remaps) == expected
+
+
+@pytest.mark.ros
+def test_play_publishes_every_message_in_order_with_its_qos(ros_context, ros_env, tmp_path):
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from std_msgs.msg import String
+
+    bag = tmp_path / 'bag'
+    write_bag(bag)
+    node = rclpy.create_node('listener', context=ros_context)
+    heard: list[str] = []
+    node.create_subscription(String, '/played/chatter', lambda m: heard.append(m.data),
+                             QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE))
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    try:
+        result = subprocess.run([*CLI, 'play', str(bag), '--remap', '/recorded:=/played',
+                                 '--delay', '3'], env=ros_env, capture_output=True, text=True,
+                                timeout=120)
+        assert result.returncode == 0, result.stderr
+        assert f'played {COUNT + 1} messages of 2 topics' in result.stdout
+        deadline = time.monotonic() + 10.0
+        while len(heard) < COUNT and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert heard == [f'message {i}' for i in range(COUNT)]
+        # The latched topic is offered latched again, as its recorded publisher offered it.
+        late = subprocess.Popen([*CLI, 'play', str(bag), '--topics', '/recorded/state',
+                                 '--remap', '/recorded:=/played', '--delay', '10'],
+                                env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+        deadline = time.monotonic() + 30.0
+        while not node.get_publishers_info_by_topic('/played/state') and \
+                time.monotonic() < deadline:
+            time.sleep(0.1)
+        offered = [i.qos_profile.durability for i in
+                   node.get_publishers_info_by_topic('/played/state')]
+        assert late.wait(timeout=60) == 0, late.stderr.read()
+        late.stdout.close()
+        late.stderr.close()
+        assert offered == [DurabilityPolicy.TRANSIENT_LOCAL]
+    finally:
+        executor.shutdown()
+        spinner.join(timeout=5.0)
+        node.destroy_node()
