@@ -2,10 +2,11 @@
  * The application: link logic, failsafe, servo output, sensors and the telemetry schedule.
  *
  * The firmware rules are the virtual fish's (wirefish_sim.virtual_fish), and
- * test/firmware/test_virtual_fish_parity.py holds the two to the same output frames and
- * states. One poll: read every byte the UART holds (one chunk), act on each valid frame, send
- * one ERROR per kind of drop the chunk saw; sample the sensors; run the failsafe and set the
- * servos; send the telemetry and the heartbeat that are due, in that order.
+ * test/firmware/test_fw_virtual_fish_parity.py holds the two to the same output frames and
+ * states. One poll: read every byte the UART holds (one chunk, up to 512), act on each valid
+ * frame, send one ERROR per kind of drop not yet reported (at most one per kind per 20 ms);
+ * sample the sensors; run the failsafe and set the servos; send the telemetry and the
+ * heartbeat that are due, in that order.
  */
 #include "wf/app.h"
 
