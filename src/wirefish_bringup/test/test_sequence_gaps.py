@@ -1,7 +1,10 @@
-"""SequenceGaps counts exactly the samples absent from a publisher's sequence numbers."""
+"""SequenceGaps counts exactly the samples absent from a publisher's sequence numbers; a run says so."""
+
+from pathlib import Path
 
 import pytest
-from wirefish_bringup.sequence_gaps import SequenceGaps
+from wirefish_bringup.record import recording_summary
+from wirefish_bringup.sequence_gaps import recording_account, SequenceGaps, TopicAccount
 
 
 def _gaps(numbers: list[int | None]) -> SequenceGaps:
@@ -34,3 +37,26 @@ def test_a_number_going_back_is_a_new_writer_not_a_loss():
 
 def test_one_writer_in_order_is_not_ambiguous():
     assert not _gaps([1, 2, 4]).ambiguous
+
+
+def _account(numbers: list[int | None], latched: bool = False) -> TopicAccount:
+    return TopicAccount(len(numbers), _gaps(numbers), 250_000_000, latched)
+
+
+def test_a_recording_that_lost_names_each_topic_and_count_in_its_last_line():
+    accounts = {'/a': _account([1, 2, 5]), '/b': _account([1, 2, 3]),
+                '/c': _account([4, 9], latched=True), '/d': _account([3, 1])}
+    text = recording_summary(Path('bag'), accounts)
+    assert text.splitlines()[-1] == 'recording: LOST 6 messages: /a 2, /c 4'
+    assert '/d' in text and 'several publishers: sequence not checked' in text
+
+
+def test_a_recording_that_lost_nothing_says_so():
+    text = recording_summary(Path('bag'), {'/a': _account([1, 2, 3])})
+    assert text.splitlines()[-1] == 'recording: 0 lost on 1 topics'
+    assert 'lag max 0.25 s' in text
+
+
+def test_a_latched_topic_keeps_no_lag_in_the_account():
+    account = recording_account({'/a': _account([1]), '/c': _account([1], latched=True)})
+    assert account == {'missing:/a': '0', 'lag_max_s:/a': '0.250', 'missing:/c': '0'}
