@@ -140,8 +140,11 @@ def _drive(mission, namespace: str, bag_path: Path,
     heard: list[PlannerState] = []
     node.create_subscription(PlannerState, 'planner_state', heard.append, reliable)
     speeds: deque[tuple[float, float]] = deque()  # (node clock s, |surge speed| m/s), last 1 s
-    node.create_subscription(Odometry, 'sim/ground_truth', lambda m: speeds.append(
-        (now(), abs(m.twist.twist.linear.x))), reliable)
+
+    def on_truth(message: Odometry) -> None:
+        speeds.append((now(), abs(message.twist.twist.linear.x)))
+
+    node.create_subscription(Odometry, 'sim/ground_truth', on_truth, reliable)
     parameters = node.create_client(GetParameters, 'planner_node/get_parameters')
     answer: list = []
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'

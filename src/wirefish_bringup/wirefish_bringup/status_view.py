@@ -15,6 +15,7 @@ from collections import deque
 from dataclasses import dataclass, field
 import math
 import time
+from typing import Any
 
 DIAGNOSTIC_LEVELS = {0: 'OK', 1: 'WARN', 2: 'ERROR', 3: 'STALE'}
 QUEUE_DEPTH = 500  # per topic between two refreshes: 1 s of the fastest stream, with room
@@ -81,7 +82,7 @@ def battery_text(message) -> str:
 
 @dataclass
 class _Watched:
-    subscription: object
+    subscription: Any  # an rclpy Subscription (rclpy is imported only when watching)
     type_name: str
     latched: bool
     window: RateWindow

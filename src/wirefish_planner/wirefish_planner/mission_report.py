@@ -89,7 +89,7 @@ def rest_index(track: Track, mission: Mission) -> tuple[int, bool]:
         return len(track.t) - 1, False
     if not moving:
         return int(after[0]), True
-    last_moving = moving[-1]
+    last_moving = int(moving[-1])
     if last_moving >= len(track.t) - 1 or track.t[-1] - track.t[last_moving] < SMOOTH_S:
         return len(track.t) - 1, False
     return last_moving + 1, True
