@@ -1,4 +1,4 @@
-"""SequenceGaps counts exactly the samples absent from a publisher's sequence numbers; a run says so."""
+"""SequenceGaps counts the samples absent from a publisher's sequence numbers; a run says so."""
 
 from pathlib import Path
 
