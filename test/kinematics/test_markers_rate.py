@@ -30,8 +30,11 @@ def test_markers_go_out_with_every_nth_body_wave(start_node, probe, markers_rate
     probe.markers.clear()
     stream_until(probe, lambda: len(probe.body) >= BODY_WAVES)
     body_stamps = {(m.header.stamp.sec, m.header.stamp.nanosec) for m in probe.body}
-    marker_stamps = [(a.markers[0].header.stamp.sec, a.markers[0].header.stamp.nanosec)
-                     for a in probe.markers]
+    # Markers are reliable, body_wave best effort: the markers of a tick just before the clear
+    # may arrive after it, when its body_wave came before; only later ticks are compared.
+    marker_stamps = [stamp for stamp in (
+        (a.markers[0].header.stamp.sec, a.markers[0].header.stamp.nanosec)
+        for a in probe.markers) if stamp >= min(body_stamps)]
     # Each markers array shows the shape of a body_wave tick, and only every n-th tick has one.
     assert set(marker_stamps[:-1]) <= body_stamps
-    assert len(probe.markers) == pytest.approx(len(probe.body) / every, abs=2)
+    assert len(marker_stamps) == pytest.approx(len(probe.body) / every, abs=2)

@@ -18,7 +18,8 @@ import time
 
 import psutil
 
-RATE_HZ = 200.0  # servo_cmd's rate: the graph's busiest stream
+RATE_HZ = 200.0  # servo_cmd's rate before its default became 100 Hz
+TICK_HZ = 50.0  # kinematics_node's body_wave tick
 WARM_UP_S = 4.0
 MODULE = 'wirefish_analysis.message_cost'  # each probe runs as its own process
 # The probes' own topic: not one of the graph's (CONTRACTS.md lists those).
@@ -54,17 +55,55 @@ def _publisher(rate_hz: float) -> None:
 
 
 def _subscriber(kind: str) -> None:
-    """Take the probe's messages on the events executor: ``msg``, ``raw`` bytes, or ``none``."""
+    """
+    Take the probe's messages on the events executor: ``msg``, ``raw`` bytes, or ``none``.
+
+    ``msg+tick``: a callback per message beside a 50 Hz timer (kinematics_node before);
+    ``batch+tick``: the 50 Hz timer takes what arrived from a ``BatchIntake`` and reads each
+    sample (kinematics_node now); ``raw+read``: a raw callback that reads the servo pair from
+    the bytes, ``msg+read`` the same from the message (the bridge's intake, now and before).
+    """
     import rclpy
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
+    from wirefish_common.batch_intake import BatchIntake
+    from wirefish_common.joint_state_cdr import read_joint_state
+    from wirefish_common.servo_joints import servo_sample
+
+    def read_message(msg) -> None:
+        servo_sample(msg)
+
+    def read_bytes(data) -> None:
+        servo_sample(read_joint_state(data))
 
     rclpy.init()
     node = rclpy.create_node('cost_subscriber')
-    if kind != 'none':
+    if kind in ('msg', 'raw'):
         node.create_subscription(JointState, PROBE_TOPIC, lambda _m: None,
                                  qos_profile_sensor_data, raw=kind == 'raw')
+    elif kind == 'msg+read':
+        node.create_subscription(JointState, PROBE_TOPIC, read_message, qos_profile_sensor_data)
+    elif kind == 'raw+read':
+        node.create_subscription(JointState, PROBE_TOPIC, read_bytes, qos_profile_sensor_data,
+                                 raw=True)
+    elif kind == 'msg+tick':
+        node.create_subscription(JointState, PROBE_TOPIC, read_message, qos_profile_sensor_data)
+        node.create_timer(1.0 / TICK_HZ, lambda: None)
+    elif kind == 'batch+tick':
+        intake = BatchIntake(node, JointState, PROBE_TOPIC, _batch_qos())
+
+        def take_batch() -> None:
+            for data in intake.take():
+                read_bytes(data)
+        node.create_timer(1.0 / TICK_HZ, take_batch)
     _spin(node)
+
+
+def _batch_qos():
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    # Four ticks' worth of samples at the probe's rate: a late tick loses none.
+    return QoSProfile(depth=16, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 
 def _timer(rate_hz: float) -> None:
@@ -98,8 +137,8 @@ def _measure(roles: list[tuple[str, str]], window_s: float, domain_id: int) -> l
             p.wait()
 
 
-def run(window_s: float = 8.0, domain_id: int = 93) -> dict:
-    """Measure every probe; return CPU per process and per event (us)."""
+def run(window_s: float = 8.0, domain_id: int = 93, only: str = '') -> dict:
+    """Measure every probe (``only``: those whose name holds it); return CPU and us/event."""
     rate = str(RATE_HZ)
     probes = {
         'idle node': [('subscriber', 'none')],
@@ -109,9 +148,16 @@ def run(window_s: float = 8.0, domain_id: int = 93) -> dict:
         'publisher at 200 Hz, one raw reader': [('publisher', rate), ('subscriber', 'raw')],
         'publisher at 200 Hz, two readers': [('publisher', rate), ('subscriber', 'msg'),
                                              ('subscriber', 'msg')],
+        'servo pair read from each message': [('publisher', rate), ('subscriber', 'msg+read')],
+        'servo pair read from the raw bytes': [('publisher', rate), ('subscriber', 'raw+read')],
+        'a callback per message and a 50 Hz tick': [('publisher', rate),
+                                                    ('subscriber', 'msg+tick')],
+        'a 50 Hz tick taking a batch': [('publisher', rate), ('subscriber', 'batch+tick')],
     }
     results = {}
     for name, roles in probes.items():
+        if only not in name:
+            continue
         cpu = _measure(roles, window_s, domain_id)
         results[name] = {'cpu_percent': [round(c, 2) for c in cpu],
                          'us_per_event': [round(c / 100.0 / RATE_HZ * 1e6) for c in cpu]}
@@ -123,11 +169,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--role', nargs=2, metavar=('ROLE', 'ARG'), help=argparse.SUPPRESS)
     parser.add_argument('--window', type=float, default=8.0, help='seconds measured per probe')
+    parser.add_argument('--only', default='', help='run the probes whose name holds this text')
     args = parser.parse_args(argv)
     if args.role:
         ROLES[args.role[0]](args.role[1])
         return 0
-    print(json.dumps(run(args.window), indent=1))
+    print(json.dumps(run(args.window, only=args.only), indent=1))
     return 0
 
 

@@ -59,6 +59,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
                                        SerialLink)
 from wirefish_common.frames import declare_frame_prefix, prefixed
+from wirefish_common.joint_state_cdr import CdrError, read_joint_state
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
@@ -98,8 +99,9 @@ class BridgeNode(Node):
         self._battery_pub = self.create_publisher(BatteryState, 'battery',
                                                   SENSOR_DATA)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
+        # Raw: the pair is read from the bytes (joint_state_cdr), no Python message is built.
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
-                                 SENSOR_DATA)
+                                 SENSOR_DATA, raw=True)
         self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
         self.add_on_set_parameters_callback(self._validate)
@@ -238,8 +240,11 @@ class BridgeNode(Node):
             self._battery_pub.publish(battery_message(
                 telemetry, stamp, low_battery, prefixed(self._frame_prefix, 'base_link')))
 
-    def _on_servo_cmd(self, msg: JointState) -> None:
-        angles = servo_angles(msg)
+    def _on_servo_cmd(self, data: bytes) -> None:
+        try:
+            angles = servo_angles(read_joint_state(data))
+        except CdrError as error:
+            angles = JointProblem('bytes', str(error))
         if isinstance(angles, JointProblem):
             self.get_logger().warn(f'servo_cmd ignored: {angles.message}',
                                    throttle_duration_sec=2.0)
