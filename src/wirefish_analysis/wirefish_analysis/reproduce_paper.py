@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 from wirefish_common.plotting import legend_beside
+from wirefish_common.progress import end_line, Progress
 from wirefish_cpg.oscillator import CpgParameters, NetworkArrays, simulate
 from wirefish_cpg.pso import PsoOptions
 from wirefish_cpg.tuning import fit_gait, FitResult
@@ -134,11 +135,25 @@ def table1_summary(problem: WaveFitProblem) -> dict:
 
 
 def run(out_dir: Path, seed: int = 0,
-        options: PsoOptions = PsoOptions(max_iterations=DEFAULT_ITERATIONS)) -> dict:
-    """Fit the section 5.2 case in both modes, write the figures into ``out_dir``."""
+        options: PsoOptions = PsoOptions(max_iterations=DEFAULT_ITERATIONS),
+        progress: Progress | None = None) -> dict:
+    """
+    Fit the section 5.2 case in both modes, write the figures into ``out_dir``.
+
+    ``progress`` (``len(FIT_MODES) * (max_iterations + 1)`` steps) is told after every PSO
+    iteration of each fit.
+    """
     problem = WaveFitProblem()
-    fits = {mode: fit_gait(problem, np.random.default_rng(seed), options, mode=mode)
-            for mode in FIT_MODES}
+    fits = {}
+    for index, mode in enumerate(FIT_MODES):
+        first = index * (options.max_iterations + 1)
+
+        def step(iteration: int, loss: float, _best, first: int = first, mode: str = mode):
+            if progress is not None:
+                progress.step(first + iteration + 1, f'{mode} fit: loss {loss:.4g}')
+
+        fits[mode] = fit_gait(problem, np.random.default_rng(seed), options, mode=mode,
+                              callback=step)
     summary: dict[str, Any] = {
         'wave': {'c1': 0.15, 'c2': 1.0, 'k': 8.0, 'frequency_hz': 1.0},
         'window_s': [problem.window_start_s, problem.window_end_s],
@@ -285,11 +300,19 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--out', type=Path, default=Path('out/paper'), help='output dir')
     parser.add_argument('--seed', type=int, default=0, help='PSO seed')
-    parser.add_argument('--swarm', type=int, default=PsoOptions.swarm_size)
-    parser.add_argument('--iterations', type=int, default=DEFAULT_ITERATIONS)
+    parser.add_argument('--swarm', type=int, default=PsoOptions.swarm_size,
+                        help='PSO particles of each fit')
+    parser.add_argument('--iterations', type=int, default=DEFAULT_ITERATIONS,
+                        help='PSO iterations of each fit (at most)')
     args = parser.parse_args(argv)
-    s = run(args.out, args.seed, PsoOptions(swarm_size=args.swarm,
-                                            max_iterations=args.iterations))
+    options = PsoOptions(swarm_size=args.swarm, max_iterations=args.iterations)
+    progress = Progress('reproduce_paper', len(FIT_MODES) * (options.max_iterations + 1))
+    try:
+        s = run(args.out, args.seed, options, progress)
+    except KeyboardInterrupt:
+        end_line()
+        print('reproduce_paper: interrupted (Ctrl-C)', file=sys.stderr)
+        return 130
     print(report(s))
     print(f'figures: {args.out}/fig6a.png fig6b.png fig7a.png fig7bc.png summary.json')
     met = all(all(a <= b for a, b in zip(m['rmse_theta_deg']['axial'], PAPER_RMSE_DEG))
