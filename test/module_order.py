@@ -23,6 +23,7 @@ LONGEST_MODULES = (
     'test/bringup/test_loaded_recording.py',
     'test/view/test_dashboard_browser.py',
     'test/view/test_view_protocol.py',
+    'test/bringup/test_topic_param_commands.py',
 )
 
 
