@@ -72,7 +72,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='where run logs, bags and reports go (default: ./out)')
     parser.add_argument('--single-process', action='store_true',
                         help="run the fish's ROS nodes in one process (wirefish compose)")
-    parser.add_argument('--no-status', action='store_true', help='skip the topic-rate table')
+    parser.add_argument('--no-status', action='store_true',
+                        help='no status (topic rates, link, battery, planner mode; on a '
+                        'terminal kept up to date while the graph runs)')
     parser.add_argument('--view', action='store_true',
                         help='also the live view: Foxglove WebSocket server and dashboard '
                         '(wirefish view; view_node parameters port, http_port)')
