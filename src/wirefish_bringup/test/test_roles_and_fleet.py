@@ -23,7 +23,8 @@ def _option(spec, name: str) -> str:
 
 def test_the_fish_role_holds_what_keeps_the_fish_swimming_and_the_relay():
     assert _names(fish_graph('/w', role=FISH)) == [
-        'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'planner_node', 'link_relay']
+        'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'tf_node', 'planner_node',
+        'link_relay']
 
 
 def test_the_shore_role_holds_the_tuner_and_the_recorder_of_the_shore_copies():
@@ -46,7 +47,7 @@ def test_an_unknown_role_is_refused_naming_the_choices():
 def test_a_frame_prefix_goes_to_every_node_that_writes_frames_and_only_those():
     specs = {s.name: s for s in fish_graph('/w', frame_prefix='fish_7')}
     given = {name for name, s in specs.items() if 'frame_prefix:=fish_7' in s.command_arguments()}
-    assert given == {'fish_sim', 'bridge_node', 'kinematics_node'}
+    assert given == {'fish_sim', 'bridge_node', 'kinematics_node', 'tf_node'}
 
 
 def test_no_frame_prefix_passes_no_parameter():
