@@ -225,10 +225,11 @@ class Tap:
         except OSError:
             pass   # the pty's buffer is full: nobody reads the host side (the bridge is dead)
 
-    def inject(self, data: bytes) -> None:
-        """Write ``data`` to the board between two frames of the bridge."""
+    def inject(self, data: bytes) -> int:
+        """Write ``data`` to the board between two frames; return its last frame end's index."""
         with self._lock:
             self._forward(data)
+            return self.zeros_forwarded - 1
 
     def close(self) -> None:
         self._stop.set()
