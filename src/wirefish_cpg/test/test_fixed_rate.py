@@ -1,10 +1,12 @@
 """FixedRateLoop: calls at a fixed rate on its own thread, skips (never bursts) when late."""
 
+import os
+import sys
 import threading
 import time
 
 import pytest
-from wirefish_cpg.fixed_rate import FixedRateLoop
+from wirefish_cpg.fixed_rate import FixedRateLoop, GIL_SWITCH_INTERVAL_S
 
 
 def test_tick_is_called_repeatedly_until_stop_and_never_after():
@@ -57,3 +59,26 @@ def test_stop_from_inside_the_tick_does_not_deadlock():
 def test_a_non_positive_period_is_rejected(period):
     with pytest.raises(ValueError):
         FixedRateLoop(period, lambda: None, name='t')
+
+
+def test_the_loop_thread_runs_with_the_scheduling_it_reports():
+    seen = []
+    loop = FixedRateLoop(0.005, lambda: seen.append(os.sched_getscheduler(0)), name='t')
+    loop.start()
+    deadline = time.monotonic() + 30.0
+    while not seen and time.monotonic() < deadline:
+        time.sleep(0.01)
+    loop.stop()
+    expected = os.SCHED_FIFO if loop.scheduling.startswith('SCHED_FIFO') else os.SCHED_OTHER
+    assert seen and seen[0] == expected, loop.scheduling
+    assert os.sched_getscheduler(0) == os.SCHED_OTHER  # the caller's thread is left alone
+
+
+def test_the_loop_bounds_how_long_another_thread_keeps_the_gil():
+    loop = FixedRateLoop(0.005, lambda: None, name='t')
+    loop.start()
+    deadline = time.monotonic() + 30.0
+    while loop.scheduling == 'not started' and time.monotonic() < deadline:
+        time.sleep(0.01)
+    loop.stop()
+    assert sys.getswitchinterval() <= GIL_SWITCH_INTERVAL_S
