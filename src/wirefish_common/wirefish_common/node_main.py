@@ -19,10 +19,7 @@ The one ``main()`` of every wirefish node: signals, rclpy, the node, its executo
 from __future__ import annotations
 
 from collections.abc import Callable
-import faulthandler
-import os
-import sys
-from typing import NoReturn, TypeVar
+from typing import TypeVar
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
@@ -30,11 +27,9 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from wirefish_common.executors import executor_kind, make_executor, spin_until_stopped
 from wirefish_common.parameter_table import InvalidParameters
-from wirefish_common.shutdown import ignore_stop_signals, SignalShutdown
+from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
 
 NodeT = TypeVar('NodeT', bound=Node)
-# The longest a node's teardown (destroy_node, executor, context) may take after its spin ends.
-TEARDOWN_S = 2.0
 
 
 def create_node_or_exit(node_class: Callable[[], NodeT]) -> NodeT:
@@ -79,11 +74,7 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         pass
     finally:
         signals.attach_executor(None)
-        # A DDS teardown that never returns (seen once in 41 stops of a loaded graph: tf_node's
-        # main thread in rclpy's EventHandler.__exit__ under destroy_node, held until the
-        # launcher's SIGKILL) ends the process after TEARDOWN_S with its threads' stacks and
-        # exit code 1: faulthandler's own C thread needs no GIL, which that call may hold.
-        faulthandler.dump_traceback_later(TEARDOWN_S, exit=True)
+        bound_teardown()
         # The node's own threads (serial reader, publish loop) are joined by destroy_node
         # before the executor goes: a task they hand over meets a live executor.
         executor.remove_node(node)
@@ -92,25 +83,3 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         rclpy.try_shutdown()
     exit_now(0)
 
-
-def exit_now(code: int) -> NoReturn:
-    """
-    End the process with ``code`` now, once everything it owns is stopped and destroyed.
-
-    What is left after a node's clean stop is the interpreter's finalisation: module teardown
-    and a full garbage collection of every object rclpy, numpy and the node made. On a loaded
-    machine that was most of a stop (perf: ``gc_collect_main``; at load 60-90 every node of a
-    graph was still finalising when `ros2 launch` killed it ~13 s after Ctrl-C), and Python
-    ignores SIGTERM from atexit on. Late signals are ignored, Python's logging handlers and
-    stdout/stderr are flushed (rclpy's log file is closed by ``try_shutdown``), then
-    ``os._exit``.
-    """
-    ignore_stop_signals()
-    if 'logging' in sys.modules:
-        sys.modules['logging'].shutdown()
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):  # a closed or broken pipe: nothing left to say there
-            pass
-    os._exit(code)

@@ -38,15 +38,34 @@ from __future__ import annotations
 
 import atexit
 import faulthandler
+import os
 import signal
 import socket
+import sys
 import threading
-from typing import Any
+from typing import Any, NoReturn
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # Under the 6 s `wirefish up` gives a graph of 6 processes to stop; a stop takes < 2 s on the
 # loaded 2-core reference machine (load average 10).
 STOP_STACKS_AFTER_S = 4.0
+# The longest a process's teardown (destroy_node, executor, context) may take once its loop has
+# stopped: under the launcher's deadline (1 s per process, at least 5 s), over what a teardown
+# took at load 100 (8 graphs at once on 2 cores: some took more than 2 s and then finished).
+TEARDOWN_S = 4.0
+
+
+def bound_teardown(seconds: float = TEARDOWN_S) -> None:
+    """
+    End the process with its threads' stacks and exit code 1 if it is still here ``seconds`` on.
+
+    For the teardown after a process's loop has stopped. A DDS teardown that never returns
+    (seen once in 41 stops of a loaded graph: tf_node's main thread in rclpy's
+    ``EventHandler.__exit__`` under ``destroy_node``, held until the launcher's SIGKILL) may
+    hold the GIL, so no Python thread could end it: faulthandler's own C thread can. A process
+    that finishes in time leaves through ``exit_now``, which ends the timer with the process.
+    """
+    faulthandler.dump_traceback_later(seconds, exit=True)
 
 
 def ignore_stop_signals() -> None:
@@ -122,3 +141,26 @@ class SignalShutdown:
             guard.trigger()
         except InvalidHandle:  # the node is being destroyed: its stop is already under way
             pass
+
+
+def exit_now(code: int) -> NoReturn:
+    """
+    End the process with ``code`` now, once everything it owns is stopped and destroyed.
+
+    What is left after a node's clean stop is the interpreter's finalisation: module teardown
+    and a full garbage collection of every object rclpy, numpy and the node made. On a loaded
+    machine that was most of a stop (perf: ``gc_collect_main``; at load 60-90 every node of a
+    graph was still finalising when `ros2 launch` killed it ~13 s after Ctrl-C), and Python
+    ignores SIGTERM from atexit on. Late signals are ignored, Python's logging handlers and
+    stdout/stderr are flushed (rclpy's log file is closed by its ``try_shutdown``), then
+    ``os._exit``.
+    """
+    ignore_stop_signals()
+    if 'logging' in sys.modules:
+        sys.modules['logging'].shutdown()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed or broken pipe: nothing left to say there
+            pass
+    os._exit(code)

@@ -34,12 +34,13 @@ import math
 from pathlib import Path
 import sys
 import time
+from typing import NoReturn
 
 import numpy as np
 
 from wirefish_common.frames import frame_prefix_problem
 from wirefish_common.parameter_table import InvalidParameters
-from wirefish_common.shutdown import SignalShutdown
+from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.servo_model import ServoParameters
@@ -274,6 +275,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
             next_tick = max(next_tick + tick_s, now)
             time.sleep(max(0.0, next_tick - time.monotonic()))
     finally:
+        bound_teardown()  # closing the devices and the ROS side must not hang the stop
         for link in links:
             link.device.close()
             link.device.remove_link()
@@ -297,8 +299,8 @@ def _reopen(link: _FishLink, closing: int | None) -> None:
               flush=True)
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point: split off --ros-args, parse the flags, run."""
+def main(argv: list[str] | None = None) -> NoReturn:
+    """Entry point: split off --ros-args, parse the flags, run; exit with its code."""
     argv = list(sys.argv if argv is None else argv)
     ros_args = argv
     try:
@@ -311,7 +313,7 @@ def main(argv: list[str] | None = None) -> int:
     problem = flags_problem(args)
     if problem is not None:
         parser.error(problem)  # one line and exit code 2, before a device is opened
-    return run(args, ros_args)
+    exit_now(run(args, ros_args))  # no interpreter finalisation on the way out
 
 
 def flags_problem(args: argparse.Namespace) -> str | None:
