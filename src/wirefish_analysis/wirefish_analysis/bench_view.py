@@ -6,7 +6,8 @@ client (the view idle: it subscribes to nothing), and a 10 s window with Debian'
 chromium on the dashboard (Selenium), which subscribes to the dashboard's topics, servo_cmd
 among them. In each window: the view_node process's CPU, the rest of the graph's, the
 browser's (chromium and its children), and the rates of servo_cmd and imu/data as a separate
-ROS subscriber receives them (header stamps in the window). ``python -m
+ROS subscriber receives them (header stamps in the window); a third window without the
+browser again says how much the machine's own noise moves them. ``python -m
 wirefish_analysis.bench_view`` prints the JSON.
 """
 
@@ -151,7 +152,12 @@ def run(domain_id: int) -> dict[str, Any]:
         browser = psutil.Process(driver.service.process.pid).children(recursive=True)
         with_browser = _window(node, executor, {'view_node': view, 'graph': rest,
                                                 'browser': browser})
-        return {'idle': idle, 'one_browser': with_browser, 'window_s': WINDOW_S}
+        driver.quit()
+        driver = None
+        # The same again without the browser: how much of a change is the machine's own noise.
+        after = _window(node, executor, {'view_node': view, 'graph': rest})
+        return {'idle': idle, 'one_browser': with_browser, 'after': after,
+                'window_s': WINDOW_S, 'load_average': os.getloadavg()}
     finally:
         if driver is not None:
             driver.quit()
@@ -187,11 +193,15 @@ def row(result: dict) -> tuple[str, str, str, str, str]:
 
     def rates(w: dict) -> str:
         return ', '.join(f'{t} {hz:.1f} Hz' for t, hz in w['rates_hz'].items())
+    after = result.get('after')
     measured = (f'view_node {one["cpu_percent"]["view_node"]:.1f} % of a core with the browser '
                 f'({idle["cpu_percent"]["view_node"]:.1f} % idle); the rest of the graph '
                 f'{one["cpu_percent"]["graph"]:.1f} % ({idle["cpu_percent"]["graph"]:.1f} %); '
                 f'chromium {one["cpu_percent"]["browser"]:.1f} %; {rates(one)} '
-                f'(without a client: {rates(idle)})')
+                f'(without a client before: {rates(idle)}'
+                + (f'; after: {rates(after)}' if after else '') + ')'
+                + (f'; load average {result["load_average"][0]:.1f}'
+                   if 'load_average' in result else ''))
     met = all(one['rates_hz'][t] >= 0.95 * idle['rates_hz'][t] for t in STREAMS)
     return (figure, goal, measured, 'met' if met else 'missed',
             f'wirefish up --sim --view, {result["window_s"]:g} s windows after '
