@@ -90,9 +90,16 @@ def one_round(graphs: int, domain: int, out: Path) -> dict:
         left = [p.pid for p in watched if not _gone(p)]
         return {'processes': len(watched), 'slowest_s': max(stopped_at.values(), default=0.0),
                 'launcher_codes': codes, 'reported': reported, 'left': left, 'said': said}
-    finally:
+    finally:  # a round that failed: the launchers stop their own processes, or all are killed
         for launcher in launchers:
             if launcher.poll() is None:
+                launcher.send_signal(signal.SIGINT)
+        for launcher in launchers:
+            try:
+                launcher.wait(timeout=WATCH_S)
+            except subprocess.TimeoutExpired:
+                for proc in psutil.Process(launcher.pid).children(recursive=True):
+                    proc.kill()
                 launcher.kill()
                 launcher.wait()
             launcher.stdout.close()
