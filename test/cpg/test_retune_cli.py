@@ -29,7 +29,8 @@ def test_retune_prints_the_fit_and_a_line_per_iteration(tuner, python, ros_env):
     # Not a terminal: plain lines from the action's feedback, one per iteration.
     lines = [line for line in result.stderr.splitlines() if line.startswith('iteration ')]
     assert lines[0].startswith('iteration 0/20 best loss ') and 'RMSE theta' in lines[0]
-    assert lines[-1].startswith('iteration 20/20 ')
+    assert lines[-1].startswith('iteration 20/20 ') and lines[-1].endswith(' s')  # 'done in'
+    assert any(line.endswith(' left') for line in lines[1:-1])  # the estimate of what is left
     assert len(lines) == 21
 
 

@@ -15,6 +15,7 @@ import time
 
 from wirefish_bringup.goal_sender import GoalSender
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+from wirefish_common.progress import estimate_text
 
 BAR_WIDTH = 30
 UINT32_MAX = 2**32 - 1
@@ -51,18 +52,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='seconds to wait for the answer')
 
 
-def progress_line(iteration: int, best_loss: float, total: int) -> str:
-    """Return a one-line text progress bar for one feedback message."""
+def progress_line(iteration: int, best_loss: float, total: int, estimate: str = '') -> str:
+    """Return a one-line text progress bar for one feedback message (and the time left)."""
     fraction = min(max(iteration / total, 0.0), 1.0) if total > 0 else 0.0
     filled = int(round(fraction * BAR_WIDTH))
     return (f'[{"#" * filled}{"." * (BAR_WIDTH - filled)}] '
-            f'iteration {iteration}/{total}  best loss {best_loss:.4f}')
+            f'iteration {iteration}/{total}  best loss {best_loss:.4f}'
+            + (f'  {estimate}' if estimate else ''))
 
 
-def feedback_line(iteration: int, best_loss: float, total: int, rmse) -> str:
+def feedback_line(iteration: int, best_loss: float, total: int, rmse,
+                  estimate: str = '') -> str:
     """Return one plain line for one feedback message (when stderr is not a terminal)."""
     return (f'iteration {iteration}/{total} best loss {best_loss:.6g} m*s RMSE theta '
-            f'{rmse[0]:.3f}/{rmse[1]:.3f} deg')
+            f'{rmse[0]:.3f}/{rmse[1]:.3f} deg' + (f', {estimate}' if estimate else ''))
 
 
 def result_table(result) -> str:
@@ -125,17 +128,23 @@ def run(args: argparse.Namespace) -> int:
     terminal = sys.stderr.isatty()
     drawn = [False]
     last_iteration = [-1]
+    first: list[tuple[float, int]] = []  # (when, iteration) of the first feedback
 
     def on_feedback(message) -> None:
         f = message.feedback
         last_iteration[0] = f.iteration
+        if not first:
+            first.append((time.monotonic(), f.iteration))
+        # The PSO may stop early (stalled): the estimate is for all its iterations.
+        estimate = estimate_text(f.iteration - first[0][1], f.max_iterations - first[0][1],
+                                 time.monotonic() - first[0][0])
         if terminal:
-            print('\r' + progress_line(f.iteration, f.best_loss, f.max_iterations), end='',
-                  file=sys.stderr, flush=True)
+            print('\r' + progress_line(f.iteration, f.best_loss, f.max_iterations, estimate),
+                  end='', file=sys.stderr, flush=True)
             drawn[0] = True
         else:
-            print(feedback_line(f.iteration, f.best_loss, f.max_iterations, f.rmse_theta_deg),
-                  file=sys.stderr, flush=True)
+            print(feedback_line(f.iteration, f.best_loss, f.max_iterations, f.rmse_theta_deg,
+                                estimate), file=sys.stderr, flush=True)
 
     def spin_until(done, deadline: float) -> bool:
         while not done() and time.monotonic() < deadline:
