@@ -43,6 +43,8 @@ def test_the_status_counts_streams_shows_latched_state_and_hides_action_topics(r
         assert float(rows[f'{NAMESPACE}/stream'].split()[-2]) > 0.0, rows
         assert live.header() == ('link: no /diagnostics yet | battery: no battery yet | '
                                  'planner: no planner_state yet')
+        live.close()
+        assert live.lines()[2:] == [] and not list(watcher.subscriptions)
     finally:
         watcher.destroy_node()
         publisher_node.destroy_node()

@@ -319,6 +319,8 @@ def _run(args: argparse.Namespace) -> int:
             raise RuntimeError(status)
         # On a terminal the status is redrawn in place while the graph runs; else shown once.
         live = live_views[0] if live_views and sys.stdout.isatty() else None
+        if live is None and live_views:
+            live_views[0].close()  # shown once: no more samples to keep
         block = TerminalBlock(sys.stdout) if live is not None else None
         if status and block is None:
             print(status)

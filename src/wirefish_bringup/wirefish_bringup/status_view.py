@@ -140,6 +140,12 @@ class LiveStatus:
             watched.received += count
             watched.window.add(now, count)
 
+    def close(self) -> None:
+        """Destroy the subscriptions (the middleware stops keeping their samples)."""
+        for watched in self._watched.values():
+            self._node.destroy_subscription(watched.subscription)
+        self._watched.clear()
+
     def _last(self, topic: str):
         watched = self._watched.get(topic)
         return watched.last if watched is not None else None
