@@ -109,7 +109,7 @@ def run_all(quick: bool = False) -> dict:
     results: dict = {'machine': machine()}
     results['cpg_rate'] = [_run(f'cpg at {r} Hz ({e})', bench_graph.cpg_rate, r, 10.0 * scale,
                                 DOMAIN, e)
-                           for r in (200.0, 500.0, 1000.0) for e in EXECUTORS]
+                           for r in (100.0, 200.0, 500.0, 1000.0) for e in EXECUTORS]
     try:
         from wirefish_analysis import bench_links
         results['links_by_executor'] = {
@@ -142,6 +142,9 @@ def run_all(quick: bool = False) -> dict:
     results['recorder_cpu'] = _run('recorder CPU, old and new', bench_recorder.run, DOMAIN)
     from wirefish_analysis import bench_view  # the view server with one browser connected
     results['view_cpu'] = _run('view server with one browser', bench_view.run, DOMAIN)
+    from wirefish_analysis import bench_old_new  # CPG timing, virtual fish, intakes: old vs new
+    results['old_new'] = _run('old vs new: CPG timing, virtual fish, servo intakes',
+                              bench_old_new.run, domain_id=DOMAIN)
     results['fleet'] = []
     for mode in ('per-node', 'single'):
         one = _run(f'1 fish ({mode}, both executors, {ONE_FISH_REPEATS} alternated runs)',
