@@ -158,7 +158,7 @@ def rows(result: dict) -> list[tuple[str, str, str, str, str]]:
         f'bench_graph.cpg_rate, 10 s each, old and new alternated; old = src/wirefish_cpg at '
         f'{CPG_COMMIT} from git (bench_old_new.py); medians')]
     table.append((
-        f'Virtual fish of a {sim["fish"]}-fish fleet, CPU (% of a core): {sim["fish"]} old '
+        f'Virtual fish of a fleet of {sim["fish"]}, CPU (% of a core): {sim["fish"]} old '
         'fish_sim processes vs one new fish_sim of all', '— (a fleet run measures the stack)',
         f'old {sim["old_cpu_percent"]:.1f} %, new {sim["new_cpu_percent"]:.1f} % (ratio '
         f'{sim["ratio"]:.2f})', '—',
