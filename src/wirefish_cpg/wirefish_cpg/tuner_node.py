@@ -9,7 +9,10 @@ swing-angle RMSE <= ``max_rmse_deg``); a refused wave or fit answers ``success: 
 the reason and the figures and is never applied. With ``apply: true`` the fitted parameters are
 set on the CPG node through its standard ``<cpg_node_name>/set_parameters_atomically`` service
 (the same change as ``ros2 param set``), and success is reported only after the CPG node
-accepted them. Offsets are not touched (the fit assumes b = 0).
+accepted them. Offsets are not touched (the fit assumes b = 0). An applied fit is the CPG's
+manual override (``wirefish_cpg.cpg_control``): the planner stands aside until
+``cpg_node/follow_commands``. The tuner keeps this atomic parameter set rather than the
+planner's control topic: a fit is a one-off configuration change that must be confirmed.
 
 Service: every request is answered, however many arrive at once: the service keeps up to 1000
 requests (``SERVICE_QOS``), answers are paced 20 ms apart so that no client's answer is pushed
