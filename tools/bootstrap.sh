@@ -60,6 +60,23 @@ if [ ${#arm_missing[@]} -gt 0 ]; then
   fi
 fi
 
+# --- the dashboard's real-browser test and benchmark (test/view, bench_view): Debian's chromium
+# and its driver, driven by Selenium. As the ARM toolchain: apt as root, else one line.
+browser_missing=()
+command -v chromium >/dev/null 2>&1 || browser_missing+=(chromium)
+command -v chromedriver >/dev/null 2>&1 || browser_missing+=(chromium-driver)
+if [ ${#browser_missing[@]} -gt 0 ]; then
+  apt_install=(apt-get install -y --no-install-recommends -o DPkg::Lock::Timeout=300)
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    log "installing ${browser_missing[*]} (the dashboard's browser test)"
+    { "${apt_install[@]}" "${browser_missing[@]}" >/dev/null 2>&1 \
+      || { apt-get update >/dev/null 2>&1 && "${apt_install[@]}" "${browser_missing[@]}" >/dev/null 2>&1; }; } \
+      || log "apt-get could not install ${browser_missing[*]}: the dashboard's browser test will fail until it is installed"
+  else
+    log "the dashboard's browser test needs: apt-get install ${browser_missing[*]} (as root; not needed to run wirefish)"
+  fi
+fi
+
 # --- virtual environment -------------------------------------------------------------------
 req_files=(requirements/python.txt)
 [ "$MODE" = wheels ] && req_files+=(requirements/ros-jazzy.txt requirements/constraints.txt)
