@@ -36,13 +36,14 @@ def test_the_status_counts_streams_shows_latched_state_and_hides_action_topics(r
                 hidden.publish(String(data='x'))
             time.sleep(0.05)
             live.refresh()
-        rows = {line.split()[0]: line for line in live.lines()[2:]}
+        # /diagnostics is watched too, whoever publishes it on this domain: not counted here.
+        rows = {line.split()[0]: line for line in live.lines()[2:]
+                if line.startswith(f'{NAMESPACE}/')}
         assert set(rows) == {f'{NAMESPACE}/stream', f'{NAMESPACE}/state'}, rows
         assert rows[f'{NAMESPACE}/state'].endswith('latched'), rows
         assert rows[f'{NAMESPACE}/stream'].endswith(' Hz'), rows
         assert float(rows[f'{NAMESPACE}/stream'].split()[-2]) > 0.0, rows
-        assert live.header() == ('link: no /diagnostics yet | battery: no battery yet | '
-                                 'planner: no planner_state yet')
+        assert live.header().endswith('| battery: no battery yet | planner: no planner_state yet')
         live.close()
         assert live.lines()[2:] == [] and not list(watcher.subscriptions)
     finally:

@@ -42,7 +42,7 @@ def test_the_link_is_the_bridges_serial_link_status():
                 _status('/w/bridge_node: serial link /tmp/tty', 2, 'no heartbeat for 2.0 s')]
     assert link_text(statuses) == 'ERROR: no heartbeat for 2.0 s'
     assert link_text([_status('/w/bridge_node: serial link /tmp/tty', 0, 'ok')]) == 'OK'
-    assert link_text(statuses[:1]) == 'no /diagnostics yet'
+    assert link_text(statuses[:1]) == 'no serial link diagnostics yet'
 
 
 def test_the_battery_shows_what_it_knows():

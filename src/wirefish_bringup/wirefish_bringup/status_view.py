@@ -65,7 +65,7 @@ def link_text(statuses) -> str:
         if 'serial link' in status.name:
             level = DIAGNOSTIC_LEVELS.get(_level(status.level), str(status.level))
             return level if level == 'OK' else f'{level}: {status.message}'
-    return 'no /diagnostics yet'
+    return 'no serial link diagnostics yet'
 
 
 def _level(value) -> int:
@@ -88,6 +88,7 @@ class _Watched:
     window: RateWindow
     received: int = 0
     last: object = None
+    primed: bool = False  # the first take holds the backlog since subscribing: not a rate
 
 
 class LiveStatus:
@@ -97,6 +98,7 @@ class LiveStatus:
         """Subscribe to what runs now (``refresh`` subscribes to topics that appear later)."""
         self._node, self._namespace, self._clock = node, namespace.rstrip('/'), clock
         self._watched: dict[str, _Watched] = {}
+        self._diagnostics: dict[str, Any] = {}  # the last status of each name seen
         self._scan()
 
     def _scan(self) -> None:
@@ -137,8 +139,11 @@ class LiveStatus:
                 count += 1
                 if not raw:
                     watched.last = got[0]
+                if topic == '/diagnostics':
+                    self._diagnostics.update((s.name, s) for s in got[0].status)
             watched.received += count
-            watched.window.add(now, count)
+            watched.window.add(now, count if watched.primed else 0)
+            watched.primed = True
 
     def close(self) -> None:
         """Destroy the subscriptions (the middleware stops keeping their samples)."""
@@ -152,10 +157,12 @@ class LiveStatus:
 
     def header(self) -> str:
         """Return the line of the link, the battery and the planner's mode."""
-        diagnostics = self._last('/diagnostics')
         battery = self._last(f'{self._namespace}/battery')
         planner = self._last(f'{self._namespace}/planner_state')
-        return (f'link: {link_text(diagnostics.status) if diagnostics else "no /diagnostics yet"}'
+        # /diagnostics is shared by every graph of the domain: this namespace's statuses only.
+        ours = [s for name, s in self._diagnostics.items()
+                if name.startswith(f'{self._namespace}/')]
+        return (f'link: {link_text(ours)}'
                 f' | battery: {battery_text(battery) if battery else "no battery yet"}'
                 f' | planner: {planner.mode if planner else "no planner_state yet"}')
 
