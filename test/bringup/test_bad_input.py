@@ -88,3 +88,12 @@ def test_drive_without_a_graph_says_which_graph_it_waits_for(spawn, tmp_path):
     finally:
         os.close(master)
         os.close(slave)
+
+
+def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
+    proc = subprocess.Popen([*CLI, 'gaits', 'list', '--library', str(tmp_path / 'gaits.yaml')],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()  # the reader left before anything was written (`| head -0`)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 1 and 'Traceback' not in stderr and 'BrokenPipe' not in stderr, (
+        stderr)

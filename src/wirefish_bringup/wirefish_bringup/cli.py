@@ -8,6 +8,7 @@ beside the standard tools it stands in for on pip-only machines.
 import argparse
 import importlib
 import math
+import os
 import sys
 
 # subcommand -> (module, one-line help); modules are imported only when their command runs,
@@ -99,6 +100,11 @@ def main(argv: list[str] | None = None) -> int:
         end_line()
         print(f'wirefish {args.command}: interrupted (Ctrl-C)', file=sys.stderr)
         return INTERRUPTED
+    except BrokenPipeError:
+        # Piped into a reader that left (`wirefish topic echo ... | head`): end quietly, as
+        # the shell's own tools do; stdout goes nowhere so the exit flush cannot fail again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
 
 
 if __name__ == '__main__':
