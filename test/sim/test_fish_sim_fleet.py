@@ -5,7 +5,9 @@ Each fish is driven over its own pty with pyserial (its own servo command) and m
 there with its own servos; with --ros each publishes its own sim/ground_truth under its name.
 """
 
+import os
 from pathlib import Path
+import select
 import time
 
 from ament_index_python.packages import get_package_prefix
@@ -111,3 +113,30 @@ def test_a_fleet_of_bad_flags_ends_with_one_line_and_exit_2(spawn, tmp_path, fla
     out, _ = proc.communicate(timeout=30)
     assert proc.returncode == 2 and says in out, out
     assert not any(tmp_path.iterdir())  # no device link was made
+
+
+def test_each_fish_of_a_fleet_reopens_its_own_device_and_answers_there(spawn, tmp_path):
+    links = [tmp_path / f'tty_{name}' for name in NAMES[:2]]
+    proc = spawn([str(BIN / 'fish_sim'), *(a for link in links for a in ('--link', str(link))),
+                  '--reopen-every', '1.0', '--reopen-count', '1', '--reopen-delay', '0.3'])
+    _wait_for_links(proc, links)
+    output, deadline = b'', time.monotonic() + 20.0
+    fd = proc.stdout.fileno()  # unbuffered reads: select sees every byte not yet read
+    while output.count(b': reopened as ') < len(links):  # each fish says so on stderr
+        remaining = deadline - time.monotonic()
+        assert remaining > 0 and select.select([fd], [], [], remaining)[0], output
+        output += os.read(fd, 4096)
+    reopened = {line.split(':')[0] for line in output.decode().splitlines()
+                if ': reopened as ' in line}
+    assert reopened == {f'fish_sim {name}' for name in NAMES[:2]}
+    assert all(link.is_symlink() for link in links)
+    assert len({link.resolve() for link in links}) == len(links)
+    ports = [serial.Serial(str(link), 115200, timeout=0) for link in links]
+    try:
+        commands = [(0.2, 0.1), (-0.3, 0.4)]
+        for k, received in enumerate(_drive(ports, commands, 1.0)):
+            assert (received[-1].servo_1, received[-1].servo_2) == pytest.approx(
+                commands[k], abs=1e-3)
+    finally:
+        for port in ports:
+            port.close()
