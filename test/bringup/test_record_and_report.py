@@ -32,6 +32,9 @@ def test_recorded_bag_holds_every_published_message(tmp_path, spawn, python, ros
     assert f'{len(counters)}' in result.stdout
     # The recorder's own account agrees: no number missing from the talker's DDS sequence.
     assert "missing from the publishers' sequences: 0" in result.stdout, result.stdout
+    # Its progress, off a terminal: a line now and then, with the time left, then 'done'.
+    progress = [line for line in result.stderr.splitlines() if line.startswith('record bag: ')]
+    assert progress and progress[-1].startswith('record bag: 3/3, done in'), result.stderr
 
 
 def test_report_writes_summary_from_a_bag(tmp_path, spawn, python, ros_env):

@@ -2,12 +2,14 @@
 
 import argparse
 from datetime import datetime
+import math
 from pathlib import Path
 import sys
 
 from wirefish_bringup.cli import duration_s
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 from wirefish_bringup.sequence_gaps import loss_line, recording_account, TopicAccount
+from wirefish_common.progress import Progress
 
 NOTHING_TIMEOUT_S = 30.0
 
@@ -59,17 +61,26 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish record: {error}', file=sys.stderr)
         return 2
     started_ns = time.time_ns()
+    progress = (Progress(f'record {bag_path.name}', math.ceil(args.duration))
+                if args.duration is not None else None)
 
     def stopped() -> bool:
         if signals.requested:
             return True
-        if args.duration is None:
+        if args.duration is None or progress is None:
             return False
         now, first = time.time_ns(), recorder.first_message_ns
+        recorded_s = 0 if first is None else int((now - first) * 1e-9)
+        if recorded_s > progress.done:  # counted from the first message, as the duration is
+            progress.step(min(recorded_s, progress.total), f'{recorder_count()} messages')
         # Discovery can take a few seconds on a loaded machine: the duration counts from
         # the first message, with a bound for a graph that never publishes anything.
         return (first is not None and now - first >= args.duration * 1e9) or \
             now - started_ns >= (args.duration + NOTHING_TIMEOUT_S) * 1e9
+
+    def recorder_count() -> int:
+        return sum(account.count for account in recorder.accounts.values())
+
     try:
         recorder.record(stopped)
     finally:
