@@ -97,3 +97,26 @@ def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
     _, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 1 and 'Traceback' not in stderr and 'BrokenPipe' not in stderr, (
         stderr)
+
+
+@pytest.mark.ros
+def test_a_mission_interrupted_before_its_first_leg_exits_130_and_leaves_nothing(
+        tmp_path, ros_env):
+    import signal
+
+    proc = subprocess.Popen([*CLI, 'mission', 'square', '--namespace', '/no_graph_here',
+                             '--wait', '60'], cwd=tmp_path, env=ros_env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        assert 'waiting for planner_state' in proc.stderr.readline()  # after HINT_AFTER_S
+        os.killpg(proc.pid, signal.SIGINT)
+        _, stderr = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130, stderr
+    assert stderr.strip() == ('wirefish mission: interrupted (Ctrl-C) before the first leg; '
+                              'nothing was written')
+    assert list(tmp_path.iterdir()) == []
