@@ -6,10 +6,12 @@ The page is that of a running `wirefish up --sim --view`.
 One graph and one browser for the module. The claims: the plots update (values read back from
 the page); a drive key raises planner_state's target speed; a retune from the form shows its
 progress and applies; the stop button brings cmd_vel to zero and the fish to rest. The retune
-test saves the screenshot the README shows (docs/dashboard.png).
+test saves its screenshot to out/dashboard.png; with WIREFISH_UPDATE_DOCS=1 it also replaces
+docs/dashboard.png, the picture the README shows (a plain run leaves the tree clean).
 """
 
 import math
+import os
 from pathlib import Path
 import shutil
 import time
@@ -29,7 +31,9 @@ from wirefish_msgs.msg import CpgParams, PlannerState
 pytestmark = pytest.mark.ros
 
 CHROMIUM, CHROMEDRIVER = shutil.which('chromium'), shutil.which('chromedriver')
-SCREENSHOT = Path(__file__).resolve().parents[2] / 'docs' / 'dashboard.png'
+ROOT = Path(__file__).resolve().parents[2]
+SCREENSHOT = ROOT / 'out' / 'dashboard.png'
+DOCS_SCREENSHOT = ROOT / 'docs' / 'dashboard.png'
 REST_RAD = 0.05  # servo commands within this of neutral: the fish at rest
 
 
@@ -128,7 +132,9 @@ def test_a_retune_from_the_form_shows_progress_and_applies(browser, probe):
     assert 'done' in browser.find_element(By.ID, 'v-retune').text
     assert _live(browser, "document.getElementById('retune-progress').value") > 0
     SCREENSHOT.parent.mkdir(exist_ok=True)
-    browser.save_screenshot(str(SCREENSHOT))
+    assert browser.save_screenshot(str(SCREENSHOT))
+    if os.environ.get('WIREFISH_UPDATE_DOCS') == '1':
+        shutil.copyfile(SCREENSHOT, DOCS_SCREENSHOT)
 
 
 def test_the_stop_button_zeroes_cmd_vel_and_rests_the_fish(browser, probe):
