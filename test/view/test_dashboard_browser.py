@@ -5,7 +5,8 @@ The page is that of a running `wirefish up --sim --view`.
 
 One graph and one browser for the module. The claims: the plots update (values read back from
 the page); a drive key raises planner_state's target speed; a retune from the form shows its
-progress and applies; the stop button brings cmd_vel to zero and the fish to rest. The retune
+progress and applies, and the page then offers the hand-back that gives the drive keys their
+effect again; the stop button brings cmd_vel to zero and the fish to rest. The retune
 test saves its screenshot to out/dashboard.png; with WIREFISH_UPDATE_DOCS=1 it also replaces
 docs/dashboard.png, the picture the README shows (a plain run leaves the tree clean).
 """
@@ -135,6 +136,17 @@ def test_a_retune_from_the_form_shows_progress_and_applies(browser, probe):
     assert browser.save_screenshot(str(SCREENSHOT))
     if os.environ.get('WIREFISH_UPDATE_DOCS') == '1':
         shutil.copyfile(SCREENSHOT, DOCS_SCREENSHOT)
+
+
+def test_after_an_applied_retune_the_page_hands_the_gait_back_to_the_planner(browser, probe):
+    heard, executor = probe
+    assert spin_until(executor, lambda: bool(heard['planner_state']) and (
+        heard['planner_state'][-1].mode == 'manual'), timeout_s=20.0)
+    assert _wait_page(browser, "!document.getElementById('hand-back').hidden", 10.0)
+    browser.find_element(By.ID, 'hand-back').click()
+    assert spin_until(executor, lambda: heard['planner_state'][-1].mode != 'manual',
+                      timeout_s=20.0)
+    assert _wait_page(browser, "document.getElementById('hand-back').hidden", 10.0)
 
 
 def test_the_stop_button_zeroes_cmd_vel_and_rests_the_fish(browser, probe):

@@ -16,7 +16,9 @@ Client publish
     limits or malformed, is refused: a warning in the log and a status message to the clients.
 Services (JSON)
     ``start``, ``stop`` (std_srvs/Trigger of cpg_node; stop also sends cmd_vel zero first, so
-    the planner rests the fish), ``retune_gait`` (sends the tuner's action goal; its progress
+    the planner rests the fish), ``follow_commands`` (cpg_node's: hands the gait back to the
+    planner after a manual override such as an applied retune, as `wirefish hand-back` does),
+    ``retune_gait`` (sends the tuner's action goal; its progress
     and result go out on ``view/retune``).
 The dashboard
     ``http://address:http_port/``: the bundled page (``share/wirefish_view/dashboard``, built by
@@ -148,6 +150,7 @@ class ViewNode(Node):
         self._cmd_pub = self.create_publisher(Twist, 'cmd_vel', RELIABLE)
         self._start_client = self.create_client(Trigger, 'start')
         self._stop_client = self.create_client(Trigger, 'stop')
+        self._follow_client = self.create_client(Trigger, 'cpg_node/follow_commands')
         self._retune = ActionClient(self, RetuneGait, 'retune_gait')
         self._retune_busy = threading.Event()
         self._start_servers()
@@ -172,6 +175,7 @@ class ViewNode(Node):
                                    data=RETUNE_PROGRESS_SCHEMA))
         services = [self._service('start', self._start_client),
                     self._service('stop', self._stop_client),
+                    self._service('follow_commands', self._follow_client),
                     foxglove.Service(f'{self._namespace}/retune_gait', schema=_json_schema(
                         'wirefish_msgs/action/RetuneGait'), handler=self._on_retune)]
         self._server = foxglove.start_server(

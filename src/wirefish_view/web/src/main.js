@@ -140,6 +140,9 @@ function onMessage(topic, m) {
       live.latest.planner_state = { mode: m.mode, target_speed: m.target_speed,
         predicted_speed: m.predicted_speed, note: m.note };
       $('v-mode').textContent = m.mode;
+      // A manual override (an applied retune, a parameter set) leaves the drive keys without
+      // effect until the gait is handed back: offer that where the keys are.
+      $('hand-back').hidden = m.mode !== 'manual';
       $('v-target-speed').textContent = fixed(m.target_speed);
       $('v-predicted-speed').textContent = fixed(m.predicted_speed);
       $('v-note').textContent = m.note || m.clamp_reason || '';
@@ -277,6 +280,10 @@ function wireControls() {
   $('start').addEventListener('click', () => {
     stopped = false;
     callService('start', {}).then((r) => { $('v-drive-status').textContent = r.message; });
+  });
+  $('hand-back').addEventListener('click', () => {
+    callService('follow_commands', {}).then((r) => { $('v-drive-status').textContent = r.message; })
+      .catch((err) => { $('v-drive-status').textContent = String(err); });
   });
   $('retune-form').addEventListener('submit', (e) => {
     e.preventDefault();
