@@ -9,62 +9,60 @@ answer before its executor takes it: 20 requests at once left 6-10 unanswered, 5
 once 29 (measured; with 3 s between discovery and the burst, or with clients keeping 1000
 answers, none is lost). The server cannot deepen its clients' queues (`ros2 service call` uses
 the default), so it paces its answers instead: at most one per ``ANSWER_INTERVAL_S``. A client
-then has 10 intervals (200 ms) to take its answer before 10 others could push it out, and a
-burst of N requests is answered within N intervals (50: 1 s) plus the one fit.
+then has 10 intervals (200 ms) to take its answer before 10 others could push it out.
 
-A second way to lose an answer: rmw_fastrtps sends it only once the server has matched the
-client's response reader, waiting at most 100 ms, and otherwise drops it with only a
-``RuntimeWarning: failed to send response (timeout)``. A server that has just (re)started
-meets clients it has not discovered yet (a respawned tuner, a client that found the old one).
-Such an answer is retried every ``RETRY_S`` for at most ``RETRY_FOR_S``.
+The pacing is done in the callback, through rclpy's public API only: the executor sends what a
+callback returns right after it returns, so a callback that returns no sooner than
+``interval_s`` after the previous one returned spaces the answers. The work itself (a fit) runs
+outside the pacing lock; only the wait for the next slot is serialised, and it holds an
+executor thread at most ``interval_s`` per answer queued ahead of it.
+
+An answer can also be dropped when the server has not matched the client's response reader yet
+(a server that has just started, a client just created): the workspace's Fast DDS profile
+(wirefish_bringup config/fastdds.xml) makes the reply writer wait for that match instead.
 """
 
 from __future__ import annotations
 
 import threading
 import time
-import warnings
-
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-from rclpy.service import Service
+from typing import Callable, TypeVar
 
 ANSWER_INTERVAL_S = 0.02
-RETRY_S = 0.05
-RETRY_FOR_S = 10.0
-# Only sends made from this module raise instead of warning: the filter matches the module a
-# warning is attributed to, the caller of the C extension, i.e. this one.
-warnings.filterwarnings('error', message='failed to send response', category=RuntimeWarning,
-                        module=__name__)
+
+Request = TypeVar('Request')
+Response = TypeVar('Response')
 
 
-def pace_answers(service: Service, interval_s: float = ANSWER_INTERVAL_S) -> Service:
-    """Make ``service`` send at most one answer per ``interval_s``; return the service."""
-    lock = threading.Lock()
+class AnswerPacer:
+    """Hands out answer slots at least ``interval_s`` apart (clock and sleep are passed in)."""
 
-    def send(response, header) -> None:
-        request_id = (header.request_id if isinstance(header, _rclpy.rmw_service_info_t)
-                      else header)
-        deadline = time.monotonic() + RETRY_FOR_S
-        while True:
-            try:
-                with service.handle:
-                    service.handle.service_send_response(response, request_id)
-                return
-            except RuntimeWarning:  # the client is not matched yet: retry, then give up
-                if time.monotonic() >= deadline:
-                    return
-                time.sleep(RETRY_S)
+    def __init__(self, interval_s: float = ANSWER_INTERVAL_S,
+                 clock: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        """Start with the first slot free."""
+        self.interval_s = interval_s
+        self._clock = clock
+        self._sleep = sleep
+        self._lock = threading.Lock()
+        self._next = float('-inf')
 
-    next_send = [0.0]
-
-    def paced_send_response(response, header) -> None:
-        with lock:  # the executor's threads answer one after the other, interval_s apart
-            delay = next_send[0] - time.monotonic()
+    def wait_for_slot(self) -> None:
+        """Return once this answer may go out: ``interval_s`` after the previous one."""
+        with self._lock:
+            delay = self._next - self._clock()
             if delay > 0.0:
-                time.sleep(delay)
-            send(response, header)
-            next_send[0] = time.monotonic() + interval_s
+                self._sleep(delay)
+            self._next = self._clock() + self.interval_s
 
-    # The executor sends through this attribute: the instance's own shadows the method.
-    service.send_response = paced_send_response  # type: ignore[method-assign]
-    return service
+
+def paced(callback: Callable[[Request, Response], Response],
+          pacer: AnswerPacer | None = None) -> Callable[[Request, Response], Response]:
+    """Return a service callback that answers as ``callback`` does, its answers paced."""
+    slots = AnswerPacer() if pacer is None else pacer
+
+    def answer(request: Request, response: Response) -> Response:
+        result = callback(request, response)
+        slots.wait_for_slot()
+        return result
+    return answer

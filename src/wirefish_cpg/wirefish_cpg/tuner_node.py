@@ -46,7 +46,7 @@ from rclpy.parameter import Parameter
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
 from wirefish_common.qos import LATCHED, reliable
-from wirefish_cpg.answered_service import pace_answers
+from wirefish_cpg.answered_service import paced
 from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.feasibility import FitLimits
 from wirefish_cpg.gait_library import default_library_path, Gait, GaitLibrary, LibraryFile
@@ -146,9 +146,8 @@ class TunerNode(Node):
         self._client_group = MutuallyExclusiveCallbackGroup()
         self._param_clients: dict[str, object] = {}
         serving = ReentrantCallbackGroup()
-        pace_answers(self.create_service(
-            RetuneGait, 'retune_gait', self._on_retune, qos_profile=SERVICE_QOS,
-            callback_group=serving))
+        self.create_service(RetuneGait, 'retune_gait', paced(self._on_retune),
+                            qos_profile=SERVICE_QOS, callback_group=serving)
         self._action = ActionServer(
             self, RetuneGaitAction, 'retune_gait', execute_callback=self._execute_goal,
             goal_callback=self._on_goal, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
