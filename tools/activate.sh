@@ -34,4 +34,7 @@ case ":$PATH:" in
   *":$_wf_root/install/wirefish_bringup/lib/wirefish_bringup:"*) ;;
   *) export PATH="$_wf_root/install/wirefish_bringup/lib/wirefish_bringup:$PATH" ;;
 esac
+# The Fast DDS profile of the graph (reply writers wait for a new client's reader; see
+# config/fastdds.xml); a value already set, even empty (no profile), is kept.
+export FASTRTPS_DEFAULT_PROFILES_FILE="${FASTRTPS_DEFAULT_PROFILES_FILE-$_wf_root/install/wirefish_bringup/share/wirefish_bringup/config/fastdds.xml}"
 unset _wf_root _wf_venv _wf_nounset

@@ -30,6 +30,7 @@ class Recorded:
 
     nodes: list[dict] = field(default_factory=list)
     arguments: dict[str, str] = field(default_factory=dict)
+    environment: dict[str, object] = field(default_factory=dict)
 
 
 class _Context:
@@ -69,6 +70,14 @@ def _stand_ins(recorded: Recorded) -> dict[str, types.ModuleType]:
         def perform(self, context):
             return context.launch_configurations[self.name]
 
+    class SetEnvironmentVariable:
+        def __init__(self, name, value):
+            recorded.environment[name] = value
+
+    class EnvironmentVariable:
+        def __init__(self, name, default_value=''):
+            self.name, self.default_value = name, default_value
+
     def node(**kwargs):
         recorded.nodes.append(kwargs)
         return kwargs
@@ -77,6 +86,8 @@ def _stand_ins(recorded: Recorded) -> dict[str, types.ModuleType]:
     actions.DeclareLaunchArgument = DeclareLaunchArgument
     actions.OpaqueFunction = OpaqueFunction
     actions.Shutdown = Shutdown
+    actions.SetEnvironmentVariable = SetEnvironmentVariable
+    substitutions.EnvironmentVariable = EnvironmentVariable
     substitutions.LaunchConfiguration = LaunchConfiguration
     ros_actions.Node = node
     launch.actions, launch.substitutions, launch_ros.actions = actions, substitutions, ros_actions
@@ -84,9 +95,10 @@ def _stand_ins(recorded: Recorded) -> dict[str, types.ModuleType]:
             'launch_ros': launch_ros, 'launch_ros.actions': ros_actions}
 
 
-def launched_nodes(monkeypatch, **overrides: str) -> list[dict]:
+def launched_nodes(monkeypatch, recorded: Recorded | None = None, **overrides: str
+                   ) -> list[dict]:
     """Return the Node(...) keyword arguments of `ros2 launch ... key:=value ...`."""
-    recorded = Recorded()
+    recorded = Recorded() if recorded is None else recorded
     for name, module in _stand_ins(recorded).items():
         monkeypatch.setitem(sys.modules, name, module)
     spec = importlib.util.spec_from_file_location('wirefish_launch_under_test', LAUNCH_FILE)
@@ -155,3 +167,12 @@ def test_a_string_where_a_bool_is_declared_is_found():
 def test_a_parameter_no_node_declares_is_found():
     node = {'name': 'cpg_node', 'parameters': [{'no_such_parameter': 1.0}]}
     assert type_problems(node) == ['cpg_node: no_such_parameter is not declared']
+
+
+def test_the_launch_gives_its_nodes_the_fast_dds_profile_unless_one_is_set(monkeypatch):
+    recorded = Recorded()
+    launched_nodes(monkeypatch, recorded)
+    value = recorded.environment['FASTRTPS_DEFAULT_PROFILES_FILE']
+    assert value.name == 'FASTRTPS_DEFAULT_PROFILES_FILE'  # the user's own value wins
+    assert Path(value.default_value).name == 'fastdds.xml'
+    assert Path(value.default_value).is_file()

@@ -13,9 +13,11 @@ uses. launch has no back-off: a node is respawned after its policy's first delay
 """
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
-from launch.substitutions import LaunchConfiguration
+from launch.actions import (DeclareLaunchArgument, OpaqueFunction, SetEnvironmentVariable,
+                            Shutdown)
+from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
+from wirefish_bringup.dds_profile import profile_path, PROFILES_VARIABLE
 from wirefish_bringup.graph import ALL, DEFAULT_NAMESPACE, fish_graph, ROLES
 
 
@@ -56,6 +58,10 @@ def _nodes(context):
 
 def generate_launch_description():
     return LaunchDescription([
+        # The reply writers' wait for a new client (config/fastdds.xml); a profile file the
+        # user set is kept.
+        SetEnvironmentVariable(PROFILES_VARIABLE, EnvironmentVariable(
+            PROFILES_VARIABLE, default_value=str(profile_path()))),
         DeclareLaunchArgument('sim', default_value='true',
                               description='drive the virtual fish (fish_sim) on a pty'),
         DeclareLaunchArgument('port', default_value='',

@@ -18,6 +18,7 @@ import sys
 import time
 
 from wirefish_bringup.cli import duration_s
+from wirefish_bringup.dds_profile import with_profile
 from wirefish_bringup.errors import QemuBoardError
 from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
                                     validate_namespace)
@@ -271,7 +272,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
-    supervisor = Supervisor(run_dir / 'logs')
+    supervisor = Supervisor(run_dir / 'logs', env=with_profile(os.environ))
     stop_requested = []
 
     def request_stop(signum, _frame) -> None:
