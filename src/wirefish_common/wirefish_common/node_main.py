@@ -82,4 +82,3 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         executor.shutdown()
         rclpy.try_shutdown()
     exit_now(0)
-
