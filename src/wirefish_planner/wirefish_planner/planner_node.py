@@ -184,7 +184,8 @@ class PlannerNode(Node):
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.targets = CpgParams(
             frequency_hz=sent['frequency_hz'],
-            amplitude=[sent['amplitude_1'], sent['amplitude_2']], offset=[sent['offset_1'], sent['offset_2']], w12=sent['w12'], w21=sent['w21'],
+            amplitude=[sent['amplitude_1'], sent['amplitude_2']],
+            offset=[sent['offset_1'], sent['offset_2']], w12=sent['w12'], w21=sent['w21'],
             phi12=sent['phi12'], phi21=sent['phi21'], alpha=sent['alpha'])
         self._command_pub.publish(msg)
 
