@@ -1,0 +1,40 @@
+"""
+Fresh clients against restarted servers with the workspace's Fast DDS profile: every call answered.
+
+The reduced form of ``tools/reply_probe.py`` (which also runs a second graph for load and shows
+the loss without the profile): a new participant, node and client per call, wait_for_service,
+one request, no retry, the server restarted before every tenth call.
+"""
+
+import importlib.util
+from pathlib import Path
+import sys
+
+import pytest
+
+PROBE = Path(__file__).resolve().parents[2] / 'tools' / 'reply_probe.py'
+
+
+def _probe():
+    spec = importlib.util.spec_from_file_location('reply_probe', PROBE)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize('server, call', [('tuner_node', 'tuner_call'),
+                                          ('cpg_node', 'cpg_call')])
+def test_fresh_clients_of_a_restarted_server_are_all_answered(ros_env, monkeypatch, tmp_path,
+                                                              server, call):
+    probe = _probe()
+    for name in ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE'):
+        monkeypatch.setenv(name, ros_env[name])  # the probe's clients, as its servers
+    env = probe.server_environment(profile=True, domain=int(ros_env['ROS_DOMAIN_ID']))
+    batch = probe.Batch(calls=20, restart_every=10, deadline_s=10.0, find_s=30.0)
+    with open(tmp_path / 'server.log', 'w') as log:
+        tally = probe.run_batch(probe.server_command(server), getattr(probe, call), batch,
+                                env, log)
+    assert tally.no_service == 0
+    assert tally.unanswered == 0
+    assert tally.answered == 20

@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""
+Count the service answers fresh clients never get, the way the standard tools make them.
+
+Every call is a new DDS participant (its own rclpy context), node and client, then
+``wait_for_service``, one request and no retry: what ``ros2 service call`` and
+``ros2 param set`` do. A call not answered within ``--deadline`` s is counted unanswered.
+The server is the graph's own executable (tuner_node: ``retune_gait``; cpg_node:
+``set_parameters``), started by the probe in the namespace the Fast DDS profile names and
+restarted before every ``--restart-every``-th call (a server that has just started meets
+clients it has not discovered yet: where rmw_fastrtps drops answers). A second graph
+(``wirefish up`` in ``/load``) loads the machine unless ``--no-load``.
+
+    tools/wfenv python tools/reply_probe.py --profile off --calls 100
+    tools/wfenv python tools/reply_probe.py --profile on --calls 100
+
+``--profile on`` gives the servers the workspace's Fast DDS profile (config/fastdds.xml:
+reply writers wait for the client's reader); ``off`` gives them none.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+NAMESPACE = '/wirefish'
+LOAD_NAMESPACE = '/load'
+PROFILE = Path(__file__).resolve().parent.parent / 'src' / 'wirefish_bringup' / 'config' / \
+    'fastdds.xml'
+STOP_TIMEOUT_S = 10.0
+
+
+@dataclass
+class Tally:
+    """What the calls of one batch got."""
+
+    answered: int = 0
+    unanswered: int = 0
+    no_service: int = 0
+    seconds: list[float] = field(default_factory=list)
+
+    def line(self, label: str) -> str:
+        """Return the batch's summary line."""
+        calls = self.answered + self.unanswered + self.no_service
+        slowest = max(self.seconds, default=float('nan'))
+        return (f'{label}: {calls} calls, answered {self.answered}, unanswered '
+                f'{self.unanswered}, service never found {self.no_service}; '
+                f'slowest answer {slowest:.2f} s')
+
+
+def server_environment(profile: bool, domain: int) -> dict[str, str]:
+    """Return the environment of the probe's servers and load graph (profile on or off)."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), PYTHONUNBUFFERED='1')
+    # An empty value: no profile file (Fast DDS then looks only for its default file in cwd).
+    env['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(PROFILE) if profile else ''
+    return env
+
+
+def executable(package: str, name: str) -> str:
+    """Return the installed executable of a node (as ``ros2 run`` finds it)."""
+    from ament_index_python.packages import get_package_prefix
+    return str(Path(get_package_prefix(package), 'lib', package, name))
+
+
+def server_command(name: str) -> list[str]:
+    """Return the command of one of the graph's servers (wirefish_cpg) in ``NAMESPACE``."""
+    return [executable('wirefish_cpg', name), '--ros-args', '-r', f'__ns:={NAMESPACE}']
+
+
+def start(command: list[str], env: dict[str, str], log) -> subprocess.Popen:
+    """Start one child in its own session (stopped by its pid only)."""
+    return subprocess.Popen(command, env=env, stdin=subprocess.DEVNULL, stdout=log,
+                            stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def stop(proc: subprocess.Popen) -> None:
+    """SIGINT the child, SIGKILL it if it outlives ``STOP_TIMEOUT_S``; reap it."""
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(STOP_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def tuner_call():
+    """Return (service type, name, request) of a small retune order (answered either way)."""
+    from wirefish_msgs.msg import BodyWaveSpec
+    from wirefish_msgs.srv import RetuneGait
+    request = RetuneGait.Request(seed=1, max_iterations=2, swarm_size=8, apply=False)
+    request.wave = BodyWaveSpec(c1=0.15, c2=1.0, k=8.0, frequency_hz=1.0)
+    return RetuneGait, f'{NAMESPACE}/retune_gait', request
+
+
+def cpg_call():
+    """Return (service type, name, request) of a set_parameters call that changes nothing."""
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    request = SetParameters.Request(
+        parameters=[Parameter('use_sim_time', Parameter.Type.BOOL, False).to_parameter_msg()])
+    return SetParameters, f'{NAMESPACE}/cpg_node/set_parameters', request
+
+
+def fresh_call(kind, name: str, request, deadline_s: float, find_s: float):
+    """Make one call as the standard tools do; return its round trip (s), False or None."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        node = rclpy.create_node('reply_probe', context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        client = node.create_client(kind, name)
+        if not client.wait_for_service(timeout_sec=find_s):
+            return None
+        sent = time.monotonic()
+        future = client.call_async(request)
+        executor.spin_until_future_complete(future, timeout_sec=deadline_s)
+        result = time.monotonic() - sent if future.done() else False
+        executor.shutdown()
+        node.destroy_node()
+        return result
+    finally:
+        context.try_shutdown()
+
+
+@dataclass(frozen=True)
+class Batch:
+    """How many calls, how often the server restarts, how long a call may take."""
+
+    calls: int = 200
+    restart_every: int = 10
+    deadline_s: float = 10.0
+    find_s: float = 30.0
+
+
+def run_batch(server: list[str], call, batch: Batch, env: dict[str, str], log) -> Tally:
+    """Run ``batch.calls`` fresh calls, restarting the server before every n-th."""
+    tally = Tally()
+    proc = None
+    try:
+        for index in range(batch.calls):
+            if index % batch.restart_every == 0:
+                if proc is not None:
+                    stop(proc)
+                proc = start(server, env, log)
+            kind, name, request = call()
+            outcome = fresh_call(kind, name, request, batch.deadline_s, batch.find_s)
+            if outcome is None:
+                tally.no_service += 1
+            elif outcome is False:
+                tally.unanswered += 1
+                print(f'  call {index} unanswered', flush=True)
+            else:
+                tally.answered += 1
+                tally.seconds.append(outcome)
+    finally:
+        if proc is not None:
+            stop(proc)
+    return tally
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the batches the options ask for; print one summary line each."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--profile', choices=('on', 'off'), required=True)
+    parser.add_argument('--calls', type=int, default=200, help='calls per service')
+    parser.add_argument('--restart-every', type=int, default=10)
+    parser.add_argument('--deadline', type=float, default=10.0,
+                        help='an answer later than this (s) counts as unanswered')
+    parser.add_argument('--find-timeout', type=float, default=30.0,
+                        help='wait_for_service timeout (s)')
+    parser.add_argument('--services', default='tuner,cpg', help='tuner, cpg or both')
+    parser.add_argument('--domain', type=int, default=77)
+    parser.add_argument('--no-load', action='store_true', help='no second graph')
+    args = parser.parse_args(argv)
+    os.environ['ROS_DOMAIN_ID'] = str(args.domain)
+    env = server_environment(args.profile == 'on', args.domain)
+    servers = {'tuner': (server_command('tuner_node'), tuner_call),
+               'cpg': (server_command('cpg_node'), cpg_call)}
+    with tempfile.TemporaryDirectory(prefix='reply_probe_') as out, \
+            open(Path(out, 'servers.log'), 'w') as log:
+        load = None
+        if not args.no_load:
+            load = start(['wirefish', 'up', '--no-status', '--allow-duplicate', '--namespace',
+                          LOAD_NAMESPACE, '--out', out], env, log)
+            time.sleep(5.0)  # its six processes starting are part of the load
+        try:
+            for label in args.services.split(','):
+                command, call = servers[label]
+                batch = Batch(args.calls, args.restart_every, args.deadline, args.find_timeout)
+                tally = run_batch(command, call, batch, env, log)
+                print(tally.line(f'{label} profile {args.profile}'), flush=True)
+        finally:
+            if load is not None:
+                stop(load)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
