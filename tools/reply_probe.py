@@ -9,7 +9,7 @@ The server is the graph's own executable (tuner_node: ``retune_gait``; cpg_node:
 ``set_parameters``), started by the probe in the namespace the Fast DDS profile names and
 restarted before every ``--restart-every``-th call (a server that has just started meets
 clients it has not discovered yet: where rmw_fastrtps drops answers). A second graph
-(``wirefish up`` in ``/load``) loads the machine unless ``--no-load``.
+(``wirefish up`` in ``/load_0``) loads the machine (``--load-graphs``: how many).
 
     tools/wfenv python tools/reply_probe.py --profile off --calls 100
     tools/wfenv python tools/reply_probe.py --profile on --calls 100
@@ -182,19 +182,26 @@ def main(argv: list[str] | None = None) -> int:
                         help='wait_for_service timeout (s)')
     parser.add_argument('--services', default='tuner,cpg', help='tuner, cpg or both')
     parser.add_argument('--domain', type=int, default=77)
-    parser.add_argument('--no-load', action='store_true', help='no second graph')
+    parser.add_argument('--out', help='keep the servers\' log here (default: a scratch dir)')
+    parser.add_argument('--load-graphs', type=int, default=1,
+                        help='graphs running beside the servers (0: none)')
     args = parser.parse_args(argv)
     os.environ['ROS_DOMAIN_ID'] = str(args.domain)
     env = server_environment(args.profile == 'on', args.domain)
     servers = {'tuner': (server_command('tuner_node'), tuner_call),
                'cpg': (server_command('cpg_node'), cpg_call)}
-    with tempfile.TemporaryDirectory(prefix='reply_probe_') as out, \
-            open(Path(out, 'servers.log'), 'w') as log:
-        load = None
-        if not args.no_load:
-            load = start(['wirefish', 'up', '--no-status', '--allow-duplicate', '--namespace',
-                          LOAD_NAMESPACE, '--out', out], env, log)
-            time.sleep(5.0)  # its six processes starting are part of the load
+    with tempfile.TemporaryDirectory(prefix='reply_probe_') as scratch:
+        out = args.out or scratch
+        Path(out).mkdir(parents=True, exist_ok=True)
+        return _run(args, env, servers, out)
+
+
+def _run(args, env: dict[str, str], servers, out: str) -> int:
+    with open(Path(out, 'servers.log'), 'w') as log:
+        loads = [start(['wirefish', 'up', '--no-status', '--allow-duplicate', '--namespace',
+                        f'{LOAD_NAMESPACE}_{index}', '--out', out], env, log)
+                 for index in range(args.load_graphs)]
+        time.sleep(5.0 if loads else 0.0)  # their processes starting are part of the load
         try:
             for label in args.services.split(','):
                 command, call = servers[label]
@@ -202,8 +209,12 @@ def main(argv: list[str] | None = None) -> int:
                 tally = run_batch(command, call, batch, env, log)
                 print(tally.line(f'{label} profile {args.profile}'), flush=True)
         finally:
-            if load is not None:
+            for load in loads:
                 stop(load)
+    # What rclpy says when rmw_fastrtps drops an answer (the servers' own stderr).
+    dropped = Path(out, 'servers.log').read_text(errors='replace').count(
+        'failed to send response')
+    print(f'servers said "failed to send response" {dropped} times (log: {out})')
     return 0
 
 
