@@ -182,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
                         help='wait_for_service timeout (s)')
     parser.add_argument('--services', default='tuner,cpg', help='tuner, cpg or both')
     parser.add_argument('--domain', type=int, default=77)
-    parser.add_argument('--out', help='keep the servers\' log here (default: a scratch dir)')
+    parser.add_argument('--out', help="keep the servers' log here (default: a scratch dir)")
     parser.add_argument('--load-graphs', type=int, default=1,
                         help='graphs running beside the servers (0: none)')
     args = parser.parse_args(argv)
