@@ -180,8 +180,8 @@ def test_a_second_request_while_one_runs_is_refused_as_busy(spawn, tuner, probe)
 
 # One client's own queue keeps 10 requests (rclpy's default service QoS): more at once are
 # lost inside that client before they are sent, which no server can answer.
-# Seen failing once under a loaded full run (2026-12-01 closing note), passing alone: one rerun
-# so a shared machine does not sink CI; a real regression fails both runs.
+# Seen failing once under a loaded full run and passing alone: one rerun so a shared machine
+# does not sink CI while the race is open; a real regression fails both runs.
 @pytest.mark.flaky(reruns=1)
 @pytest.mark.parametrize('clients, requests_each', [(50, 1), (1, 10)])
 def test_a_burst_of_requests_is_answered_every_one(spawn, tuner, probe, clients, requests_each):
