@@ -37,4 +37,7 @@ esac
 # The Fast DDS profile of the graph (reply writers wait for a new client's reader; see
 # config/fastdds.xml); a value already set, even empty (no profile), is kept.
 export FASTRTPS_DEFAULT_PROFILES_FILE="${FASTRTPS_DEFAULT_PROFILES_FILE-$_wf_root/install/wirefish_bringup/share/wirefish_bringup/config/fastdds.xml}"
+# No shared-memory transport: a SIGKILLed subscriber would stall its publishers for up to 1 s
+# (wirefish_bringup.dds_profile); a value already set is kept.
+export FASTDDS_BUILTIN_TRANSPORTS="${FASTDDS_BUILTIN_TRANSPORTS-UDPv4}"
 unset _wf_root _wf_venv _wf_nounset

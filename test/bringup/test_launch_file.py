@@ -176,3 +176,11 @@ def test_the_launch_gives_its_nodes_the_fast_dds_profile_unless_one_is_set(monke
     assert value.name == 'FASTRTPS_DEFAULT_PROFILES_FILE'  # the user's own value wins
     assert Path(value.default_value).name == 'fastdds.xml'
     assert Path(value.default_value).is_file()
+
+
+def test_the_launch_leaves_shared_memory_out_unless_the_user_set_the_transports(monkeypatch):
+    recorded = Recorded()
+    launched_nodes(monkeypatch, recorded)
+    value = recorded.environment['FASTDDS_BUILTIN_TRANSPORTS']
+    assert value.name == 'FASTDDS_BUILTIN_TRANSPORTS'  # the user's own value wins
+    assert value.default_value == 'UDPv4'

@@ -17,7 +17,8 @@ from launch.actions import (DeclareLaunchArgument, OpaqueFunction, SetEnvironmen
                             Shutdown)
 from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
-from wirefish_bringup.dds_profile import profile_path, PROFILES_VARIABLE
+from wirefish_bringup.dds_profile import (profile_path, PROFILES_VARIABLE, TRANSPORTS,
+                                          TRANSPORTS_VARIABLE)
 from wirefish_bringup.graph import ALL, DEFAULT_NAMESPACE, fish_graph, ROLES
 
 
@@ -62,6 +63,9 @@ def generate_launch_description():
         # user set is kept.
         SetEnvironmentVariable(PROFILES_VARIABLE, EnvironmentVariable(
             PROFILES_VARIABLE, default_value=str(profile_path()))),
+        # No shared memory: a killed subscriber would stall its publishers (dds_profile).
+        SetEnvironmentVariable(TRANSPORTS_VARIABLE, EnvironmentVariable(
+            TRANSPORTS_VARIABLE, default_value=TRANSPORTS)),
         DeclareLaunchArgument('sim', default_value='true',
                               description='drive the virtual fish (fish_sim) on a pty'),
         DeclareLaunchArgument('port', default_value='',
