@@ -3,14 +3,18 @@ Fresh clients against restarted servers with the workspace's Fast DDS profile: e
 
 The reduced form of ``tools/reply_probe.py`` (which also runs a second graph for load and shows
 the loss without the profile): a new participant, node and client per call, wait_for_service,
-one request, no retry, the server restarted before every tenth call.
+one request, no retry, the server restarted before every tenth call. And every reply writer the
+profile names is one of a service the servers offer (a misspelt name would wait for nothing).
 """
 
 import importlib.util
 from pathlib import Path
 import sys
 
+from cpg_probe import CPG_NODE, TUNER_NODE
 import pytest
+from ros_utils import spin_until
+from wirefish_bringup.dds_profile import reply_writer_names
 
 PROBE = Path(__file__).resolve().parents[2] / 'tools' / 'reply_probe.py'
 
@@ -38,3 +42,15 @@ def test_fresh_clients_of_a_restarted_server_are_all_answered(ros_env, monkeypat
     assert tally.no_service == 0
     assert tally.unanswered == 0
     assert tally.answered == 20
+
+
+def test_every_reply_writer_of_the_profile_names_a_service_the_servers_offer(spawn, probe):
+    for node in (CPG_NODE, TUNER_NODE):
+        spawn([node, '--ros-args', '-r', '__ns:=/profile_check'])
+    wanted = {name[len('rr'):-len('Reply')] for name in reply_writer_names('/profile_check')}
+
+    def offered() -> set[str]:
+        return {name for name, _ in probe.node.get_service_names_and_types()}
+
+    spin_until(probe.executor, lambda: wanted <= offered(), 30.0)
+    assert sorted(wanted - offered()) == []

@@ -3,7 +3,13 @@ The workspace's Fast DDS profile (config/fastdds.xml), its transports, and the e
 
 rmw_fastrtps reads ``FASTRTPS_DEFAULT_PROFILES_FILE`` when a process creates its first
 participant; the profile makes the reply writers of the tuner's and the CPG's services wait for
-a new client's reader instead of dropping the answer (the file says which and why).
+a new client's reader instead of dropping the answer (the file says which and why). rmw looks a
+reply writer's profile up by its topic's full name, so a profile covers given namespaces only:
+the installed file covers ``/wirefish`` and the root namespace (``ros2 run`` without one), and
+`wirefish up` in any other namespace (a test's, a fleet's ``/fish_<i>``) writes one for its own
+namespaces into the run's directory (``graph_environment``). ``render_profile`` makes both;
+for ``ros2 launch`` in another namespace:
+``python3 -m wirefish_bringup.dds_profile /fish_1 > fastdds.xml``.
 
 ``FASTDDS_BUILTIN_TRANSPORTS=UDPv4`` leaves Fast DDS's shared-memory transport out. With it, a
 publisher whose subscriber was SIGKILLed and restarted stalls in ``publish()``: the writer
@@ -18,7 +24,7 @@ afford. A value the user already set, for either variable (even empty), is kept.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
@@ -27,6 +33,48 @@ PROFILES_VARIABLE = 'FASTRTPS_DEFAULT_PROFILES_FILE'
 PROFILE_FILE_NAME = 'fastdds.xml'
 TRANSPORTS_VARIABLE = 'FASTDDS_BUILTIN_TRANSPORTS'
 TRANSPORTS = 'UDPv4'
+INSTALLED_NAMESPACES = ('/wirefish', '/')
+# Servers whose executor can afford to wait for a new client's reader: the tuner (a
+# multi-threaded executor) and the CPG (its oscillator runs on a loop thread of its own). Not
+# the bridge: its executor ticks the servo commands, and the fish goes neutral after 500 ms.
+WAITING_SERVICES = ('retune_gait', 'retune_gait/_action/send_goal',
+                    'retune_gait/_action/cancel_goal', 'retune_gait/_action/get_result',
+                    'start', 'stop', 'cpg_node/follow_commands')
+WAITING_PARAMETER_SERVERS = ('tuner_node', 'cpg_node')
+PARAMETER_SERVICES = ('set_parameters', 'set_parameters_atomically', 'get_parameters',
+                      'get_parameter_types', 'list_parameters', 'describe_parameters',
+                      'get_type_description')
+REPLY_WAIT_S = 5
+
+_HEADER = """<?xml version="1.0" encoding="UTF-8"?>
+<!--
+  Fast DDS profile of the wirefish graph (rmw_fastrtps_cpp, Jazzy: Fast DDS 2.14), made by
+  wirefish_bringup.dds_profile.render_profile for the namespaces {namespaces}.
+
+  rmw_fastrtps answers a request only once the server's reply writer has matched the client's
+  reply reader, waiting at most the writer's reliability max_blocking_time (100 ms by default)
+  and otherwise dropping the answer ("client will not receive response"). A fresh client (one
+  `ros2 service call`, `ros2 param set`, `ros2 action send_goal`) or a server that has just
+  (re)started can need longer than that on a loaded machine. The reply writers below wait up
+  to {wait} s: the wait ends as soon as the reader matches, and holds only the executor thread
+  answering that request. Only servers whose executor can afford it are listed: the tuner (a
+  multi-threaded executor) and the CPG (its oscillator runs on its own loop thread). Not the
+  bridge: its executor ticks the servo commands, and the fish goes neutral after 500 ms without.
+
+  rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
+  Loaded through FASTRTPS_DEFAULT_PROFILES_FILE (wirefish up, the launch file,
+  tools/activate.sh).
+-->
+<dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <profiles>
+"""
+_WRITER = """    <data_writer profile_name="{name}">
+      <qos><reliability><max_blocking_time><sec>{wait}</sec></max_blocking_time></reliability></qos>
+    </data_writer>
+"""
+_FOOTER = """  </profiles>
+</dds>
+"""
 
 
 def profile_path() -> Path:
@@ -34,9 +82,66 @@ def profile_path() -> Path:
     return Path(get_package_share_directory('wirefish_bringup'), 'config', PROFILE_FILE_NAME)
 
 
+def reply_writer_names(namespace: str) -> list[str]:
+    """Return the reply topics of the waiting services in ``namespace`` (absolute)."""
+    prefix = namespace.rstrip('/')
+    services = [*WAITING_SERVICES,
+                *(f'{node}/{service}' for node in WAITING_PARAMETER_SERVERS
+                  for service in PARAMETER_SERVICES)]
+    return [f'rr{prefix}/{service}Reply' for service in services]
+
+
+def render_profile(namespaces: Iterable[str]) -> str:
+    """Return the profile XML whose reply writers of ``namespaces`` wait REPLY_WAIT_S."""
+    chosen = list(dict.fromkeys(namespaces))
+    writers = ''.join(_WRITER.format(name=name, wait=REPLY_WAIT_S)
+                      for namespace in chosen for name in reply_writer_names(namespace))
+    return (_HEADER.format(namespaces=', '.join(chosen), wait=REPLY_WAIT_S) + writers
+            + _FOOTER)
+
+
 def with_profile(env: Mapping[str, str]) -> dict[str, str]:
-    """Return ``env`` with the workspace's profile and transports, unless it sets them already."""
+    """Return ``env`` with the installed profile and transports, unless it sets them already."""
     result = dict(env)
     result.setdefault(PROFILES_VARIABLE, str(profile_path()))
     result.setdefault(TRANSPORTS_VARIABLE, TRANSPORTS)
     return result
+
+
+def graph_environment(env: Mapping[str, str], namespaces: Iterable[str],
+                      run_dir: Path) -> dict[str, str]:
+    """
+    Return ``env`` for a graph in ``namespaces``: with_profile, or a profile of its own.
+
+    When the user set no profile and the installed one does not cover every namespace, the
+    graph's own profile is written to ``run_dir``/fastdds.xml and named instead.
+    """
+    chosen = set(namespaces)
+    if PROFILES_VARIABLE in env or chosen <= set(INSTALLED_NAMESPACES):
+        return with_profile(env)
+    path = Path(run_dir) / PROFILE_FILE_NAME
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(render_profile(sorted(chosen)))
+    return with_profile({**env, PROFILES_VARIABLE: str(path)})
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print the profile of the namespaces given on the command line."""
+    import sys
+    from wirefish_bringup.graph import validate_namespace
+    names = sys.argv[1:] if argv is None else argv
+    if not names:
+        print('usage: python3 -m wirefish_bringup.dds_profile NAMESPACE [NAMESPACE ...]',
+              file=sys.stderr)
+        return 2
+    try:
+        namespaces = [validate_namespace(name) for name in names]
+    except ValueError as error:
+        print(f'dds_profile: {error}', file=sys.stderr)
+        return 2
+    sys.stdout.write(render_profile(namespaces))
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

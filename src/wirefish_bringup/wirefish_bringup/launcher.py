@@ -18,7 +18,7 @@ import sys
 import time
 
 from wirefish_bringup.cli import duration_s
-from wirefish_bringup.dds_profile import with_profile
+from wirefish_bringup.dds_profile import graph_environment
 from wirefish_bringup.errors import QemuBoardError
 from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
                                     validate_namespace)
@@ -272,7 +272,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
-    supervisor = Supervisor(run_dir / 'logs', env=with_profile(os.environ))
+    # The reply writers' profile must name the graph's own namespaces (dds_profile).
+    env = graph_environment(os.environ, {s.namespace for s in specs if s.namespace}, run_dir)
+    supervisor = Supervisor(run_dir / 'logs', env=env)
     stop_requested = []
 
     def request_stop(signum, _frame) -> None:

@@ -1,0 +1,59 @@
+"""The graph's Fast DDS profile: the installed file, a graph's own, and who wins."""
+
+from pathlib import Path
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+from wirefish_bringup.dds_profile import (graph_environment, INSTALLED_NAMESPACES,
+                                          PROFILES_VARIABLE, render_profile,
+                                          reply_writer_names, TRANSPORTS_VARIABLE)
+
+INSTALLED = Path(__file__).resolve().parents[1] / 'config' / 'fastdds.xml'
+NS = '{http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles}'
+
+
+def _writer_names(xml_text: str) -> list[str]:
+    root = ElementTree.fromstring(xml_text)
+    return [w.get('profile_name') for w in root.iter(f'{NS}data_writer')]
+
+
+def test_the_installed_profile_is_the_rendered_one_of_its_namespaces():
+    assert INSTALLED.read_text() == render_profile(INSTALLED_NAMESPACES)
+
+
+@pytest.mark.parametrize('namespace, reply', [
+    ('/wirefish', 'rr/wirefish/retune_gaitReply'),
+    ('/', 'rr/retune_gaitReply'),
+    ('/fish_2', 'rr/fish_2/cpg_node/set_parametersReply'),
+    ('/a/b', 'rr/a/b/retune_gait/_action/send_goalReply'),
+])
+def test_reply_writer_names_follow_the_namespace(namespace, reply):
+    assert reply in reply_writer_names(namespace)
+
+
+def test_every_reply_writer_waits_the_same_five_seconds():
+    root = ElementTree.fromstring(render_profile(['/x']))
+    waits = {e.text for e in root.iter(f'{NS}sec')}
+    assert waits == {'5'}
+    assert len(_writer_names(render_profile(['/x']))) == len(reply_writer_names('/x'))
+
+
+def test_a_graph_in_the_installed_namespaces_uses_the_installed_profile(tmp_path):
+    env = graph_environment({}, {'/wirefish'}, tmp_path)
+    assert Path(env[PROFILES_VARIABLE]).name == 'fastdds.xml'
+    assert not (tmp_path / 'fastdds.xml').exists()
+    assert env[TRANSPORTS_VARIABLE] == 'UDPv4'
+
+
+def test_a_graph_in_other_namespaces_writes_and_names_its_own_profile(tmp_path):
+    env = graph_environment({}, {'/fish_1', '/fish_2'}, tmp_path)
+    assert env[PROFILES_VARIABLE] == str(tmp_path / 'fastdds.xml')
+    names = _writer_names((tmp_path / 'fastdds.xml').read_text())
+    assert 'rr/fish_1/retune_gaitReply' in names
+    assert 'rr/fish_2/cpg_node/follow_commandsReply' in names
+
+
+def test_the_users_profile_is_kept_even_empty(tmp_path):
+    env = graph_environment({PROFILES_VARIABLE: ''}, {'/fish_1'}, tmp_path)
+    assert env[PROFILES_VARIABLE] == ''
+    assert not (tmp_path / 'fastdds.xml').exists()
