@@ -79,6 +79,9 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         # before the executor goes: a task they hand over meets a live executor.
         executor.remove_node(node)
         node.destroy_node()
-        executor.shutdown()
+        # No executor.shutdown(): exit_now follows, and what it would free the exit frees. Its
+        # teardown of the removed node's entities (the events executor's, with the GIL held)
+        # was seen to hang: bridge_node's main thread in executor.shutdown() until the 6 s
+        # teardown bound, in one of three bridges of a fleet's stop.
         rclpy.try_shutdown()
     exit_now(0)
