@@ -44,6 +44,9 @@ REST_WITHIN_S = 3.0  # cmd_vel_timeout_s 0.5 + a control period + the CPG's para
 RATE_WINDOW_S = 10.0
 SERVO_WINDOW_S = 5.0  # of driving before the cut
 RATE_FRACTION = 0.8  # of each relayed topic's configured rate, over RATE_WINDOW_S
+# Packets the fish side's bucket may drop in the shaped window: 0 and 5 in two runs with
+# discovery announcing every 10 s; 26-41 when it announced every 3 s (a saturated bucket).
+MAX_BUCKET_DROPS = 5
 
 
 def _count(probe, topic: str) -> int:
@@ -208,9 +211,6 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
             slack = 1.0 / RATE_WINDOW_S if row.topic in FISH_SOURCES else 0.0
             assert figures[True][2][row.topic] >= RATE_FRACTION * wanted - slack, row.topic
     assert figures[True][2]['speed_estimate'] > 0.0
-    # What crosses keeps its rates through the bucket (above). The bucket's drops are a figure,
-    # not a claim: since the fish graph gained tf_node and the cpg_command/cpg_status topics,
-    # the fish side saturates the 100 kbit/s bucket (161 kB sent and 41 of 488 packets dropped
-    # in 13 s, where 5 was the bound before): an open regression of the radio's budget, most
-    # likely discovery traffic of the new process and endpoints; the rates still hold.
-    print(f'radio budget: {dropped} packets dropped by the bucket (was at most 5)')
+    # The bucket drops next to nothing: discovery announces every 10 s (dds_profile), so the
+    # fish side stays under the 100 kbit/s it is given.
+    assert dropped <= MAX_BUCKET_DROPS, qdisc

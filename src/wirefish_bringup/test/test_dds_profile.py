@@ -33,9 +33,23 @@ def test_reply_writer_names_follow_the_namespace(namespace, reply):
 
 def test_every_reply_writer_waits_the_same_five_seconds():
     root = ElementTree.fromstring(render_profile(['/x']))
-    waits = {e.text for e in root.iter(f'{NS}sec')}
+    waits = {e.text for w in root.iter(f'{NS}data_writer') for e in w.iter(f'{NS}sec')}
     assert waits == {'5'}
     assert len(_writer_names(render_profile(['/x']))) == len(reply_writer_names('/x'))
+
+
+def test_the_default_participant_runs_over_udp_only_and_announces_every_ten_seconds():
+    root = ElementTree.fromstring(render_profile(['/x']))
+    (participant,) = root.iter(f'{NS}participant')
+    assert participant.get('is_default_profile') == 'true'
+    assert participant.find(f'.//{NS}useBuiltinTransports').text == 'false'
+    (transport,) = root.iter(f'{NS}transport_descriptor')
+    assert transport.find(f'{NS}type').text == 'UDPv4'
+    discovery = participant.find(f'.//{NS}discovery_config')
+    lease = int(discovery.find(f'{NS}leaseDuration/{NS}sec').text)
+    announce = int(discovery.find(f'{NS}leaseAnnouncement/{NS}sec').text)
+    assert (lease, announce) == (30, 10)
+    assert lease > 10 + announce  # a 10 s radio cut never ends a lease
 
 
 def test_a_graph_in_the_installed_namespaces_uses_the_installed_profile(tmp_path):

@@ -11,15 +11,22 @@ namespaces into the run's directory (``graph_environment``). ``render_profile`` 
 for ``ros2 launch`` in another namespace:
 ``python3 -m wirefish_bringup.dds_profile /fish_1 > fastdds.xml``.
 
-``FASTDDS_BUILTIN_TRANSPORTS=UDPv4`` leaves Fast DDS's shared-memory transport out. With it, a
-publisher whose subscriber was SIGKILLed and restarted stalls in ``publish()``: the writer
-reopens the dead reader's shared-memory port and waits out the port's health check
-(``healthy_check_timeout_ms``, 1000 ms by default). Measured here (tools/kill_stall_probe.py,
-a 100 Hz publisher, 12 kills of a subscriber): with shared memory its longest publish took
-1001 ms (twice, and 334 ms twice), over UDP 6 ms. A CPG stalled that long starves the bridge
-past its 500 ms command timeout and the fish goes neutral; messages in flight to the recorder
-were lost with it. Loopback UDP costs a copy per reader, which the graph's small messages
-afford. A value the user already set, for either variable (even empty), is kept.
+The profile's default participant runs over UDPv4 only and announces itself every ANNOUNCE_S
+(lease LEASE_S) instead of Fast DDS's 3 s (20 s): the fish's and the shore's participants
+announcing to each other every 3 s saturated a 100 kbit/s radio (test/twohost: fish->shore
+12.4 kB/s and 26-41 packets dropped by the bucket in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped).
+A 10 s radio cut stays inside the lease. ``FASTDDS_BUILTIN_TRANSPORTS=UDPv4`` (set beside the
+profile) gives UDP also to a process whose user named a profile of their own.
+
+Why no shared memory: with it, a publisher whose subscriber was SIGKILLed and restarted stalls
+in ``publish()``: the writer reopens the dead reader's shared-memory port and waits out the
+port's health check (``healthy_check_timeout_ms``, 1000 ms by default). Measured here
+(tools/kill_stall_probe.py, a 100 Hz publisher, 12 kills of a subscriber): with shared memory
+its longest publish took 1001 ms (twice, and 334 ms twice), over UDP 6 ms. A CPG stalled that
+long starves the bridge past its 500 ms command timeout and the fish goes neutral; messages in
+flight to the recorder were lost with it. Loopback UDP costs a copy per reader, which the
+graph's small messages afford. A value the user already set, for either variable (even empty),
+is kept.
 """
 
 from __future__ import annotations
@@ -45,6 +52,8 @@ PARAMETER_SERVICES = ('set_parameters', 'set_parameters_atomically', 'get_parame
                       'get_parameter_types', 'list_parameters', 'describe_parameters',
                       'get_type_description')
 REPLY_WAIT_S = 5
+LEASE_S = 30
+ANNOUNCE_S = 10
 
 _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
 <!--
@@ -61,6 +70,11 @@ _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
   multi-threaded executor) and the CPG (its oscillator runs on its own loop thread). Not the
   bridge: its executor ticks the servo commands, and the fish goes neutral after 500 ms without.
 
+  The default participant: UDPv4 only (over shared memory a SIGKILLed subscriber stalled its
+  publishers for 1 s: the dead port's health check), and discovery announcements every
+  {announce} s with a {lease} s lease (every 3 s with 20 s by default: with the fish's and the
+  shore's participants announcing to each other that alone saturated a 100 kbit/s radio).
+
   rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
   Loaded through FASTRTPS_DEFAULT_PROFILES_FILE (wirefish up, the launch file,
   tools/activate.sh).
@@ -71,6 +85,26 @@ _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
 _WRITER = """    <data_writer profile_name="{name}">
       <qos><reliability><max_blocking_time><sec>{wait}</sec></max_blocking_time></reliability></qos>
     </data_writer>
+"""
+_TRANSPORTS = """    <transport_descriptors>
+      <transport_descriptor>
+        <transport_id>wirefish_udp</transport_id>
+        <type>UDPv4</type>
+      </transport_descriptor>
+    </transport_descriptors>
+"""
+_PARTICIPANT = """    <participant profile_name="wirefish_participant" is_default_profile="true">
+      <rtps>
+        <userTransports><transport_id>wirefish_udp</transport_id></userTransports>
+        <useBuiltinTransports>false</useBuiltinTransports>
+        <builtin>
+          <discovery_config>
+            <leaseDuration><sec>{lease}</sec></leaseDuration>
+            <leaseAnnouncement><sec>{announce}</sec></leaseAnnouncement>
+          </discovery_config>
+        </builtin>
+      </rtps>
+    </participant>
 """
 _FOOTER = """  </profiles>
 </dds>
@@ -92,12 +126,15 @@ def reply_writer_names(namespace: str) -> list[str]:
 
 
 def render_profile(namespaces: Iterable[str]) -> str:
-    """Return the profile XML whose reply writers of ``namespaces`` wait REPLY_WAIT_S."""
+    """Return the profile XML: the default participant, and reply writers of ``namespaces``."""
     chosen = list(dict.fromkeys(namespaces))
     writers = ''.join(_WRITER.format(name=name, wait=REPLY_WAIT_S)
                       for namespace in chosen for name in reply_writer_names(namespace))
-    return (_HEADER.format(namespaces=', '.join(chosen), wait=REPLY_WAIT_S) + writers
-            + _FOOTER)
+    participant = _TRANSPORTS + _PARTICIPANT.format(lease=LEASE_S, announce=ANNOUNCE_S)
+    header = _HEADER.format(namespaces=', '.join(chosen), wait=REPLY_WAIT_S, lease=LEASE_S,
+                            announce=ANNOUNCE_S)
+    return (header + participant
+            + writers + _FOOTER)
 
 
 def with_profile(env: Mapping[str, str]) -> dict[str, str]:
