@@ -5,7 +5,7 @@ import xml.etree.ElementTree as ElementTree
 
 import pytest
 from wirefish_bringup.dds_profile import (graph_environment, INSTALLED_NAMESPACES,
-                                          PROFILES_VARIABLE, render_profile,
+                                          profile_path, PROFILES_VARIABLE, render_profile,
                                           reply_writer_names, TRANSPORTS_VARIABLE)
 
 INSTALLED = Path(__file__).resolve().parents[1] / 'config' / 'fastdds.xml'
@@ -38,8 +38,8 @@ def test_every_reply_writer_waits_the_same_five_seconds():
     assert len(_writer_names(render_profile(['/x']))) == len(reply_writer_names('/x'))
 
 
-def test_the_default_participant_runs_over_udp_only_and_announces_every_ten_seconds():
-    root = ElementTree.fromstring(render_profile(['/x']))
+def test_one_side_of_a_radio_gets_a_participant_over_udp_announcing_every_ten_seconds():
+    root = ElementTree.fromstring(render_profile(['/x'], radio=True))
     (participant,) = root.iter(f'{NS}participant')
     assert participant.get('is_default_profile') == 'true'
     assert participant.find(f'.//{NS}useBuiltinTransports').text == 'false'
@@ -50,6 +50,18 @@ def test_the_default_participant_runs_over_udp_only_and_announces_every_ten_seco
     announce = int(discovery.find(f'{NS}leaseAnnouncement/{NS}sec').text)
     assert (lease, announce) == (30, 10)
     assert lease > 10 + announce  # a 10 s radio cut never ends a lease
+
+
+def test_one_host_keeps_fast_dds_participant_defaults():
+    root = ElementTree.fromstring(render_profile(['/x']))
+    assert list(root.iter(f'{NS}participant')) == []
+
+
+def test_a_radio_side_writes_its_own_profile_even_in_the_installed_namespace(tmp_path):
+    env = graph_environment({PROFILES_VARIABLE: str(profile_path())}, {'/wirefish'}, tmp_path,
+                            radio=True)
+    assert env[PROFILES_VARIABLE] == str(tmp_path / 'fastdds.xml')
+    assert 'leaseAnnouncement' in (tmp_path / 'fastdds.xml').read_text()
 
 
 def test_a_graph_in_the_installed_namespaces_uses_the_installed_profile(tmp_path):

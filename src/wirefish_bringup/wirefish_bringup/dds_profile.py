@@ -11,12 +11,15 @@ namespaces into the run's directory (``graph_environment``). ``render_profile`` 
 for ``ros2 launch`` in another namespace:
 ``python3 -m wirefish_bringup.dds_profile /fish_1 > fastdds.xml``.
 
-The profile's default participant runs over UDPv4 only and announces itself every ANNOUNCE_S
-(lease LEASE_S) instead of Fast DDS's 3 s (20 s): the fish's and the shore's participants
-announcing to each other every 3 s saturated a 100 kbit/s radio (test/twohost: fish->shore
-12.4 kB/s and 26-41 packets dropped by the bucket in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped).
-A 10 s radio cut stays inside the lease. ``FASTDDS_BUILTIN_TRANSPORTS=UDPv4`` (set beside the
-profile) gives UDP also to a process whose user named a profile of their own.
+Over a radio (``wirefish up --role fish|shore``) the graph's own profile also has a default
+participant that announces itself every ANNOUNCE_S (lease LEASE_S) instead of Fast DDS's 3 s
+(20 s): the fish's and the shore's participants announcing to each other every 3 s saturated a
+100 kbit/s radio (test/twohost: fish->shore 12.4 kB/s and 26-41 packets dropped by the bucket
+in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped). A 10 s radio cut stays inside the lease. That
+participant names its UDPv4 transport itself: a default participant profile otherwise brings
+the builtin transports (shared memory) back. On one host (role all) there is no such
+participant: there a 10 s period slowed discovery (a full run: topics and an action not found
+in their tests' time).
 
 Why no shared memory: with it, a publisher whose subscriber was SIGKILLed and restarted stalls
 in ``publish()``: the writer reopens the dead reader's shared-memory port and waits out the
@@ -70,12 +73,7 @@ _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
   multi-threaded executor) and the CPG (its oscillator runs on its own loop thread). Not the
   bridge: its executor ticks the servo commands, and the fish goes neutral after 500 ms without.
 
-  The default participant: UDPv4 only (over shared memory a SIGKILLed subscriber stalled its
-  publishers for 1 s: the dead port's health check), and discovery announcements every
-  {announce} s with a {lease} s lease (every 3 s with 20 s by default: with the fish's and the
-  shore's participants announcing to each other that alone saturated a 100 kbit/s radio).
-
-  rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
+{radio}  rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
   Loaded through FASTRTPS_DEFAULT_PROFILES_FILE (wirefish up, the launch file,
   tools/activate.sh).
 -->
@@ -85,6 +83,11 @@ _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
 _WRITER = """    <data_writer profile_name="{name}">
       <qos><reliability><max_blocking_time><sec>{wait}</sec></max_blocking_time></reliability></qos>
     </data_writer>
+"""
+_RADIO = """  Over a radio (role fish or shore) the default participant: UDPv4 only, and discovery
+  announcements every {announce} s with a {lease} s lease (every 3 s with 20 s by default: the
+  fish's and the shore's participants announcing to each other saturated a 100 kbit/s radio).
+
 """
 _TRANSPORTS = """    <transport_descriptors>
       <transport_descriptor>
@@ -125,16 +128,17 @@ def reply_writer_names(namespace: str) -> list[str]:
     return [f'rr{prefix}/{service}Reply' for service in services]
 
 
-def render_profile(namespaces: Iterable[str]) -> str:
-    """Return the profile XML: the default participant, and reply writers of ``namespaces``."""
+def render_profile(namespaces: Iterable[str], radio: bool = False) -> str:
+    """Return the profile XML: reply writers of ``namespaces`` (and the radio's participant)."""
     chosen = list(dict.fromkeys(namespaces))
     writers = ''.join(_WRITER.format(name=name, wait=REPLY_WAIT_S)
                       for namespace in chosen for name in reply_writer_names(namespace))
-    participant = _TRANSPORTS + _PARTICIPANT.format(lease=LEASE_S, announce=ANNOUNCE_S)
-    header = _HEADER.format(namespaces=', '.join(chosen), wait=REPLY_WAIT_S, lease=LEASE_S,
-                            announce=ANNOUNCE_S)
-    return (header + participant
-            + writers + _FOOTER)
+    participant = (_TRANSPORTS + _PARTICIPANT.format(lease=LEASE_S, announce=ANNOUNCE_S)
+                   if radio else '')
+    header = _HEADER.format(namespaces=', '.join(chosen), wait=REPLY_WAIT_S,
+                            radio=_RADIO.format(lease=LEASE_S, announce=ANNOUNCE_S)
+                            if radio else '')
+    return header + participant + writers + _FOOTER
 
 
 def with_profile(env: Mapping[str, str]) -> dict[str, str]:
@@ -146,19 +150,22 @@ def with_profile(env: Mapping[str, str]) -> dict[str, str]:
 
 
 def graph_environment(env: Mapping[str, str], namespaces: Iterable[str],
-                      run_dir: Path) -> dict[str, str]:
+                      run_dir: Path, radio: bool = False) -> dict[str, str]:
     """
     Return ``env`` for a graph in ``namespaces``: with_profile, or a profile of its own.
 
-    When the user set no profile and the installed one does not cover every namespace, the
-    graph's own profile is written to ``run_dir``/fastdds.xml and named instead.
+    When the user set no profile and the installed one does not fit (a namespace it does not
+    cover, or ``radio``: one side of a radio link), the graph's own profile is written to
+    ``run_dir``/fastdds.xml and named instead.
     """
     chosen = set(namespaces)
-    if PROFILES_VARIABLE in env or chosen <= set(INSTALLED_NAMESPACES):
+    # tools/activate.sh names the installed profile: that is the workspace's, not the user's.
+    users_own = env.get(PROFILES_VARIABLE, str(profile_path())) != str(profile_path())
+    if users_own or (chosen <= set(INSTALLED_NAMESPACES) and not radio):
         return with_profile(env)
     path = Path(run_dir) / PROFILE_FILE_NAME
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(render_profile(sorted(chosen)))
+    path.write_text(render_profile(sorted(chosen), radio=radio))
     return with_profile({**env, PROFILES_VARIABLE: str(path)})
 
 
