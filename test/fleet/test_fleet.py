@@ -60,6 +60,9 @@ def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_en
     rest, _ = up.communicate(timeout=DURATION_S + 120)
     print(''.join(lines) + rest[-2000:])
     assert up.returncode == 0
+    # Off a terminal the timed run says how far it is, with the time left.
+    timed = [line for line in rest.splitlines() if line.startswith('recording, seconds: ')]
+    assert any(' left' in line for line in timed), rest[-2000:]
     bag = next(tmp_path.glob('run_*/bag'))
     counts = assert_bag_readable(bag)
     for name in FISH:

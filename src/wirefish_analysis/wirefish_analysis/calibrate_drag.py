@@ -34,6 +34,7 @@ import sys
 
 import numpy as np
 from scipy.optimize import minimize_scalar
+from wirefish_common.progress import end_line, Progress
 from wirefish_cpg.table1_gait import (amplitude_scale_for, locked_speed_estimate,
                                       one_locked_period, table1_locked_at, tip_half_amplitude)
 from wirefish_kinematics.geometry import FishGeometry
@@ -134,7 +135,8 @@ def least_squares_drag(geometry: FishGeometry = FishGeometry(),
 
 
 def virtual_fish_speeds(geometry: FishGeometry,
-                        points: tuple[PaperPoint, ...] = PAPER_POINTS) -> list[float]:
+                        points: tuple[PaperPoint, ...] = PAPER_POINTS,
+                        progress: Progress | None = None) -> list[float]:
     """Return the virtual fish's steady mean speeds (m/s) at ``points`` (its servo model)."""
     from wirefish_analysis.fig11 import run_steady
 
@@ -144,17 +146,21 @@ def virtual_fish_speeds(geometry: FishGeometry,
                  else amplitude_scale_for(point.tip_amplitude, point.frequency_hz, geometry))
         params = table1_locked_at(point.frequency_hz, scale)
         speeds.append(run_steady(params, point.frequency_hz, geometry).speed)
+        if progress is not None:
+            progress.step(text=f'virtual fish at {point.frequency_hz:g} Hz')
     return speeds
 
 
-def least_squares_report(geometry: FishGeometry, with_virtual_fish: bool = True) -> str:
+def least_squares_report(geometry: FishGeometry, with_virtual_fish: bool = True,
+                         progress: Progress | None = None) -> str:
     """Return the printed least-squares part: C_D, speeds, RMSE, Sw, the servo's share."""
     fit = least_squares_drag(geometry)
     fitted = replace(geometry, drag_coefficient=fit.drag_coefficient)
     lines = [f'least squares over the {len(PAPER_POINTS)} points: C_D = '
              f'{fit.drag_coefficient:.6f}, speed RMSE {fit.rmse:.4f} m/s '
              f'(paper sim-vs-experiment RMSE {PAPER_RMSE} m/s)']
-    fish = virtual_fish_speeds(fitted) if with_virtual_fish else [math.nan] * len(PAPER_POINTS)
+    fish = (virtual_fish_speeds(fitted, progress=progress) if with_virtual_fish
+            else [math.nan] * len(PAPER_POINTS))
     lines.append(f'{"paper point":30s} {"U paper":>8s} {"U eq 18":>8s} {"Sw eq18":>8s} '
                  f'{"Sw paper":>8s} {"U fish":>8s}')
     for point, speed, fish_speed in zip(PAPER_POINTS, fit.speeds, fish):
@@ -219,9 +225,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--no-virtual-fish', action='store_true',
                         help='skip the virtual fish runs (a few seconds)')
     args = parser.parse_args(argv)
-    print(report(FishGeometry()))
-    print()
-    print(least_squares_report(FishGeometry(), with_virtual_fish=not args.no_virtual_fish))
+    # The virtual fish's runs are the slow part (seconds each): their progress on stderr.
+    progress = Progress('calibrate_drag', len(PAPER_POINTS))
+    try:
+        print(report(FishGeometry()))
+        print()
+        print(least_squares_report(FishGeometry(), with_virtual_fish=not args.no_virtual_fish,
+                                   progress=progress))
+    except KeyboardInterrupt:
+        end_line()
+        print('calibrate_drag: interrupted (Ctrl-C)', file=sys.stderr)
+        return 130
     return 0
 
 

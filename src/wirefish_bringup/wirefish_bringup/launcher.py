@@ -11,6 +11,7 @@ import argparse
 from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import datetime
+import math
 import os
 from pathlib import Path
 import signal
@@ -25,6 +26,7 @@ from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec
 from wirefish_bringup.input_checks import params_file_problem, serial_port_problem
 from wirefish_bringup.status_view import LiveStatus, TerminalBlock
 from wirefish_bringup.supervisor import Supervisor, wait_for_path
+from wirefish_common.progress import duration_text, Progress
 
 STATUS_WINDOW_S = 3.0
 LIVE_REFRESH_S = 1.0  # how often the status is redrawn on a terminal
@@ -273,7 +275,8 @@ def _run(args: argparse.Namespace) -> int:
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
     # The reply writers' profile must name the graph's own namespaces (dds_profile).
-    env = graph_environment(os.environ, {s.namespace for s in specs if s.namespace}, run_dir)
+    env = graph_environment(os.environ, {s.namespace for s in specs if s.namespace}, run_dir,
+                            radio=args.role != ALL)
     supervisor = Supervisor(run_dir / 'logs', env=env)
     stop_requested = []
 
@@ -334,17 +337,29 @@ def _run(args: argparse.Namespace) -> int:
         else:
             print('running: Ctrl-C stops everything', flush=True)
         started = drawn = time.monotonic()
+        # A timed run off a terminal says how far it is (a line per 5 %, with the time left);
+        # on a terminal the live status's first line says it.
+        timed = (Progress('recording, seconds', math.ceil(args.duration), stream=sys.stdout)
+                 if args.duration is not None and block is None and not stop_requested
+                 else None)
         while not stop_requested:
             reports = supervisor.supervise()
             if reports and block is not None:
                 block.forget()  # the reports stay; the status goes on below them
             _report(reports)
-            if args.duration is not None and time.monotonic() - started >= args.duration:
+            elapsed = time.monotonic() - started
+            if args.duration is not None and elapsed >= args.duration:
                 break
+            if timed is not None and int(elapsed) > timed.done:
+                timed.step(int(elapsed))
             if live is not None and block is not None and (
                     time.monotonic() - drawn >= LIVE_REFRESH_S or drawn == started):
                 live.refresh()
-                block.draw([*(status or '').splitlines()[:1], *live.lines()])
+                first = (status or '').splitlines()[:1]
+                if args.duration is not None:
+                    left = duration_text(args.duration - elapsed)
+                    first = [f'{first[0] if first else "running"}; stopping in {left}']
+                block.draw([*first, *live.lines()])
                 drawn = time.monotonic()
             time.sleep(0.1)
     except (RuntimeError, FileNotFoundError) as error:
