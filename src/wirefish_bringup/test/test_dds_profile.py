@@ -6,7 +6,8 @@ import xml.etree.ElementTree as ElementTree
 import pytest
 from wirefish_bringup.dds_profile import (graph_environment, INSTALLED_NAMESPACES,
                                           profile_path, PROFILES_VARIABLE, render_profile,
-                                          reply_writer_names, TRANSPORTS_VARIABLE)
+                                          reply_writer_names, TRANSPORTS_VARIABLE,
+                                          write_profile)
 
 INSTALLED = Path(__file__).resolve().parents[1] / 'config' / 'fastdds.xml'
 NS = '{http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles}'
@@ -58,28 +59,30 @@ def test_one_host_keeps_fast_dds_participant_defaults():
 
 
 def test_a_radio_side_writes_its_own_profile_even_in_the_installed_namespace(tmp_path):
-    env = graph_environment({PROFILES_VARIABLE: str(profile_path())}, {'/wirefish'}, tmp_path,
-                            radio=True)
+    env, own = graph_environment({PROFILES_VARIABLE: str(profile_path())}, {'/wirefish'},
+                                 tmp_path, radio=True)
     assert env[PROFILES_VARIABLE] == str(tmp_path / 'fastdds.xml')
-    assert 'leaseAnnouncement' in (tmp_path / 'fastdds.xml').read_text()
+    assert 'leaseAnnouncement' in own
 
 
 def test_a_graph_in_the_installed_namespaces_uses_the_installed_profile(tmp_path):
-    env = graph_environment({}, {'/wirefish'}, tmp_path)
-    assert Path(env[PROFILES_VARIABLE]).name == 'fastdds.xml'
-    assert not (tmp_path / 'fastdds.xml').exists()
+    env, own = graph_environment({}, {'/wirefish'}, tmp_path)
+    assert env[PROFILES_VARIABLE] == str(profile_path())
+    assert own is None
     assert env[TRANSPORTS_VARIABLE] == 'UDPv4'
 
 
 def test_a_graph_in_other_namespaces_writes_and_names_its_own_profile(tmp_path):
-    env = graph_environment({}, {'/fish_1', '/fish_2'}, tmp_path)
-    assert env[PROFILES_VARIABLE] == str(tmp_path / 'fastdds.xml')
-    names = _writer_names((tmp_path / 'fastdds.xml').read_text())
+    env, own = graph_environment({}, {'/fish_1', '/fish_2'}, tmp_path / 'run')
+    assert env[PROFILES_VARIABLE] == str(tmp_path / 'run' / 'fastdds.xml')
+    assert not (tmp_path / 'run').exists()  # written only when the graph starts
+    write_profile(env, own)
+    names = _writer_names((tmp_path / 'run' / 'fastdds.xml').read_text())
     assert 'rr/fish_1/retune_gaitReply' in names
     assert 'rr/fish_2/cpg_node/follow_commandsReply' in names
 
 
 def test_the_users_profile_is_kept_even_empty(tmp_path):
-    env = graph_environment({PROFILES_VARIABLE: ''}, {'/fish_1'}, tmp_path)
+    env, own = graph_environment({PROFILES_VARIABLE: ''}, {'/fish_1'}, tmp_path)
     assert env[PROFILES_VARIABLE] == ''
-    assert not (tmp_path / 'fastdds.xml').exists()
+    assert own is None

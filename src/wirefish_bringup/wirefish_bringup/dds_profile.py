@@ -149,24 +149,33 @@ def with_profile(env: Mapping[str, str]) -> dict[str, str]:
     return result
 
 
-def graph_environment(env: Mapping[str, str], namespaces: Iterable[str],
-                      run_dir: Path, radio: bool = False) -> dict[str, str]:
+def graph_environment(env: Mapping[str, str], namespaces: Iterable[str], run_dir: Path,
+                      radio: bool = False) -> tuple[dict[str, str], str | None]:
     """
-    Return ``env`` for a graph in ``namespaces``: with_profile, or a profile of its own.
+    Return ``env`` for a graph in ``namespaces``, and the profile it needs of its own, if any.
 
     When the user set no profile and the installed one does not fit (a namespace it does not
-    cover, or ``radio``: one side of a radio link), the graph's own profile is written to
-    ``run_dir``/fastdds.xml and named instead.
+    cover, or ``radio``: one side of a radio link), the environment names
+    ``run_dir``/fastdds.xml and the second value is that file's text: ``write_profile`` writes
+    it once the graph really starts (a refused start leaves no run directory).
     """
     chosen = set(namespaces)
     # tools/activate.sh names the installed profile: that is the workspace's, not the user's.
     users_own = env.get(PROFILES_VARIABLE, str(profile_path())) != str(profile_path())
     if users_own or (chosen <= set(INSTALLED_NAMESPACES) and not radio):
-        return with_profile(env)
+        return with_profile(env), None
     path = Path(run_dir) / PROFILE_FILE_NAME
+    return (with_profile({**env, PROFILES_VARIABLE: str(path)}),
+            render_profile(sorted(chosen), radio=radio))
+
+
+def write_profile(env: Mapping[str, str], text: str | None) -> None:
+    """Write a graph's own profile ``text`` (if any) where ``env`` names it."""
+    if text is None:
+        return
+    path = Path(env[PROFILES_VARIABLE])
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(render_profile(sorted(chosen), radio=radio))
-    return with_profile({**env, PROFILES_VARIABLE: str(path)})
+    path.write_text(text)
 
 
 def main(argv: list[str] | None = None) -> int:

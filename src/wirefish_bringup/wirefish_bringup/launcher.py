@@ -19,7 +19,7 @@ import sys
 import time
 
 from wirefish_bringup.cli import duration_s
-from wirefish_bringup.dds_profile import graph_environment
+from wirefish_bringup.dds_profile import graph_environment, write_profile
 from wirefish_bringup.errors import QemuBoardError
 from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
                                     validate_namespace)
@@ -275,8 +275,9 @@ def _run(args: argparse.Namespace) -> int:
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
     # The reply writers' profile must name the graph's own namespaces (dds_profile).
-    env = graph_environment(os.environ, {s.namespace for s in specs if s.namespace}, run_dir,
-                            radio=args.role != ALL)
+    env, own_profile = graph_environment(
+        os.environ, {s.namespace for s in specs if s.namespace}, run_dir,
+        radio=args.role != ALL)
     supervisor = Supervisor(run_dir / 'logs', env=env)
     stop_requested = []
 
@@ -304,6 +305,7 @@ def _run(args: argparse.Namespace) -> int:
                     return 1
                 if stop_requested:
                     return 0
+            write_profile(env, own_profile)
             for spec in specs:
                 proc = supervisor.start(spec)
                 for link in spec.links:
