@@ -203,11 +203,13 @@ class _FishLink:
         return f'fish_sim{f" {self.name}" if self.name else ""}'
 
 
-# The most simulated time one pass of the loop integrates (s): five of its slowest ticks. A
-# process behind real time (a starved CPU) drops the rest instead of working through it:
-# catching up on 1 ms physics steps and their telemetry frames kept it behind, and deaf to a
-# stop, for as long as the load lasted.
-MAX_STEP_S = 0.05
+# The most simulated time one pass of the loop integrates (s). A process behind real time (a
+# starved CPU) drops the rest instead of working through it: catching up on 1 ms physics steps
+# and their telemetry frames kept it behind, and deaf to a stop, for as long as the load
+# lasted. At 0.05 s the scheduling delays of a loaded 2-core machine (60-100 ms passes) were
+# dropped too, ~3 s in a 2-minute drive: the fish froze while the planner's clock ran on, and
+# its heading hold missed its 3 deg bound (3.20 and 3.74 deg, with 3.07 and 2.98 s dropped).
+MAX_STEP_S = 0.25
 
 
 def loop_step(elapsed_s: float) -> tuple[float, float]:
