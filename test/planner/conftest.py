@@ -18,6 +18,7 @@ import time
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 import pytest
 from ros_utils import stop_process
+from wirefish_common.executors import EVENTS, make_executor, spin_until_stopped, wake
 
 NAMESPACE = '/h181_planner'
 YAW_DISTURBANCE_RAD_S = 0.05  # the current: 2.9 deg/s of yaw on a straight tail
@@ -102,7 +103,6 @@ class Driver:
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.qos import qos_profile_sensor_data
         from sensor_msgs.msg import JointState
         from wirefish_msgs.msg import PlannerState
@@ -118,22 +118,36 @@ class Driver:
                                       qos_profile_sensor_data)
         self.node.create_subscription(PlannerState, 'planner_state', self._on_state, 50)
         self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 50)
-        self.node.create_timer(1.0 / CMD_RATE_HZ, self._on_timer)
-        self._executor = SingleThreadedExecutor(context=context)
+        self._stopping = False
+        # The events executor: a Python executor's wake-ups cost ~0.2 ms each, and at ~190
+        # messages a second a loaded machine left this probe behind for most of a second.
+        self._executor = make_executor(EVENTS, context)
         self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._executor.spin, daemon=True)
-        self._thread.start()
+        self._spinner = threading.Thread(
+            target=spin_until_stopped, args=(self._executor, lambda: self._stopping),
+            daemon=True)
+        self._spinner.start()
+        # cmd_vel from a thread of its own, not a timer among ~190 callbacks a second: a
+        # probe behind on its recording must not starve the planner of cmd_vel (it rests the
+        # fish after cmd_vel_timeout_s and then latches a new heading).
+        self._sender = threading.Thread(target=self._send_commands, daemon=True)
+        self._sender.start()
 
     def now(self) -> float:
         """Return the probe's clock (s)."""
         return self.node.get_clock().now().nanoseconds * 1e-9
 
-    def _on_timer(self) -> None:
-        command = self.command
-        if command is not None:
-            msg = self._twist()
-            msg.linear.x, msg.angular.z = command
-            self._pub.publish(msg)
+    def _send_commands(self) -> None:
+        period = 1.0 / CMD_RATE_HZ
+        due = time.monotonic()
+        while not self._stopping:
+            command = self.command
+            if command is not None:
+                msg = self._twist()
+                msg.linear.x, msg.angular.z = command
+                self._pub.publish(msg)
+            due = max(due + period, time.monotonic())
+            time.sleep(due - time.monotonic())
 
     def _on_truth(self, msg) -> None:
         import math
@@ -175,8 +189,10 @@ class Driver:
 
     def close(self) -> None:
         """Stop spinning and destroy the node."""
-        self._executor.shutdown()
-        self._thread.join(timeout=5.0)
+        self._stopping = True
+        wake(self._executor)
+        self._sender.join(timeout=5.0)
+        self._spinner.join(timeout=5.0)
         self.node.destroy_node()
 
 

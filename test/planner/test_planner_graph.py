@@ -101,8 +101,10 @@ def test_drive_the_virtual_fish(driver):
     hold_target = rec.state[-1][1].heading_target
     held = _window(rec.truth, start + HOLD_SETTLE_S, end)
     hold_rms = math.degrees(math.sqrt(np.mean(_wrap(held[:, 3] - hold_target) ** 2)))
+    hold_modes = Counter(m.mode for t, m in rec.state if start + HOLD_SETTLE_S <= t < end)
     print(f'heading hold with a {0.05:.2f} rad/s current: target {math.degrees(hold_target):.1f}'
-          f' deg, RMS error over {HOLD_WINDOW_S:.0f} s {hold_rms:.2f} deg')
+          f' deg, RMS error over {HOLD_WINDOW_S:.0f} s {hold_rms:.2f} deg (planner modes '
+          f'{dict(hold_modes)})')
 
     drifts = {}
     for name, values in (('heading hold off (yaw-rate loop only)', {'heading_hold': False}),
