@@ -51,6 +51,28 @@ def test_cmd_vel_timeout_rests_and_releases_the_hold(make_planner):
     assert out.mode == 'rest' and math.isnan(out.heading_target) and out.offset == 0.0
 
 
+def test_a_planner_that_slept_reads_its_queue_before_it_rests(make_planner):
+    planner = make_planner(cmd_vel_timeout_s=0.5, imu_timeout_s=0.5)
+    planner.command(0.0, 0.2, 0.0)
+    _imu(planner, 0.0, 0.4, yaw=0.3)
+    target = planner.step(0.4).heading_target
+    asleep = planner.step(1.2)  # 0.8 s late: the cmd_vel and IMU of that time still queued
+    planner.command(1.2, 0.2, 0.0)
+    _imu(planner, 1.2, 0.05, yaw=0.3)
+    awake = planner.step(1.25)
+    assert asleep.mode == awake.mode == 'hold'
+    assert awake.heading_target == pytest.approx(target)
+
+
+def test_a_late_step_defers_a_real_timeout_by_one_step(make_planner):
+    planner = make_planner(cmd_vel_timeout_s=0.5)
+    planner.command(0.0, 0.2, 0.0)
+    _imu(planner, 0.0, 0.4, yaw=0.3)
+    planner.step(0.4)
+    assert planner.step(1.2).mode == 'hold'
+    assert planner.step(1.25).mode == 'rest'
+
+
 def test_the_heading_is_latched_when_the_turn_command_ends(make_planner):
     planner = make_planner()
     _imu(planner, 0.0, 2.0, yaw=0.0, rate=0.2, command=(0.2, 0.2))  # turning at 0.2 rad/s

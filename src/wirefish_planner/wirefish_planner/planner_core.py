@@ -2,7 +2,8 @@
 The planner's rules (pure; no rclpy): cmd_vel in, gait and turning offset out.
 
 Modes
-    ``rest``      no cmd_vel yet, the last one older than ``cmd_vel_timeout_s``, or speed 0:
+    ``rest``      no cmd_vel yet, the last one older than ``cmd_vel_timeout_s`` (judged by an
+                  on-time step: see ``LATE_STEP_FRACTION``), or speed 0:
                   amplitudes and offsets go to 0 (the CPG converges there smoothly), the
                   heading hold releases and the integrator empties.
     ``turn``      angular.z != 0: the yaw-rate PI tracks angular.z (REP-103: + turns left).
@@ -25,6 +26,10 @@ from wirefish_planner.yaw_control import (feedforward_offset, heading_rate_refer
 
 REST_WINDOW_S = 0.5  # filter window while no gait beats (s)
 SPEED_RESOLUTION_M_S = 0.001  # targets closer than this share a gait (no re-plan per message)
+# A step this fraction of a timeout or more after the previous one comes from a planner that
+# was itself asleep (a loaded machine): what arrived meanwhile still waits in its queues, so
+# that step keeps the last judgement of the input and the next, on-time step judges it.
+LATE_STEP_FRACTION = 0.5
 
 
 @dataclass(frozen=True)
@@ -89,6 +94,9 @@ class Planner:
         self._choice = GaitChoice(0.0, None)
         self._imu_s: float | None = None  # stamp of the last IMU sample
         self._imu_wall_s: float | None = None  # receipt time of the last IMU sample
+        self._step_s: float | None = None
+        self._command_lapsed = True  # judged by step: no cmd_vel, or none for the timeout
+        self._imu_lapsed = True  # judged by step: no IMU sample, or none for the timeout
         self._unwrapped_yaw = math.nan
         self._rate_mean = PeriodMean(REST_WINDOW_S)
         self._yaw_mean = PeriodMean(REST_WINDOW_S)
@@ -115,9 +123,10 @@ class Planner:
         problem = command_problem(speed, yaw_rate)
         if problem is not None:
             return problem
-        if self._resting(now_s):
+        if self._command_lapsed:
             self._was_turning = True  # a new run latches its heading when it goes straight
         self._command_s = now_s
+        self._command_lapsed = False
         self._speed = speed
         self._yaw_rate_cmd = yaw_rate
         if abs(speed - self._choice.target_speed) >= SPEED_RESOLUTION_M_S or \
@@ -141,12 +150,13 @@ class Planner:
         self._unwrapped_yaw = yaw if math.isnan(self._unwrapped_yaw) else \
             self._unwrapped_yaw + wrap_angle(yaw - self._unwrapped_yaw)
         self._imu_s, self._imu_wall_s = stamp_s, now_s
+        self._imu_lapsed = False
         self._measured_rate = self._rate_mean.add(stamp_s, yaw_rate)
         self._heading = self._yaw_mean.add(stamp_s, self._unwrapped_yaw)
         if math.isnan(self._heading_target) and not self._was_turning and \
-                self.settings.heading_hold and self._swimming(now_s):
+                self.settings.heading_hold and self._swimming():
             self._heading_target = self._heading_now()  # the first sample of a straight run
-        if previous is None or not self._swimming(now_s) or not self.settings.yaw_control:
+        if previous is None or not self._swimming() or not self.settings.yaw_control:
             return
         self._reference = self._yaw_rate_reference()
         self.pi.update(self._reference, self._measured_rate, stamp_s - previous,
@@ -155,19 +165,20 @@ class Planner:
     # --- outputs ------------------------------------------------------------------------------
     def step(self, now_s: float) -> PlannerOutput:
         """Return the gait, offset and state for now (timeouts are judged here)."""
-        if not self._swimming(now_s):
+        self._judge_timeouts(now_s)
+        if not self._swimming():
             self.pi.reset()
             self._heading_target = math.nan
             self._was_turning = True
             note = ''
-            if self._command_s is not None and not self._resting(now_s) and \
+            if self._command_s is not None and not self._command_lapsed and \
                     self._yaw_rate_cmd != 0.0:
                 note = 'turning needs forward speed (r = k U b): resting'
             mode = 'rest'
             return PlannerOutput(mode, GaitChoice(0.0, None), 0.0, 0.0, self._measured_rate,
                                  math.nan, self._wrapped_heading(), note)
         speed = self._choice.predicted_speed
-        if self.settings.yaw_control and self._imu_fresh(now_s):
+        if self.settings.yaw_control and not self._imu_lapsed:
             mode = 'turn' if self._yaw_rate_cmd != 0.0 else (
                 'hold' if not math.isnan(self._heading_target) else 'straight')
             offset = self.pi.offset
@@ -192,16 +203,20 @@ class Planner:
                   else 1.0 / self._choice.point.frequency_hz)
         self._rate_mean.window_s = self._yaw_mean.window_s = window
 
-    def _resting(self, now_s: float) -> bool:
-        return self._command_s is None or \
-            now_s - self._command_s > self.settings.cmd_vel_timeout_s
+    def _judge_timeouts(self, now_s: float) -> None:
+        """Judge whether cmd_vel and the IMU lapsed, unless this step comes late."""
+        gap = 0.0 if self._step_s is None else now_s - self._step_s
+        self._step_s = now_s
+        s = self.settings
+        if gap < LATE_STEP_FRACTION * s.cmd_vel_timeout_s:
+            self._command_lapsed = self._command_s is None or \
+                now_s - self._command_s > s.cmd_vel_timeout_s
+        if gap < LATE_STEP_FRACTION * s.imu_timeout_s:
+            self._imu_lapsed = self._imu_wall_s is None or \
+                now_s - self._imu_wall_s > s.imu_timeout_s
 
-    def _swimming(self, now_s: float) -> bool:
-        return not self._resting(now_s) and self._choice.point is not None
-
-    def _imu_fresh(self, now_s: float) -> bool:
-        return self._imu_wall_s is not None and \
-            now_s - self._imu_wall_s <= self.settings.imu_timeout_s
+    def _swimming(self) -> bool:
+        return not self._command_lapsed and self._choice.point is not None
 
     def _heading_now(self) -> float:
         """Return the heading now: the period mean lags a turning fish by half its window."""
