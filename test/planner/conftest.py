@@ -147,7 +147,7 @@ class Driver:
                 msg.linear.x, msg.angular.z = command
                 self._pub.publish(msg)
             due = max(due + period, time.monotonic())
-            time.sleep(due - time.monotonic())
+            time.sleep(max(0.0, due - time.monotonic()))
 
     def _on_truth(self, msg) -> None:
         import math

@@ -10,6 +10,7 @@ from collections import defaultdict
 import math
 import os
 from pathlib import Path
+import time
 
 from ament_index_python.packages import get_package_prefix
 from e2e_utils import descendants, start_graph
@@ -39,6 +40,7 @@ FRAMES = {'odom', 'base_link', 'imu_link', 'tail_base', 'tail_plate_ii', 'tail_p
 TF_NODE = Path(get_package_prefix('wirefish_tf'), 'lib', 'wirefish_tf', 'tf_node')
 MATCHED_AT_LEAST = 50  # truths a transform is checked against, for each of the two checks
 SPANNED = 2 * MATCHED_AT_LEAST  # truths the transforms span before the checks start
+SEND_PERIOD_S = 0.05  # how often the fleet test feeds its two tf_nodes
 
 
 def _stamp_ns(stamp) -> int:
@@ -184,26 +186,31 @@ def test_the_fin_frame_is_on_the_body_wave(heard):
 @pytest.fixture
 def fleet(spawn, ros_context):
     """Start the tf_node processes of two fish, fish_1 and fish_2; yield a listener."""
-    for fish in ('fish_1', 'fish_2'):
-        spawn([str(TF_NODE), '--ros-args', '-r', f'__ns:=/fleet/{fish}',
-               '-p', f'frame_prefix:={fish}'])
+    procs = {fish: spawn([str(TF_NODE), '--ros-args', '-r', f'__ns:=/fleet/{fish}',
+                          '-p', f'frame_prefix:={fish}'])
+             for fish in ('fish_1', 'fish_2')}
     node = rclpy.create_node('fleet_listener', context=ros_context)
     executor = SingleThreadedExecutor(context=ros_context)
     executor.add_node(node)
-    yield node, executor
+    yield node, executor, procs
     executor.shutdown()
     node.destroy_node()
 
 
 def test_a_fleets_frames_are_prefixed_and_distinct(fleet):
-    node, executor = fleet
+    node, executor, procs = fleet
     record = TfRecord(node)
     waves = {fish: node.create_publisher(BodyWave, f'/fleet/{fish}/body_wave', SENSOR_DATA)
              for fish in ('fish_1', 'fish_2')}
     truths = {fish: node.create_publisher(Odometry, f'/fleet/{fish}/sim/ground_truth', RELIABLE)
               for fish in ('fish_1', 'fish_2')}
 
+    sent = [-math.inf]
+
     def send_and_check() -> bool:
+        if time.monotonic() - sent[0] < SEND_PERIOD_S:  # 20 Hz, not once per callback
+            return False
+        sent[0] = time.monotonic()
         for fish in waves:
             wave = BodyWave(beta1=0.3, beta2=-0.2)
             waves[fish].publish(wave)
@@ -213,7 +220,9 @@ def test_a_fleets_frames_are_prefixed_and_distinct(fleet):
         children = set(record.parents())
         return len(children) >= 2 * (len(FRAMES) - 1)
 
-    assert spin_until(executor, send_and_check, timeout_s=30.0), sorted(record.parents())
+    if not spin_until(executor, send_and_check, timeout_s=30.0):
+        alive = {fish: proc.poll() is None for fish, proc in procs.items()}
+        pytest.fail(f'frames heard: {sorted(record.parents())}; tf_node alive: {alive}')
     parents = record.parents()
     for fish in ('fish_1', 'fish_2'):
         mine = {c for c in parents if c.startswith(f'{fish}/')}

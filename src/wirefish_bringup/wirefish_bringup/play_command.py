@@ -16,6 +16,9 @@ import math
 from pathlib import Path
 import sys
 import time
+from typing import Any
+
+ACK_WAIT_S = 5.0  # how long the played messages may take to be acknowledged at the end
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -86,6 +89,23 @@ def run(args: argparse.Namespace) -> int:
     return _play(args, remaps)
 
 
+def _wait_for_acks(publishers: dict[str, Any], reliable_topics: set[str]) -> list[str]:
+    """Return the reliable topics whose last messages a subscriber has not acknowledged.
+
+    Destroying a publisher drops what it has not delivered yet: without this wait the last
+    message of a play was now and then never heard.
+    """
+    from rclpy.duration import Duration
+
+    deadline = time.monotonic() + ACK_WAIT_S
+    unacked = []
+    for topic in sorted(reliable_topics & publishers.keys()):
+        left = max(0.0, deadline - time.monotonic())
+        if not publishers[topic].wait_for_all_acked(Duration(nanoseconds=int(left * 1e9))):
+            unacked.append(topic)
+    return unacked
+
+
 def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
     from mcap.reader import make_reader
     import rclpy
@@ -119,8 +139,11 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
     node = rclpy.create_node('wirefish_play', start_parameter_services=False)
     try:
         publishers = {}
+        reliable_topics: set[str] = set()
         for topic, type_name in wanted.items():
             reliable, latched = qos_of.get(topic, (True, False))
+            if reliable:
+                reliable_topics.add(topic)
             qos = QoSProfile(
                 depth=1 if latched else 100,
                 reliability=ReliabilityPolicy.RELIABLE if reliable
@@ -151,7 +174,11 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
                     if elapsed > progress.done:
                         progress.step(min(elapsed, progress.total), f'{played} messages')
         progress.step(progress.total, f'{played} messages')
+        unacked = _wait_for_acks(publishers, reliable_topics)
         print(f'played {played} messages of {len(publishers)} topics from {args.bag}')
+        if unacked:
+            print(f'wirefish play: not every subscriber acknowledged {", ".join(unacked)} within '
+                  f'{ACK_WAIT_S:.0f} s of the last message', file=sys.stderr)
         return 0
     finally:
         node.destroy_node()
