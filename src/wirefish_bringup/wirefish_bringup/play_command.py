@@ -90,7 +90,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _wait_for_acks(publishers: dict[str, Any], reliable_topics: set[str]) -> list[str]:
-    """Return the reliable topics whose last messages a subscriber has not acknowledged.
+    """
+    Return the reliable topics whose last messages a subscriber has not acknowledged.
 
     Destroying a publisher drops what it has not delivered yet: without this wait the last
     message of a play was now and then never heard.
