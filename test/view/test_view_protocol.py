@@ -32,6 +32,7 @@ REGISTRY_TYPES = {
     'speed_estimate': 'wirefish_msgs/msg/SpeedEstimate',
     'planner_state': 'wirefish_msgs/msg/PlannerState',
     'cpg_params': 'wirefish_msgs/msg/CpgParams', 'target_wave': 'wirefish_msgs/msg/BodyWaveSpec',
+    'cpg_command': 'wirefish_msgs/msg/CpgCommand', 'cpg_status': 'wirefish_msgs/msg/CpgStatus',
     'sim/ground_truth': 'nav_msgs/msg/Odometry', 'cmd_vel': 'geometry_msgs/msg/Twist',
     '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray', '/tf': 'tf2_msgs/msg/TFMessage',
     '/tf_static': 'tf2_msgs/msg/TFMessage'}
