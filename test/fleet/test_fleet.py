@@ -63,6 +63,9 @@ def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_en
     # Off a terminal the timed run says how far it is, with the time left.
     timed = [line for line in rest.splitlines() if line.startswith('recording, seconds: ')]
     assert any(' left' in line for line in timed), rest[-2000:]
+    # Its last line says what the recording lost, whatever it was (three fish on two cores).
+    assert re.match(r'recording: (0 lost on \d+ topics|LOST \d+ messages: )',
+                    rest.splitlines()[-1]), rest[-2000:]
     bag = next(tmp_path.glob('run_*/bag'))
     counts = assert_bag_readable(bag)
     for name in FISH:

@@ -44,9 +44,10 @@ REST_WITHIN_S = 3.0  # cmd_vel_timeout_s 0.5 + a control period + the CPG's para
 RATE_WINDOW_S = 10.0
 SERVO_WINDOW_S = 5.0  # of driving before the cut
 RATE_FRACTION = 0.8  # of each relayed topic's configured rate, over RATE_WINDOW_S
-# Packets the fish side's bucket may drop in the shaped window: 0 and 5 in two runs with
-# discovery announcing every 10 s; 26-41 when it announced every 3 s (a saturated bucket).
-MAX_BUCKET_DROPS = 5
+# Packets the fish side's bucket may drop in the shaped window: 0, 5 and 9 (of 359, a loaded
+# clean-clone run) with discovery announcing every 10 s; 26-41 when it announced every 3 s (a
+# saturated bucket). The bound is half the saturated bucket's fewest: it tells the two apart.
+MAX_BUCKET_DROPS = 13
 
 
 def _count(probe, topic: str) -> int:
