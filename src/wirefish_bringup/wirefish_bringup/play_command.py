@@ -89,9 +89,9 @@ def run(args: argparse.Namespace) -> int:
     return _play(args, remaps)
 
 
-def _wait_for_acks(publishers: dict[str, Any], reliable_topics: set[str]) -> list[str]:
+def _wait_for_acks(publishers: dict[str, Any]) -> list[str]:
     """
-    Return the reliable topics whose last messages a subscriber has not acknowledged.
+    Return the topics of reliable ``publishers`` whose messages a subscriber has not acked.
 
     Destroying a publisher drops what it has not delivered yet: without this wait the last
     message of a play was now and then never heard.
@@ -100,7 +100,7 @@ def _wait_for_acks(publishers: dict[str, Any], reliable_topics: set[str]) -> lis
 
     deadline = time.monotonic() + ACK_WAIT_S
     unacked = []
-    for topic in sorted(reliable_topics & publishers.keys()):
+    for topic in sorted(publishers):
         left = max(0.0, deadline - time.monotonic())
         if not publishers[topic].wait_for_all_acked(Duration(nanoseconds=int(left * 1e9))):
             unacked.append(topic)
@@ -140,11 +140,8 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
     node = rclpy.create_node('wirefish_play', start_parameter_services=False)
     try:
         publishers = {}
-        reliable_topics: set[str] = set()
         for topic, type_name in wanted.items():
             reliable, latched = qos_of.get(topic, (True, False))
-            if reliable:
-                reliable_topics.add(topic)
             qos = QoSProfile(
                 depth=1 if latched else 100,
                 reliability=ReliabilityPolicy.RELIABLE if reliable
@@ -175,7 +172,8 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
                     if elapsed > progress.done:
                         progress.step(min(elapsed, progress.total), f'{played} messages')
         progress.step(progress.total, f'{played} messages')
-        unacked = _wait_for_acks(publishers, reliable_topics)
+        unacked = _wait_for_acks({t: p for t, p in publishers.items()
+                                  if qos_of.get(t, (True, False))[0]})
         print(f'played {played} messages of {len(publishers)} topics from {args.bag}')
         if unacked:
             print(f'wirefish play: not every subscriber acknowledged {", ".join(unacked)} within '
