@@ -1,18 +1,19 @@
 #!/usr/bin/env python3
 """
-Count the service answers fresh clients never get, the way the standard tools make them.
+Count the answers fresh clients never get, the way the standard tools make them.
 
 Every call is a new DDS participant (its own rclpy context), node and client, then
-``wait_for_service``, one request and no retry: what ``ros2 service call`` and
-``ros2 param set`` do. A call not answered within ``--deadline`` s is counted unanswered.
-The server is the graph's own executable (tuner_node: ``retune_gait``; cpg_node:
+``wait_for_service`` (``wait_for_server``), one request and no retry: what ``ros2 service
+call``, ``ros2 param set`` and ``ros2 action send_goal`` do. A call (a goal: its acceptance or
+its result) not answered within ``--deadline`` s is counted unanswered. The server is the
+graph's own executable (tuner_node: the ``retune_gait`` service and action; cpg_node:
 ``set_parameters``), started by the probe in the namespace the Fast DDS profile names and
 restarted before every ``--restart-every``-th call (a server that has just started meets
 clients it has not discovered yet: where rmw_fastrtps drops answers). A second graph
 (``wirefish up`` in ``/load_0``) loads the machine (``--load-graphs``: how many).
 
-    tools/wfenv python tools/reply_probe.py --profile off --calls 100
-    tools/wfenv python tools/reply_probe.py --profile on --calls 100
+    tools/wfenv python tools/reply_probe.py --profile off --calls 200 --goals 100
+    tools/wfenv python tools/reply_probe.py --profile on --calls 200 --goals 100
 
 ``--profile on`` gives the servers the workspace's Fast DDS profile (config/fastdds.xml:
 reply writers wait for the client's reader); ``off`` gives them none.
@@ -100,6 +101,16 @@ def tuner_call():
     return RetuneGait, f'{NAMESPACE}/retune_gait', request
 
 
+def goal_call():
+    """Return (action type, name, goal) of a small retune goal (its result comes either way)."""
+    from wirefish_msgs.action import RetuneGait
+    from wirefish_msgs.msg import BodyWaveSpec
+    goal = RetuneGait.Goal(seed=1, max_iterations=2, swarm_size=8, apply=False,
+                           use_library=False)
+    goal.wave = BodyWaveSpec(c1=0.15, c2=1.0, k=8.0, frequency_hz=1.0)
+    return RetuneGait, f'{NAMESPACE}/retune_gait', goal
+
+
 def cpg_call():
     """Return (service type, name, request) of a set_parameters call that changes nothing."""
     from rcl_interfaces.srv import SetParameters
@@ -109,29 +120,65 @@ def cpg_call():
     return SetParameters, f'{NAMESPACE}/cpg_node/set_parameters', request
 
 
+class _FreshParticipant:
+    """A context, node and executor of their own: one DDS participant, as one CLI call makes."""
+
+    def __enter__(self):
+        import rclpy
+        from rclpy.context import Context
+        from rclpy.executors import SingleThreadedExecutor
+        self.context = Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node('reply_probe', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        return self
+
+    def wait(self, future, timeout_s: float) -> bool:
+        """Spin until ``future`` is done or ``timeout_s`` passed; return whether it is done."""
+        self.executor.spin_until_future_complete(future, timeout_sec=timeout_s)
+        return future.done()
+
+    def __exit__(self, *_exc) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.context.try_shutdown()
+
+
 def fresh_call(kind, name: str, request, deadline_s: float, find_s: float):
-    """Make one call as the standard tools do; return its round trip (s), False or None."""
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
-    context = Context()
-    rclpy.init(context=context)
-    try:
-        node = rclpy.create_node('reply_probe', context=context)
-        executor = SingleThreadedExecutor(context=context)
-        executor.add_node(node)
-        client = node.create_client(kind, name)
+    """Make one call as `ros2 service call` does; return its round trip (s), False or None."""
+    with _FreshParticipant() as fresh:
+        client = fresh.node.create_client(kind, name)
         if not client.wait_for_service(timeout_sec=find_s):
             return None
         sent = time.monotonic()
-        future = client.call_async(request)
-        executor.spin_until_future_complete(future, timeout_sec=deadline_s)
-        result = time.monotonic() - sent if future.done() else False
-        executor.shutdown()
-        node.destroy_node()
-        return result
-    finally:
-        context.try_shutdown()
+        answered = fresh.wait(client.call_async(request), deadline_s)
+        return time.monotonic() - sent if answered else False
+
+
+def fresh_goal(kind, name: str, goal, deadline_s: float, find_s: float):
+    """
+    Send one goal as `ros2 action send_goal` does; return its round trip (s), False or None.
+
+    Two answers must come: the goal's acceptance (send_goal) and its result (get_result), each
+    within ``deadline_s``; a rejected goal counts as answered (the server said so).
+    """
+    from rclpy.action import ActionClient
+    with _FreshParticipant() as fresh:
+        client = ActionClient(fresh.node, kind, name)
+        try:
+            if not client.wait_for_server(timeout_sec=find_s):
+                return None
+            sent = time.monotonic()
+            accepted = client.send_goal_async(goal)
+            if not fresh.wait(accepted, deadline_s):
+                return False
+            handle = accepted.result()
+            if handle.accepted and not fresh.wait(handle.get_result_async(), deadline_s):
+                return False
+            return time.monotonic() - sent
+        finally:
+            client.destroy()
 
 
 @dataclass(frozen=True)
@@ -154,8 +201,8 @@ def run_batch(server: list[str], call, batch: Batch, env: dict[str, str], log) -
                 if proc is not None:
                     stop(proc)
                 proc = start(server, env, log)
-            kind, name, request = call()
-            outcome = fresh_call(kind, name, request, batch.deadline_s, batch.find_s)
+            make, (kind, name, request) = call[0], call[1]()
+            outcome = make(kind, name, request, batch.deadline_s, batch.find_s)
             if outcome is None:
                 tally.no_service += 1
             elif outcome is False:
@@ -180,7 +227,10 @@ def main(argv: list[str] | None = None) -> int:
                         help='an answer later than this (s) counts as unanswered')
     parser.add_argument('--find-timeout', type=float, default=30.0,
                         help='wait_for_service timeout (s)')
-    parser.add_argument('--services', default='tuner,cpg', help='tuner, cpg or both')
+    parser.add_argument('--services', default='tuner,goal,cpg',
+                        help='comma-separated batches: tuner (retune_gait service calls), goal '
+                        '(retune_gait action goals), cpg (set_parameters on cpg_node)')
+    parser.add_argument('--goals', type=int, default=100, help='action goals (goal batch)')
     parser.add_argument('--domain', type=int, default=77)
     parser.add_argument('--out', help="keep the servers' log here (default: a scratch dir)")
     parser.add_argument('--load-graphs', type=int, default=1,
@@ -188,8 +238,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     os.environ['ROS_DOMAIN_ID'] = str(args.domain)
     env = server_environment(args.profile == 'on', args.domain)
-    servers = {'tuner': (server_command('tuner_node'), tuner_call),
-               'cpg': (server_command('cpg_node'), cpg_call)}
+    servers = {'tuner': (server_command('tuner_node'), (fresh_call, tuner_call)),
+               'goal': (server_command('tuner_node'), (fresh_goal, goal_call)),
+               'cpg': (server_command('cpg_node'), (fresh_call, cpg_call))}
     with tempfile.TemporaryDirectory(prefix='reply_probe_') as scratch:
         out = args.out or scratch
         Path(out).mkdir(parents=True, exist_ok=True)
@@ -205,7 +256,8 @@ def _run(args, env: dict[str, str], servers, out: str) -> int:
         try:
             for label in args.services.split(','):
                 command, call = servers[label]
-                batch = Batch(args.calls, args.restart_every, args.deadline, args.find_timeout)
+                calls = args.goals if label == 'goal' else args.calls
+                batch = Batch(calls, args.restart_every, args.deadline, args.find_timeout)
                 tally = run_batch(command, call, batch, env, log)
                 print(tally.line(f'{label} profile {args.profile}'), flush=True)
         finally:

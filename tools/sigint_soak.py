@@ -2,6 +2,7 @@
 SIGINT a whole `wirefish up` graph many times in a row; say how fast every process stopped.
 
     tools/wfenv python tools/sigint_soak.py --runs 50 [--graphs 8] [--domain 90]
+        [--discovery-range LOCALHOST]
 
 Each round starts ``--graphs`` virtual-fish graphs at once (each its own namespace on one ROS
 domain, the way eight users of one machine would), waits until each says "running:", sends one
@@ -31,8 +32,8 @@ START_TIMEOUT_S = 180.0
 WATCH_S = 30.0
 
 
-def _start(index: int, domain: int, out: Path) -> subprocess.Popen:
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+def _start(index: int, domain: int, out: Path, discovery: str) -> subprocess.Popen:
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE=discovery,
                PYTHONUNBUFFERED='1')
     return subprocess.Popen(
         [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
@@ -61,9 +62,20 @@ def _gone(proc: psutil.Process) -> bool:
         return True
 
 
-def one_round(graphs: int, domain: int, out: Path) -> dict:
+def _name(proc: psutil.Process) -> str:
+    """Return a process's executable name (``python -m x``: x) for the round's line."""
+    try:
+        command = proc.cmdline()
+    except psutil.Error:
+        return '?'
+    if len(command) > 2 and command[1] == '-m':
+        return command[2]
+    return Path(command[1] if len(command) > 1 and 'python' in command[0] else command[0]).name
+
+
+def one_round(graphs: int, domain: int, out: Path, discovery: str) -> dict:
     """Start ``graphs`` graphs, SIGINT them, watch them stop; return the round's figures."""
-    launchers = [_start(k, domain, out / f'g{k}') for k in range(graphs)]
+    launchers = [_start(k, domain, out / f'g{k}', discovery) for k in range(graphs)]
     try:
         for launcher in launchers:
             _wait_running(launcher)
@@ -74,6 +86,7 @@ def one_round(graphs: int, domain: int, out: Path) -> dict:
             launcher.send_signal(signal.SIGINT)
         stopped_at: dict[int, float] = {}
         watched = [p for procs in children.values() for p in procs]
+        names = {p.pid: _name(p) for p in watched}
         while len(stopped_at) < len(watched) and time.monotonic() - sent < WATCH_S:
             for proc in watched:
                 if proc.pid not in stopped_at and _gone(proc):
@@ -88,7 +101,9 @@ def one_round(graphs: int, domain: int, out: Path) -> dict:
             reported += [item.split('=')[1] for item in line.split(': ', 1)[-1].split(', ')
                          if '=' in item]
         left = [p.pid for p in watched if not _gone(p)]
+        slowest = max(stopped_at, key=stopped_at.get, default=None)
         return {'processes': len(watched), 'slowest_s': max(stopped_at.values(), default=0.0),
+                'slowest': names.get(slowest, '-'),
                 'launcher_codes': codes, 'reported': reported, 'left': left, 'said': said}
     finally:  # a round that failed: the launchers stop their own processes, or all are killed
         for launcher in launchers:
@@ -112,25 +127,33 @@ def main() -> int:
     parser.add_argument('--graphs', type=int, default=1,
                         help='graphs started and stopped at once per round (default %(default)s)')
     parser.add_argument('--domain', type=int, default=90, help='ROS domain (default %(default)s)')
+    # LOCALHOST makes rmw_fastrtps use shared memory whatever FASTDDS_BUILTIN_TRANSPORTS says;
+    # SUBNET (rmw's default, what `wirefish up` gets unless the user sets a range) keeps UDPv4.
+    parser.add_argument('--discovery-range', choices=('LOCALHOST', 'SUBNET'), default='SUBNET',
+                        help='ROS_AUTOMATIC_DISCOVERY_RANGE of the graphs (default %(default)s)')
     parser.add_argument('--bound', type=float, default=3.0,
                         help='seconds every process must stop within (default %(default)s)')
     args = parser.parse_args()
     slowest, bad = [], 0
     with tempfile.TemporaryDirectory(prefix='wirefish_soak_') as tmp:
         for run in range(args.runs):
-            figures = one_round(args.graphs, args.domain, Path(tmp) / f'r{run}')
+            figures = one_round(args.graphs, args.domain, Path(tmp) / f'r{run}',
+                                args.discovery_range)
             clean = (set(figures['launcher_codes']) == {0} and set(figures['reported']) == {'0'}
                      and len(figures['reported']) == figures['processes'] and not figures['left']
                      and figures['slowest_s'] <= args.bound)
             bad += not clean
             slowest.append(figures['slowest_s'])
             print(f'round {run + 1}: {figures["processes"]} processes, slowest stop '
-                  f'{figures["slowest_s"]:.2f} s, launchers {figures["launcher_codes"]}, '
+                  f'{figures["slowest_s"]:.2f} s ({figures["slowest"]}), '
+                  f'launchers {figures["launcher_codes"]}, '
                   f'reported codes {sorted(set(figures["reported"]))}, left {figures["left"]}, '
                   f'load {os.getloadavg()[0]:.1f}{"" if clean else "  <-- NOT CLEAN"}',
                   flush=True)
-            if not clean:  # what the launcher said: who overran, the end of its log (stacks)
-                print('    ' + '\n    '.join(figures['said'][-60:]), flush=True)
+            if not clean:  # what the launcher said, and the end of the slowest one's log
+                logs = sorted(Path(tmp, f'r{run}').glob(f'g*/run_*/logs/{figures["slowest"]}.log'))
+                tail = logs[-1].read_text(errors='replace').splitlines()[-40:] if logs else []
+                print('    ' + '\n    '.join(figures['said'][-60:] + tail), flush=True)
     print(f'{args.runs} rounds of {args.graphs} graph(s): {args.runs - bad} clean; slowest stop '
           f'median {statistics.median(slowest):.2f} s, max {max(slowest):.2f} s '
           f'(bound {args.bound:g} s)')
