@@ -201,8 +201,8 @@ def run_batch(server: list[str], call, batch: Batch, env: dict[str, str], log) -
                 if proc is not None:
                     stop(proc)
                 proc = start(server, env, log)
-            make, (kind, name, request) = call[0], call[1]()
-            outcome = make(kind, name, request, batch.deadline_s, batch.find_s)
+            exchange, message = call
+            outcome = exchange(*message(), batch.deadline_s, batch.find_s)
             if outcome is None:
                 tally.no_service += 1
             elif outcome is False:
