@@ -9,15 +9,15 @@ import sys
 from mcap.reader import make_reader
 from mcap.records import Channel, DataEnd, Message
 from mcap.stream_reader import StreamReader
-from wirefish_bringup.bag_storage import READ_ERRORS, storage_files
-from wirefish_bringup.bagfile import read_bag
+from wirefish_bag.bag_storage import READ_ERRORS, storage_files
+from wirefish_bag.bagfile import read_bag
 import yaml
 
 
 def reindex_bag(bag_path: Path, env: dict[str, str] | None = None) -> str:
     """Run the documented repair step, `wirefish bag reindex BAG`; return what it printed."""
     result = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'bag', 'reindex', str(bag_path)],
+        [sys.executable, '-m', 'wirefish_cli.cli', 'bag', 'reindex', str(bag_path)],
         env=env, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stdout + result.stderr
     return result.stdout

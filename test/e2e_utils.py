@@ -35,7 +35,7 @@ def start_graph(domain_id: int, out_dir: Path, *options: str,
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
          '--namespace', namespace, '--out', str(out_dir), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)

@@ -33,7 +33,7 @@ def command(name: str, tmp_path: Path) -> list[str]:
     if name == 'cpg_node':  # busy: 1 kHz of callbacks while the signals arrive
         return [executable('wirefish_cpg', name), '--ros-args', '-p', 'publish_rate_hz:=1000.0']
     if name == 'tuner_node':
-        return [executable('wirefish_cpg', name)]
+        return [executable('wirefish_tuner', name)]
     if name == 'kinematics_node':
         return [executable('wirefish_kinematics', name)]
     if name == 'bridge_node':  # no device: the bridge keeps retrying, which is enough here
@@ -44,7 +44,7 @@ def command(name: str, tmp_path: Path) -> list[str]:
     if name == 'fish_sim':
         return [executable('wirefish_sim', name), '--ros', '--link', str(tmp_path / 'tty')]
     if name == 'wirefish_recorder':
-        return [executable('wirefish_bringup', 'wirefish'), 'record',
+        return [executable('wirefish_bag', 'recorder'),
                 '-o', str(tmp_path / 'bag'), '--namespace', '/h61_signals']
     raise ValueError(name)
 

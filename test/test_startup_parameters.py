@@ -17,7 +17,7 @@ def executable(package: str, name: str) -> str:
     ('wirefish_cpg', 'cpg_node', 'servo_limit_rad:=0.0', 'servo_limit_rad must be > 0'),
     ('wirefish_cpg', 'cpg_node', 'frequency_hz:=0.0', 'frequency_hz must be > 0'),
     ('wirefish_cpg', 'cpg_node', 'amplitude_1:=3.0', 'amplitude_1'),  # beyond the range
-    ('wirefish_cpg', 'tuner_node', 'swarm_size:=0', 'swarm_size'),
+    ('wirefish_tuner', 'tuner_node', 'swarm_size:=0', 'swarm_size'),
     ('wirefish_kinematics', 'kinematics_node', 'l1:=-0.08', 'l1'),
     ('wirefish_bridge', 'bridge_node', 'reconnect_backoff_max_s:=0.01',
      'reconnect_backoff_max_s must be >= reconnect_backoff_min_s'),
@@ -36,7 +36,7 @@ def test_a_node_refuses_to_start_on_invalid_values(ros_env, package, node, overr
     ('wirefish_bridge', 'bridge_node', 'baudrate:=115200.0', 'an integer',
      "a double '115200.0'"),
     ('wirefish_cpg', 'cpg_node', 'frequency_hz:=2', 'a double', "an integer '2'"),
-    ('wirefish_cpg', 'tuner_node', 'swarm_size:=true', 'an integer', "a bool 'True'"),
+    ('wirefish_tuner', 'tuner_node', 'swarm_size:=true', 'an integer', "a bool 'True'"),
     ('wirefish_kinematics', 'kinematics_node', 'l1:=long', 'a double', "a string 'long'"),
     ('wirefish_planner', 'planner_node', 'cmd_vel_timeout_s:=1', 'a double', "an integer '1'"),
 ])

@@ -29,10 +29,10 @@ case $- in *u*) _wf_nounset=1; set +u ;; *) _wf_nounset= ;; esac
 # shellcheck disable=SC1091
 source "$_wf_root/install/setup.bash"
 [ -n "$_wf_nounset" ] && set -u
-# The `wirefish` command (installed the ament way, under lib/wirefish_bringup) on PATH.
+# The `wirefish` command (installed the ament way, under lib/wirefish_cli) on PATH.
 case ":$PATH:" in
-  *":$_wf_root/install/wirefish_bringup/lib/wirefish_bringup:"*) ;;
-  *) export PATH="$_wf_root/install/wirefish_bringup/lib/wirefish_bringup:$PATH" ;;
+  *":$_wf_root/install/wirefish_cli/lib/wirefish_cli:"*) ;;
+  *) export PATH="$_wf_root/install/wirefish_cli/lib/wirefish_cli:$PATH" ;;
 esac
 # The Fast DDS profile of the graph (reply writers wait for a new client's reader; see
 # config/fastdds.xml); a value already set, even empty (no profile), is kept.

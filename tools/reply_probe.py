@@ -71,8 +71,9 @@ def executable(package: str, name: str) -> str:
 
 
 def server_command(name: str) -> list[str]:
-    """Return the command of one of the graph's servers (wirefish_cpg) in ``NAMESPACE``."""
-    return [executable('wirefish_cpg', name), '--ros-args', '-r', f'__ns:={NAMESPACE}']
+    """Return the command of one of the graph's servers (cpg_node, tuner_node) in ``NAMESPACE``."""
+    package = 'wirefish_tuner' if name == 'tuner_node' else 'wirefish_cpg'
+    return [executable(package, name), '--ros-args', '-r', f'__ns:={NAMESPACE}']
 
 
 def start(command: list[str], env: dict[str, str], log) -> subprocess.Popen:

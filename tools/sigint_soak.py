@@ -36,7 +36,7 @@ def _start(index: int, domain: int, out: Path, discovery: str) -> subprocess.Pop
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE=discovery,
                PYTHONUNBUFFERED='1')
     return subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
          '--namespace', f'/soak_{index}', '--out', str(out)],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)

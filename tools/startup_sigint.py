@@ -23,7 +23,7 @@ import time
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 import numpy as np
 
-NODES = (('wirefish_cpg', 'cpg_node'), ('wirefish_cpg', 'tuner_node'),
+NODES = (('wirefish_cpg', 'cpg_node'), ('wirefish_tuner', 'tuner_node'),
          ('wirefish_kinematics', 'kinematics_node'), ('wirefish_planner', 'planner_node'),
          ('wirefish_bridge', 'bridge_node'))
 EXIT_TIMEOUT_S = 30.0

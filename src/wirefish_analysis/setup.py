@@ -27,7 +27,7 @@ setup(
             'plot_body_wave = wirefish_analysis.plot_body_wave:main',
             'bench = wirefish_analysis.bench:main',
         ],
-        # Subcommands of the `wirefish` command that live here (see wirefish_bringup.cli).
+        # Subcommands of the `wirefish` command that live here (see wirefish_cli.cli).
         'wirefish.commands': [
             'sweep = wirefish_analysis.sweep',
             'identify-geometry = wirefish_analysis.identify_geometry',

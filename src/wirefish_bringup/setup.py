@@ -18,13 +18,7 @@ setup(
     zip_safe=True,
     maintainer='wirefish maintainers',
     maintainer_email='maintainers@wirefish.dev',
-    description='Launch files, default parameters and the wirefish command-line tool.',
+    description="The graph's registry, its launch file and default parameters.",
     license='Apache-2.0',
     tests_require=['pytest'],
-    entry_points={
-        'console_scripts': [
-            'wirefish = wirefish_bringup.cli:main',
-            'link_relay = wirefish_bringup.link_relay:main',
-        ],
-    },
 )

@@ -14,13 +14,12 @@ setup(
     zip_safe=True,
     maintainer='wirefish maintainers',
     maintainer_email='maintainers@wirefish.dev',
-    description='Ijspeert CPG node and PSO gait tuner service.',
+    description="The fish's Ijspeert CPG (eq 1): the cpg node, its gaits and the gait library.",
     license='Apache-2.0',
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
             'cpg_node = wirefish_cpg.cpg_node:main',
-            'tuner_node = wirefish_cpg.tuner_node:main',
         ],
     },
 )

@@ -11,8 +11,8 @@ from wirefish_analysis.identify_geometry import (evidence, GEOMETRY_KEYS, geomet
                                                  identify, LOWER, objective,
                                                  parameter_file_text, PARAMETERS, UPPER,
                                                  with_profiled_drag)
-from wirefish_cpg.pso import PsoOptions
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_tuner.pso import PsoOptions
 import yaml
 
 TODAY = np.array([0.08, 0.10, 0.06, 0.020, 0.012, 0.018, FishGeometry().drag_coefficient])
@@ -88,7 +88,7 @@ def test_the_command_prints_the_table_and_writes_the_file(tmp_path):
 
 
 def test_wirefish_identify_geometry_is_a_subcommand(tmp_path):
-    from wirefish_bringup import cli
+    from wirefish_cli import cli
 
     out = tmp_path / 'identified.yaml'
     assert cli.main(['identify-geometry', '--out', str(out), '--swarm', '3', '--iterations',

@@ -14,7 +14,7 @@ import time
 
 import pytest
 
-CLI = [sys.executable, '-m', 'wirefish_bringup.cli']
+CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 # command -> (exit code, what its one line says)
 REFUSED = {
     'up --port /etc/passwd': (['up', '--port', '/etc/passwd'], 2, 'is a regular file'),

@@ -4,7 +4,7 @@ import argparse
 import re
 
 import pytest
-from wirefish_bringup import cli
+from wirefish_cli import api, cli
 
 # What a user's help text must not say: a tracker's number, a Python tuple or None shown as is.
 _ISSUE = re.compile(r'\bissues?\s+\d+', re.IGNORECASE)
@@ -23,7 +23,7 @@ def _parsers(parser: argparse.ArgumentParser, path: str):
 def command_parsers() -> list[tuple[str, argparse.ArgumentParser]]:
     """Return every (command path, parser) of `wirefish`, each subcommand's module imported."""
     found = [('wirefish', cli.build_parser([]))]
-    for name in cli.subcommands():
+    for name in api.verbs():
         parser = cli.build_parser([name])
         found += [item for item in _parsers(parser, 'wirefish') if item[0].split()[1:2] == [name]]
     return found
@@ -66,3 +66,10 @@ def test_an_undescribed_option_is_found():
     parser.add_argument('--described', help='something')
     parser.add_argument('--bare')
     assert undescribed_options(parser) == ['--bare']
+
+
+def test_every_verb_of_the_workspace_is_registered_by_its_package():
+    assert set(api.verbs()) == {
+        'up', 'qemu', 'compose', 'twohost', 'record', 'bag', 'play', 'report', 'retune',
+        'hand-back', 'gaits', 'drive', 'mission', 'topic', 'param', 'sweep',
+        'identify-geometry', 'view'}

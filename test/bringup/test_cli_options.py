@@ -4,7 +4,7 @@ import os
 import subprocess
 
 import pytest
-from wirefish_bringup.supervisor import remove_stale_link
+from wirefish_launcher.supervisor import remove_stale_link
 
 
 @pytest.mark.parametrize('command', [
@@ -14,7 +14,7 @@ from wirefish_bringup.supervisor import remove_stale_link
 @pytest.mark.parametrize('duration', ['-1', '0', 'nan', 'inf', 'ten'])
 def test_a_duration_that_is_not_a_positive_finite_number_is_refused(
         tmp_path, python, ros_env, command, duration):
-    result = subprocess.run([python, '-m', 'wirefish_bringup.cli', *command, '--duration',
+    result = subprocess.run([python, '-m', 'wirefish_cli.cli', *command, '--duration',
                              duration], env=ros_env, cwd=tmp_path, capture_output=True,
                             text=True, timeout=60)
     assert result.returncode == 2

@@ -62,7 +62,7 @@ def test_arrow_keys_cut_across_reads_act_at_once_on_their_axis(
     executor, received = cmd_vel
     master, slave = terminal
     log = (tmp_path / 'drive.log').open('w')
-    drive = spawn([sys.executable, '-m', 'wirefish_bringup.cli', 'drive',
+    drive = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'drive',
                    '--namespace', NAMESPACE], stdin=slave, stdout=log, stderr=log)
     assert spin_until(executor, lambda: received, 30.0), 'drive sent no cmd_vel'
     assert received[-1] == (0.0, 0.0)

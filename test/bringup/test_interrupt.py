@@ -13,7 +13,7 @@ import threading
 
 import pytest
 
-CLI = [sys.executable, '-m', 'wirefish_bringup.cli']
+CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 LONG = {
     'sweep': ['sweep', '-o', '{tmp}/sweep'],
     'identify-geometry': ['identify-geometry', '--out', '{tmp}/geometry.yaml', '--starts', '2'],

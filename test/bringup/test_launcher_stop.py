@@ -29,7 +29,7 @@ def destroy_node_that_never_returns(self):
 
 
 rclpy.node.Node.destroy_node = destroy_node_that_never_returns
-from wirefish_bringup.cli import main  # noqa: E402
+from wirefish_cli.cli import main  # noqa: E402
 sys.exit(main(sys.argv[1:]))
 """
 START_TIMEOUT_S = 90.0

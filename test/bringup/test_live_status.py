@@ -12,7 +12,7 @@ def test_the_status_counts_streams_shows_latched_state_and_hides_action_topics(r
     import rclpy
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from std_msgs.msg import String
-    from wirefish_bringup.status_view import LiveStatus
+    from wirefish_launcher.status_view import LiveStatus
 
     publisher_node = rclpy.create_node('publishers', namespace=NAMESPACE, context=ros_context)
     watcher = rclpy.create_node('watcher', namespace=NAMESPACE, context=ros_context)

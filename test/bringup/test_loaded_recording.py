@@ -27,7 +27,7 @@ HOG = 'import os\nos.nice(19)\nwhile True:\n    pass\n'
 
 
 def _graph(spawn, python, namespace: str, out: Path):
-    return spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+    return spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                   '--namespace', namespace, '--out', str(out)])
 
 
@@ -51,7 +51,7 @@ def test_a_loaded_recording_loses_nothing_lags_little_and_drains(tmp_path, spawn
         spawn([python, '-c', HOG])
     bag = tmp_path / 'bag'
     result = subprocess.run(
-        [python, '-m', 'wirefish_bringup.cli', 'record', '-o', str(bag), '--namespace',
+        [python, '-m', 'wirefish_cli.cli', 'record', '-o', str(bag), '--namespace',
          RECORDED, '--duration', str(DURATION_S)],
         env=ros_env, capture_output=True, text=True, timeout=DURATION_S + 90)
     print(result.stdout)

@@ -6,9 +6,9 @@ import threading
 import time
 
 import pytest
-from wirefish_bringup.play_command import remapped
+from wirefish_bag.play_command import remapped
 
-CLI = [sys.executable, '-m', 'wirefish_bringup.cli']
+CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 COUNT = 40
 
 

@@ -5,8 +5,8 @@ import subprocess
 
 import numpy as np
 import pytest
-from wirefish_bringup.bagfile import read_bag
-from wirefish_bringup.report import topic_stats, write_report
+from wirefish_bag.bagfile import read_bag
+from wirefish_bag.report import topic_stats, write_report
 
 PEERS = str(Path(__file__).resolve().parents[1] / 'ros_peers.py')
 pytestmark = pytest.mark.ros
@@ -17,7 +17,7 @@ def test_recorded_bag_holds_every_published_message(tmp_path, spawn, python, ros
     assert talker.stdout.readline().strip() == 'ready'
     bag_path = tmp_path / 'bag'
     result = subprocess.run(
-        [python, '-m', 'wirefish_bringup.cli', 'record', '-o', str(bag_path),
+        [python, '-m', 'wirefish_cli.cli', 'record', '-o', str(bag_path),
          '--namespace', '/wf_test', '--duration', '3'],
         env=ros_env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
@@ -41,7 +41,7 @@ def test_report_writes_summary_from_a_bag(tmp_path, spawn, python, ros_env):
     talker = spawn([python, PEERS, 'body_wave_talker', '--ros-args', '-r', '__ns:=/wf_test'])
     assert talker.stdout.readline().strip() == 'ready'
     bag_path = tmp_path / 'bag'
-    subprocess.run([python, '-m', 'wirefish_bringup.cli', 'record', '-o', str(bag_path),
+    subprocess.run([python, '-m', 'wirefish_cli.cli', 'record', '-o', str(bag_path),
                     '--namespace', '/wf_test', '--duration', '2'],
                    env=ros_env, capture_output=True, text=True, timeout=60, check=True)
     stats = write_report(bag_path, tmp_path / 'report')

@@ -20,9 +20,9 @@ import numpy as np
 import psutil
 import pytest
 from ros_utils import spin_until, stop_process
-from wirefish_bringup.bag_storage import read_file_info, storage_files
-from wirefish_bringup.bag_writer import BagFileWriter
-from wirefish_bringup.bagfile import read_bag
+from wirefish_bag.bag_storage import read_file_info, storage_files
+from wirefish_bag.bag_writer import BagFileWriter
+from wirefish_bag.bagfile import read_bag
 from wirefish_bringup.graph import expected_rates
 import yaml
 
@@ -31,7 +31,7 @@ KILL_MARGIN_S = 1.0
 
 
 def _record(namespace: str, bag: Path, *options: str) -> list[str]:
-    return [sys.executable, '-m', 'wirefish_bringup.cli', 'record', '--namespace', namespace,
+    return [sys.executable, '-m', 'wirefish_cli.cli', 'record', '--namespace', namespace,
             '-o', str(bag), *options]
 
 
@@ -139,7 +139,7 @@ def test_a_clean_stop_writes_a_finished_bag(tmp_path, spawn, talker_namespace, l
     # The talker's publisher as it offered itself: rclpy's default, reliable and volatile.
     assert [(q['reliability'], q['durability']) for q in topic['offered_qos_profiles']] == \
         [('reliable', 'volatile')]
-    result = subprocess.run([sys.executable, '-m', 'wirefish_bringup.cli', 'bag', 'info',
+    result = subprocess.run([sys.executable, '-m', 'wirefish_cli.cli', 'bag', 'info',
                              str(bag)], env=ros_env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert f'Count: {info.message_count}' in result.stdout
@@ -161,7 +161,7 @@ def _read_until(proc: subprocess.Popen, prefix: str, timeout_s: float) -> list[s
 def _up_recording(spawn, python, namespace: str, out: Path, duration_s: int
                   ) -> tuple[subprocess.Popen, Path, psutil.Process]:
     """Start `wirefish up --duration`; return it, its bag and its recorder, once it flushed."""
-    launcher = spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+    launcher = spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                       '--namespace', namespace, '--out', str(out), '--duration', str(duration_s)])
     lines = _read_until(launcher, 'recording to', 120.0)
     assert lines and lines[-1].startswith('recording to'), ''.join(lines)

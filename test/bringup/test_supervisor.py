@@ -15,7 +15,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
 from wirefish_bringup.graph import NO_RESTART, NodeSpec, RestartPolicy
-from wirefish_bringup.supervisor import ProcessExitedError, Supervisor
+from wirefish_launcher.supervisor import ProcessExitedError, Supervisor
 
 pytestmark = pytest.mark.ros
 

@@ -10,7 +10,7 @@ import time
 import pytest
 
 NAMESPACE = '/topic_param'
-CLI = [sys.executable, '-m', 'wirefish_bringup.cli']
+CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 
 
 @pytest.fixture

@@ -12,9 +12,9 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_utils import spin_until
 
-PREFIX = get_package_prefix('wirefish_cpg')
-CPG_NODE = os.path.join(PREFIX, 'lib', 'wirefish_cpg', 'cpg_node')
-TUNER_NODE = os.path.join(PREFIX, 'lib', 'wirefish_cpg', 'tuner_node')
+CPG_NODE = os.path.join(get_package_prefix('wirefish_cpg'), 'lib', 'wirefish_cpg', 'cpg_node')
+TUNER_NODE = os.path.join(get_package_prefix('wirefish_tuner'), 'lib', 'wirefish_tuner',
+                          'tuner_node')
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 WAIT_S = 30.0  # generous limit for discovery and answers on a busy 2-core machine

@@ -10,7 +10,7 @@ from wirefish_cpg.gait_library import load_library
 
 def gaits(python: str, library, *options: str) -> subprocess.CompletedProcess:
     action, *rest = options
-    return subprocess.run([python, '-m', 'wirefish_bringup.cli', 'gaits', action, '--library',
+    return subprocess.run([python, '-m', 'wirefish_cli.cli', 'gaits', action, '--library',
                            str(library), *rest], capture_output=True, text=True, timeout=300)
 
 
@@ -59,7 +59,7 @@ def test_plot_writes_the_speed_png(built, python_module, tmp_path):
 
 def test_plot_writes_into_out_by_default(built, tmp_path):
     library, _ = built
-    result = subprocess.run([sys.executable, '-m', 'wirefish_bringup.cli', 'gaits', 'plot',
+    result = subprocess.run([sys.executable, '-m', 'wirefish_cli.cli', 'gaits', 'plot',
                              '--library', str(library)], capture_output=True, text=True,
                             timeout=300, cwd=tmp_path)
     assert result.returncode == 0, result.stderr

@@ -1,7 +1,7 @@
 """
 GoalSender against a real tuner: a goal whose answer is lost is adopted from the status.
 
-rmw_fastrtps can drop the answer to a goal (see wirefish_bringup.goal_sender). The test loses
+rmw_fastrtps can drop the answer to a goal (see wirefish_operator.goal_sender). The test loses
 it on purpose: the goal goes to the tuner, but the client is handed a future that is never
 answered. The sender must find the goal in the tuner's status array, adopt it without sending
 it again, and get its result.
@@ -14,9 +14,9 @@ import pytest
 from rclpy.action import ActionClient
 from rclpy.task import Future
 from ros_utils import spin_until
-from wirefish_bringup.goal_sender import GoalSender
 from wirefish_msgs.action import RetuneGait as RetuneGaitAction
 from wirefish_msgs.msg import BodyWaveSpec
+from wirefish_operator.goal_sender import GoalSender
 
 pytestmark = pytest.mark.ros
 WAIT_S = 30.0

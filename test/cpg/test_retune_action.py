@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from rclpy.action import ActionClient
 from ros_utils import spin_until
-from wirefish_bringup.goal_sender import GoalSender
 from wirefish_common.qos import reliable
 from wirefish_cpg.gait_library import Gait, GaitLibrary, load_library, save_library
 from wirefish_msgs.action import RetuneGait as RetuneGaitAction
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
+from wirefish_operator.goal_sender import GoalSender
 
 # Any test of this module has been seen, once, to lose the first goal's answer after the tuner
 # starts (rmw_fastrtps: the response sent before the client's reader is matched), and to pass

@@ -10,7 +10,7 @@ NAMESPACE = '/wf_cli'
 
 
 def command(python: str, *options: str) -> list[str]:
-    return [python, '-m', 'wirefish_bringup.cli', 'retune', '--namespace', NAMESPACE,
+    return [python, '-m', 'wirefish_cli.cli', 'retune', '--namespace', NAMESPACE,
             '--timeout', '60', *options]
 
 

@@ -14,7 +14,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
 from wirefish_bringup.graph import expected_rates
-from wirefish_bringup.monitor import measure_rates
+from wirefish_launcher.monitor import measure_rates
 
 pytestmark = pytest.mark.ros
 EXPECTED_RATES_HZ, _ = expected_rates(sim=True)  # the registry's streams

@@ -39,7 +39,7 @@ def occupied(spawn, ros_context, request) -> str:
 
 def test_up_in_a_namespace_in_use_refuses_with_one_line_and_starts_nothing(
         occupied, python, ros_env, tmp_path):
-    result = subprocess.run([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+    result = subprocess.run([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                              '--namespace', occupied, '--out', str(tmp_path / 'out')],
                             env=ros_env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 1
@@ -52,7 +52,7 @@ def test_up_in_a_namespace_in_use_refuses_with_one_line_and_starts_nothing(
 
 
 def test_allow_duplicate_starts_the_graph_anyway(occupied, python, ros_env, spawn, tmp_path):
-    launcher = spawn([python, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+    launcher = spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                       '--allow-duplicate', '--namespace', occupied, '--out', str(tmp_path)])
     seen = []
     for line in launcher.stdout:

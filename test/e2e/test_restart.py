@@ -38,8 +38,8 @@ from rclpy.serialization import deserialize_message
 from ros_utils import stop_process
 from sensor_msgs.msg import JointState
 from wirefish_bringup.graph import default_params_file, entries, expected_rates, fish_graph
-from wirefish_bringup.monitor import StreamLog
-from wirefish_bringup.topics import message_class
+from wirefish_common.topics import message_class
+from wirefish_launcher.monitor import StreamLog
 from wirefish_msgs.srv import RetuneGait
 import yaml
 
@@ -317,7 +317,7 @@ def _params_with(tmp_path: Path, node: str, key: str, value) -> Path:
 def _up(ros_env: dict[str, str], tmp_path: Path, namespace: str, params: Path
         ) -> subprocess.Popen:
     return subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
          '--namespace', namespace, '--out', str(tmp_path / 'out'), '--params-file', str(params)],
         env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)

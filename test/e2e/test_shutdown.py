@@ -43,7 +43,7 @@ def test_sigint_during_start_up_stops_every_process_cleanly(e2e_domain_id, tmp_p
     env = dict(os.environ, ROS_DOMAIN_ID=str(e2e_domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--namespace',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--namespace',
          '/e2e_sigint_starting', '--out', str(tmp_path)],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)

@@ -18,7 +18,7 @@ def test_retune_with_apply_succeeds_when_all_nodes_share_one_process(e2e_domain_
                         namespace='/e2e_single_process')
     try:
         result = subprocess.run(
-            [sys.executable, '-m', 'wirefish_bringup.cli', 'retune', '--namespace',
+            [sys.executable, '-m', 'wirefish_cli.cli', 'retune', '--namespace',
              graph.namespace, '--apply', '--iterations', '30', '--timeout', '60'],
             env=graph.env, capture_output=True, text=True, timeout=120)
     finally:

@@ -18,10 +18,10 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
 from ros_utils import spin_until
 from sensor_msgs.msg import JointState
-from wirefish_bringup.bagfile import read_bag
+from wirefish_bag.bagfile import read_bag
+from wirefish_bag.report import topic_stats
 from wirefish_bringup.graph import expected_rates
-from wirefish_bringup.monitor import measure_rates
-from wirefish_bringup.report import topic_stats
+from wirefish_launcher.monitor import measure_rates
 from wirefish_msgs.srv import RetuneGait
 
 pytestmark = pytest.mark.ros
@@ -112,7 +112,7 @@ def _zero_crossing_hz(trace: np.ndarray) -> float:
 def test_ten_second_recording_loses_nothing(running_graph, tmp_path):
     bag_path = tmp_path / 'bag'
     result = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'record', '-o', str(bag_path),
+        [sys.executable, '-m', 'wirefish_cli.cli', 'record', '-o', str(bag_path),
          '--namespace', running_graph.namespace, '--duration', '10'],
         env=running_graph.env, capture_output=True, text=True, timeout=90)
     assert result.returncode == 0, result.stderr
@@ -149,7 +149,7 @@ def test_a_second_wirefish_up_in_its_namespace_refuses_and_nothing_doubles(
         running_graph, graph_node, tmp_path):
     node, executor = graph_node
     result = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
          '--namespace', running_graph.namespace, '--out', str(tmp_path)],
         env=running_graph.env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 1, result.stdout + result.stderr

@@ -21,8 +21,8 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import JointState
-from wirefish_bringup.errors import QemuBoardError
-from wirefish_bringup.qemu_board import build_image, QemuBoard
+from wirefish_launcher.errors import QemuBoardError
+from wirefish_launcher.qemu_board import build_image, QemuBoard
 
 BRIDGE = Path(get_package_prefix('wirefish_bridge')) / 'lib' / 'wirefish_bridge' / 'bridge_node'
 

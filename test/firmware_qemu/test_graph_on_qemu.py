@@ -24,7 +24,7 @@ from rclpy.qos import qos_profile_sensor_data
 from ros_utils import spin_until, stop_process
 from sensor_msgs.msg import JointState
 from wirefish_bringup.graph import entry
-from wirefish_bringup.monitor import measure_rates
+from wirefish_launcher.monitor import measure_rates
 
 pytestmark = pytest.mark.ros
 
@@ -71,7 +71,7 @@ def qemu_graph(tmp_path_factory) -> Iterator[QemuGraph]:
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--fish', 'qemu', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fish', 'qemu', '--no-status',
          '--namespace', NAMESPACE, '--out', str(tmp_path_factory.mktemp('qemu_run'))],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
@@ -119,7 +119,7 @@ def _full(topic: str) -> str:
 def test_without_a_firmware_tree_wirefish_up_fails_with_one_line(tmp_path):
     env = dict(os.environ, WIREFISH_FIRMWARE_DIR=str(tmp_path / 'nowhere'))
     result = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--fish', 'qemu', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fish', 'qemu', '--no-status',
          '--namespace', '/qemu_missing', '--out', str(tmp_path)],
         env=env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 1, result.stdout + result.stderr

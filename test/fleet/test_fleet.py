@@ -14,7 +14,7 @@ import time
 
 from bag_utils import assert_bag_readable
 import pytest
-from wirefish_bringup.bagfile import read_bag
+from wirefish_bag.bagfile import read_bag
 
 pytestmark = pytest.mark.ros
 
@@ -37,7 +37,7 @@ def _frames(msg) -> tuple[str, ...]:
 
 def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_env,
                                                                    tmp_path):
-    up = spawn([sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--fleet', '3',
+    up = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fleet', '3',
                 '--namespace', BASE, '--duration', str(DURATION_S), '--no-status',
                 '--out', str(tmp_path)])
     deadline = time.monotonic() + UP_TIMEOUT_S
@@ -51,7 +51,7 @@ def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_en
         pytest.fail('wirefish up ended before recording:\n' + ''.join(lines))
     time.sleep(3.0)
     retune = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'retune', '--apply', '--namespace',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'retune', '--apply', '--namespace',
          f'{BASE}/{RETUNED}', '--freq', '1.3', '--iterations', '20', '--swarm', '20',
          '--timeout', '60'], env=ros_env, capture_output=True, text=True, timeout=90)
     print(retune.stdout[-800:], retune.stderr[-400:])

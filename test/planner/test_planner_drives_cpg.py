@@ -121,7 +121,7 @@ def test_a_fit_set_on_the_cpg_is_a_manual_override_the_planner_says_and_keeps(gr
 
     # `wirefish hand-back` (cpg_node/follow_commands) gives the gait back to the planner.
     hand_back = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'hand-back', '--namespace', NAMESPACE],
+        [sys.executable, '-m', 'wirefish_cli.cli', 'hand-back', '--namespace', NAMESPACE],
         env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert spin_until(executor, lambda: hand_back.poll() is not None, WAIT_S)
     out, err = hand_back.communicate()
@@ -187,7 +187,7 @@ def test_a_command_the_cpg_refused_is_said_by_the_planner(ros_context):
 
 def test_hand_back_without_a_graph_says_so(ros_env):
     done = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'hand-back', '--namespace', '/h24_none',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'hand-back', '--namespace', '/h24_none',
          '--timeout', '1'], env=ros_env, capture_output=True, text=True, timeout=60)
     assert done.returncode == 1
     assert 'no /h24_none/cpg_node/follow_commands service' in done.stderr

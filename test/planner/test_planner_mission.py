@@ -17,7 +17,7 @@ import pytest
 def test_square_mission_is_recorded_and_reported(planner_graph, tmp_path):
     out = tmp_path / 'square'
     proc = subprocess.run(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'mission', 'square', '--namespace',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'mission', 'square', '--namespace',
          planner_graph.namespace, '-o', str(out)],
         env=planner_graph.env, capture_output=True, text=True, timeout=180)
     print(proc.stdout, proc.stderr)

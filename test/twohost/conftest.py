@@ -1,7 +1,7 @@
 """
 Fixtures of the two-host tests: a fish host and a shore host in two network namespaces.
 
-The pair (``wirefish_bringup.netns.TwoHosts``) is made for each test and deleted at its end,
+The pair (``wirefish_launcher.netns.TwoHosts``) is made for each test and deleted at its end,
 also when it fails; its names carry ``wf`` and a token of this run, its addresses are
 10.213.<(WIREFISH_TEST_DOMAIN_BASE + n) % 256>.1/.2 for the n-th pair. Making namespaces needs
 root: elsewhere every test here is skipped with the reason (CI runs as root, so they run
@@ -28,7 +28,7 @@ def hosts(request: pytest.FixtureRequest, tmp_path) -> Iterator[Hosts]:
     DDS discovery across the pair is multicast unless the test asks for ``netns.STATIC``
     (``@pytest.mark.parametrize('hosts', [STATIC], indirect=True)``).
     """
-    from wirefish_bringup.netns import MULTICAST, root_problem, TwoHosts
+    from wirefish_launcher.netns import MULTICAST, root_problem, TwoHosts
 
     problem = root_problem()
     if problem is not None:

@@ -41,7 +41,7 @@ def _print(line: dict) -> None:
 
 def main(argv: list[str]) -> int:
     from geometry_msgs.msg import Twist
-    from wirefish_bringup.topics import message_class
+    from wirefish_common.topics import message_class
 
     namespace, specs = argv[0], [a.split(':') for a in argv[1:]]
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)

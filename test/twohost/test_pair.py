@@ -11,7 +11,7 @@ import subprocess
 import sys
 
 import pytest
-from wirefish_bringup.netns import FISH, MULTICAST, MULTICAST_ROUTE, SHORE, STATIC
+from wirefish_launcher.netns import FISH, MULTICAST, MULTICAST_ROUTE, SHORE, STATIC
 
 pytestmark = pytest.mark.ros
 

@@ -20,9 +20,9 @@ import time
 import numpy as np
 import pytest
 from twohost.link_hosts import wait_for
-from wirefish_bringup.crossing import default_crossing_file, load_crossing
-from wirefish_bringup.netns import FISH, SHORE
 from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
+from wirefish_launcher.netns import FISH, SHORE
+from wirefish_relay.crossing import default_crossing_file, load_crossing
 
 pytestmark = pytest.mark.ros
 

@@ -29,7 +29,7 @@ def _listening(pid: int, ports: set[int], timeout_s: float) -> set[str]:
     (('--address', '0.0.0.0'), '0.0.0.0', True)])
 def test_the_view_binds_where_it_is_told_and_warns_when_wider(spawn, options, address, warned):
     ws_port, http_port = free_port(), free_port()
-    view = spawn([sys.executable, '-m', 'wirefish_bringup.cli', 'view', '--namespace',
+    view = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'view', '--namespace',
                   '/view_command', '--port', str(ws_port), '--http-port', str(http_port),
                   *options])
     assert _listening(view.pid, {ws_port, http_port}, 30.0) == {address}

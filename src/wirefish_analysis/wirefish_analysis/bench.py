@@ -47,11 +47,11 @@ def machine() -> dict:
 
 def recording(duration_s: float, domain_id: int) -> dict:
     """Run the whole graph with `wirefish up --duration`, then count what reached the bag."""
-    from wirefish_bringup.report import write_report
+    from wirefish_bag.report import write_report
 
     out = Path(tempfile.mkdtemp(prefix='wirefish_bench_rec_'))
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-    subprocess.run([sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--no-status',
+    subprocess.run([sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                     '--duration', str(duration_s), '--out', str(out), '--namespace',
                     '/bench_rec'], env=env, check=True, capture_output=True,
                    timeout=duration_s + 120)

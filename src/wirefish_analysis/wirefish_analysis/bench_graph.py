@@ -18,8 +18,8 @@ import numpy as np
 import psutil
 
 from wirefish_bringup.graph import fish_graph, NodeSpec
-from wirefish_bringup.supervisor import Supervisor, wait_for_path
 from wirefish_common.executors import EVENTS, EXECUTOR_VARIABLE, make_executor
+from wirefish_launcher.supervisor import Supervisor, wait_for_path
 
 READY_TIMEOUT_S = 60.0
 

@@ -1,7 +1,7 @@
 """
 Benchmark: bytes per second crossing the fish-shore radio link, per discovery mode.
 
-A fish host and a shore host in two network namespaces (``wirefish_bringup.netns``, root
+A fish host and a shore host in two network namespaces (``wirefish_launcher.netns``, root
 only), ``wirefish up --role fish`` on one and ``wirefish up --role shore --duration`` on the
 other (the shore records its copies of the crossing topics: config/crossing.yaml). Once the
 shore records, the transmit counters of both veth ends are read over a window, first as is,
@@ -32,7 +32,7 @@ LIMIT_BYTES_S = 100_000 / 8
 
 
 def _window(link, seconds: float) -> dict:
-    from wirefish_bringup.netns import FISH, SHORE
+    from wirefish_launcher.netns import FISH, SHORE
 
     before, t0 = (link.tx_bytes(FISH), link.tx_bytes(SHORE)), time.monotonic()
     time.sleep(seconds)
@@ -51,8 +51,8 @@ def _wait_for_line(proc: subprocess.Popen, start: str, what: str) -> None:
 
 def measure(discovery: str, domain_id: int, subnet: int) -> dict:
     """Return the bytes crossing each way, unshaped and under the limit, for one discovery."""
-    from wirefish_bringup.bagfile import read_bag
-    from wirefish_bringup.netns import FISH, SHORE, TwoHosts
+    from wirefish_bag.bagfile import read_bag
+    from wirefish_launcher.netns import FISH, SHORE, TwoHosts
 
     link = TwoHosts(f'b{os.getpid() % 10**6:x}', subnet)
     out = Path(tempfile.mkdtemp(prefix='wirefish_bench_radio_'))
@@ -65,7 +65,7 @@ def measure(discovery: str, domain_id: int, subnet: int) -> dict:
             env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                        **link.ros_environment(side, discovery))
             proc = subprocess.Popen(
-                [*link.exec_prefix(side), sys.executable, '-m', 'wirefish_bringup.cli', 'up',
+                [*link.exec_prefix(side), sys.executable, '-m', 'wirefish_cli.cli', 'up',
                  '--role', side, '--namespace', NAMESPACE, '--no-status', '--out',
                  str(out / side), *extra], env=env, stdout=subprocess.PIPE,
                 stderr=subprocess.STDOUT, text=True, start_new_session=True)
@@ -109,7 +109,7 @@ def measure(discovery: str, domain_id: int, subnet: int) -> dict:
 
 def run(domain_id: int = 101, subnet: int = 250) -> dict:
     """Measure both discoveries; without root say why nothing was measured."""
-    from wirefish_bringup.netns import MULTICAST, root_problem, STATIC
+    from wirefish_launcher.netns import MULTICAST, root_problem, STATIC
 
     problem = root_problem()
     if problem is not None:

@@ -9,7 +9,7 @@ temporary directory that goes first on its PYTHONPATH (nothing of it stays impor
 workspace). A second figure is the encoders alone: CPU per message written of the old
 hand-written writer, ``mcap``'s Writer (the recorder's) and foxglove-sdk's, on the same
 serialised servo_cmd and imu/data messages with a flush every 200 messages (why the recorder
-does not use the cheapest one: wirefish_bringup.bag_writer). ``python -m
+does not use the cheapest one: wirefish_bag.bag_writer). ``python -m
 wirefish_analysis.bench_recorder`` prints the JSON.
 """
 
@@ -91,7 +91,7 @@ def recorders(domain_id: int, warm_up_s: float = WARM_UP_S,
 
         def start(name: str, args: list[str], proc_env: dict) -> None:
             procs[name] = subprocess.Popen(
-                [sys.executable, '-m', 'wirefish_bringup.cli', *args], env=proc_env,
+                [sys.executable, '-m', 'wirefish_cli.cli', *args], env=proc_env,
                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                 start_new_session=True)
         try:
@@ -134,8 +134,8 @@ def _cpu_per_message_us(write, flush, messages: list[tuple[Any, bytes]]) -> floa
 
 def _writer_costs(directory: Path) -> dict[str, float]:
     """Return CPU us per message of the writers this path holds (the old one, or the others)."""
-    from wirefish_bringup.bag_storage import add_topic
-    from wirefish_bringup.bagfile import wirefish_typestore
+    from wirefish_bag.bag_storage import add_topic
+    from wirefish_bag.bagfile import wirefish_typestore
 
     store = wirefish_typestore()
     typed = _serialised_messages()
@@ -149,7 +149,7 @@ def _writer_costs(directory: Path) -> dict[str, float]:
         costs['hand-written (old)'] = _cpu_per_message_us(old.write, old.flush, old_messages)
         old.close()
     except ImportError:
-        from wirefish_bringup.bag_writer import BagFileWriter
+        from wirefish_bag.bag_writer import BagFileWriter
         new = BagFileWriter(directory / 'mcap.mcap')
         new_messages = [(add_topic(new, store, f'/t{i}', t, ''), d)
                         for i, (t, d) in enumerate(typed)]

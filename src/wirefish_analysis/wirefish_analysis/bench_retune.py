@@ -1,12 +1,12 @@
 """
 Benchmark: one retune of the section 5.2 case, ours against the obvious implementation.
 
-Ours: ``wirefish_cpg.tuning.fit_gait`` with the tuner's defaults (40 particles, at most 100
+Ours: ``wirefish_tuner.tuning.fit_gait`` with the tuner's defaults (40 particles, at most 100
 iterations, stall stop), closed-form steady state of eq 1, whole swarm per array operation.
 Baseline ("the obvious way"): pyswarms' GlobalBestPSO with the same bounds, swarm size,
 inertia and learning factors, run for the same number of iterations as ours took, whose
 objective integrates eq 1 particle by particle (plain RK4 loop, 2 ms step, 3 s to settle,
-``wirefish_cpg.reference_loss``) and scores the last cycle with the same loss definition.
+``wirefish_tuner.reference_loss``) and scores the last cycle with the same loss definition.
 Both final positions are then scored with the exact loss, so "equal or better final loss" is
 judged on one ruler. pyswarms draws from NumPy's global RNG, so the baseline seeds it.
 
@@ -27,11 +27,11 @@ import sys
 import time
 
 import numpy as np
-from wirefish_cpg.pso import PsoOptions
-from wirefish_cpg.reference_loss import simulated_body_wave_loss
-from wirefish_cpg.tuning import fit_gait
-from wirefish_cpg.wave_loss import (body_wave_loss, PAPER_LOWER, PAPER_UPPER,
-                                    swing_angle_rmse_deg, WaveFitProblem)
+from wirefish_tuner.pso import PsoOptions
+from wirefish_tuner.reference_loss import simulated_body_wave_loss
+from wirefish_tuner.tuning import fit_gait
+from wirefish_tuner.wave_loss import (body_wave_loss, PAPER_LOWER, PAPER_UPPER,
+                                      swing_angle_rmse_deg, WaveFitProblem)
 
 PAPER_RMSE_DEG = (1.7165, 1.2817)
 
@@ -184,7 +184,7 @@ def gaits_build(workers: int | None = None) -> dict:
     import tempfile
 
     with tempfile.TemporaryDirectory() as scratch:
-        command = [sys.executable, '-m', 'wirefish_bringup.cli', 'gaits', 'build', '--library',
+        command = [sys.executable, '-m', 'wirefish_cli.cli', 'gaits', 'build', '--library',
                    str(Path(scratch) / 'gaits.yaml'), '--workers',
                    str(workers or os.cpu_count() or 1)]
         start = time.perf_counter()

@@ -60,7 +60,7 @@ def _start_graph(domain_id: int, out: Path, ws_port: int, http_port: int
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_bringup.cli', 'up', '--sim', '--view', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--view', '--no-status',
          '--namespace', NAMESPACE, '--out', str(out), '--params-file', str(params)],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)

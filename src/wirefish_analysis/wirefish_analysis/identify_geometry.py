@@ -17,7 +17,7 @@ Figs 9-10 amplitudes   Table 1's tail-tip half amplitude at 1 Hz       inside 4-
 =====================  ==============================================  ==================
 
 The objective is the sum of squared (miss / tolerance): one unit is one tolerance on one piece
-of evidence. The literal mode is the paper's problem (``wirefish_cpg.wave_loss``: v = 1 Hz,
+of evidence. The literal mode is the paper's problem (``wirefish_tuner.wave_loss``: v = 1 Hz,
 eq 1 from rest, window 20-25 s, theta-bar 'axial', the tail-ward wave). The tolerances: the
 paper prints its RMSE to 4 decimals but not its theta-bar or window (the two theta-bar readings
 differ by ~0.1 deg for Table 1); Table 1 is printed to 2 decimals; 0.045 m/s is the paper's
@@ -48,11 +48,11 @@ from wirefish_analysis.calibrate_drag import (calibrated_drag_coefficient, CALIB
                                               CALIBRATION_SPEED, least_squares_drag)
 from wirefish_common.progress import Progress
 from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.pso import minimise, PsoOptions
 from wirefish_cpg.table1_gait import locked_speed_estimate, table1_locked_at, tip_half_amplitude
-from wirefish_cpg.wave_loss import (literal_body_wave_loss, literal_swing_rmse_deg,
-                                    position_of, WaveFitProblem)
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_tuner.pso import minimise, PsoOptions
+from wirefish_tuner.wave_loss import (literal_body_wave_loss, literal_swing_rmse_deg,
+                                      position_of, WaveFitProblem)
 
 PARAMETERS = ('l1', 'l2', 'l3', 'r1', 'r2', 'rd', 'drag_coefficient')
 LENGTHS = PARAMETERS[:6]

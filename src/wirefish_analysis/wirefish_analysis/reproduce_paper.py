@@ -6,7 +6,7 @@ c1 = 0.15, c2 = 1, k = 8, omega = 2 pi (alpha = 20, b = 0, default geometry) wit
 PSO twice, from the same seed, swarm and iteration budget:
 
 * literal: the paper's problem (v = 1 Hz, eq 1 from rest, the same clock in eq 23 and the CPG,
-  eq 24 over [t_s, t_o] = [20, 25] s; ``wirefish_cpg.wave_loss``);
+  eq 24 over [t_s, t_o] = [20, 25] s; ``wirefish_tuner.wave_loss``);
 * phase_free: the tuner's default, a different problem (oscillator 1's phase referenced to the
   wave, v chosen so that the network locks at 1 Hz, one locked period scored).
 
@@ -31,14 +31,14 @@ import numpy as np
 from wirefish_common.plotting import legend_beside
 from wirefish_common.progress import end_line, Progress
 from wirefish_cpg.oscillator import CpgParameters, NetworkArrays, simulate
-from wirefish_cpg.pso import PsoOptions
-from wirefish_cpg.tuning import fit_gait, FitResult
-from wirefish_cpg.wave_loss import (desired_swing_angles, FIT_MODES, literal_waveform_loss,
-                                    literal_waveform_swing_rmse_deg, PARAMETER_NAMES,
-                                    position_of, swarm_loss, swarm_swing_rmse_deg,
-                                    THETA_BAR_DEFINITIONS, WaveFitProblem)
 from wirefish_kinematics.body_wave import swing_angles
 from wirefish_kinematics.wire_coupling import bend_angles
+from wirefish_tuner.pso import PsoOptions
+from wirefish_tuner.tuning import fit_gait, FitResult
+from wirefish_tuner.wave_loss import (desired_swing_angles, FIT_MODES, literal_waveform_loss,
+                                      literal_waveform_swing_rmse_deg, PARAMETER_NAMES,
+                                      position_of, swarm_loss, swarm_swing_rmse_deg,
+                                      THETA_BAR_DEFINITIONS, WaveFitProblem)
 
 PAPER_RMSE_DEG = (1.7165, 1.2817)
 PAPER_LOSS = 4.6067  # Fig 6(a), units and window unstated

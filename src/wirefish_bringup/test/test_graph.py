@@ -38,13 +38,14 @@ def test_single_process_is_the_virtual_fish_and_one_process_of_every_node_class(
     specs = fish_graph('/wirefish', sim=True, single_process=True)
     assert [s.name for s in specs] == ['fish_sim', 'fish_nodes']
     assert specs[1].ros_nodes == tuple(e.name for e in composable_entries())
-    assert specs[1].command_arguments()[0] == 'compose'
+    assert (specs[1].package, specs[1].executable) == ('wirefish_launcher', 'compose')
 
 
 def test_a_bag_adds_the_recorder_last_with_its_own_options_only():
     specs = fish_graph('/wirefish', sim=True, bag=Path('/tmp/b'))
     recorder = specs[-1]
-    assert recorder.command_arguments() == ('record', '-o', '/tmp/b', '--namespace', '/wirefish',
+    assert (recorder.package, recorder.executable) == ('wirefish_bag', 'recorder')
+    assert recorder.command_arguments() == ('-o', '/tmp/b', '--namespace', '/wirefish',
                                             '--resume')  # a restart records on into the bag
     assert recorder.restart.respawn
     assert recorder.ros_nodes == ()  # its node is not in the namespace: not waited for

@@ -1,15 +1,10 @@
-"""Roles (fish / shore), the crossing table, frame prefixes and fleets, pure."""
+"""Roles (fish / shore), frame prefixes and fleets, pure."""
 
 from pathlib import Path
 
 import pytest
-from wirefish_bringup.crossing import (crossing_table, default_crossing_file, LatestHold,
-                                       load_crossing)
 from wirefish_bringup.fleet import fleet_graph, fleet_namespaces
 from wirefish_bringup.graph import entries, FISH, fish_graph, SHORE
-from wirefish_bringup.launcher import _registry_nodes
-
-CONFIG = Path(__file__).resolve().parents[1] / 'config' / 'crossing.yaml'
 
 
 def _names(specs):
@@ -114,45 +109,3 @@ def test_two_fleets_share_no_namespace_and_no_virtual_fish_link():
 def test_a_fleet_size_outside_its_bounds_is_refused(count):
     with pytest.raises(ValueError, match='fleet'):
         fleet_namespaces('/tank', count)
-
-
-def test_the_launcher_names_a_fleets_nodes_relative_to_its_base():
-    names = _registry_nodes(fleet_graph('/tank', 2), '/tank')
-    assert 'fish_1/cpg_node' in names and 'fish_2/cpg_node' in names
-
-
-def test_the_shipped_crossing_table_relays_the_fast_streams_slowly():
-    table = {row.topic: row for row in load_crossing(CONFIG)}
-    assert table['imu/data'].shore_topic == 'shore/imu/data'
-    assert 0 < table['imu/data'].rate_hz <= 20 and 0 < table['servo_state'].rate_hz <= 20
-    assert 'servo_cmd' not in table and 'body_wave' not in table
-
-
-def test_the_installed_crossing_table_is_the_shipped_one():
-    assert load_crossing(default_crossing_file()) == load_crossing(CONFIG)
-
-
-@pytest.mark.parametrize('row, reason', [
-    ({'topic': '/abs', 'type': 'a/msg/B', 'rate_hz': 1, 'qos': 'sensor'}, 'relative'),
-    ({'topic': 'x', 'type': 'Imu', 'rate_hz': 1, 'qos': 'sensor'}, 'type'),
-    ({'topic': 'x', 'type': 'a/msg/B', 'rate_hz': -1, 'qos': 'sensor'}, 'rate_hz'),
-    ({'topic': 'x', 'type': 'a/msg/B', 'rate_hz': 1, 'qos': 'fast'}, 'qos'),
-    ({'topic': 'x', 'type': 'a/msg/B', 'rate_hz': 1}, 'exactly'),
-])
-def test_a_bad_crossing_row_is_refused_with_the_reason(row, reason):
-    with pytest.raises(ValueError, match=reason):
-        crossing_table({'relayed': [row]})
-
-
-def test_a_topic_relayed_twice_is_refused():
-    row = {'topic': 'x', 'type': 'a/msg/B', 'rate_hz': 1, 'qos': 'sensor'}
-    with pytest.raises(ValueError, match='twice'):
-        crossing_table({'relayed': [row, row]})
-
-
-def test_a_hold_sends_the_newest_message_once():
-    hold = LatestHold()
-    hold.put(b'1')
-    hold.put(b'2')
-    assert hold.take() == b'2'
-    assert hold.take() is None

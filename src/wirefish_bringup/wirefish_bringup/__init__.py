@@ -1,1 +1,1 @@
-"""Launch files, default parameters and the wirefish command-line tool."""
+"""The graph's registry (every process, its role and rates), its launch file and parameters."""

@@ -155,8 +155,8 @@ NODES: tuple[NodeEntry, ...] = (
               arguments=('--link', '{device}', '--ros'), creates_link=True, frames=True,
               restart=RestartPolicy(required=True), rates_hz={'sim/ground_truth': 50.0}),
     # The firmware on an emulated STM32F405 (qemu_board): no physics, so no sim/ground_truth.
-    NodeEntry('wirefish_bringup', 'wirefish', 'qemu_fish', start_order=0, when=QEMU,
-              arguments=('qemu', '--link', '{device}'), creates_link=True, ros_args=False,
+    NodeEntry('wirefish_launcher', 'qemu_board', 'qemu_fish', start_order=0, when=QEMU,
+              arguments=('--link', '{device}'), creates_link=True, ros_args=False,
               restart=RestartPolicy(required=True)),
     NodeEntry('wirefish_bridge', 'bridge_node', 'bridge_node', start_order=10,
               node_class='wirefish_bridge.bridge_node:BridgeNode',
@@ -178,14 +178,14 @@ NODES: tuple[NodeEntry, ...] = (
     NodeEntry('wirefish_planner', 'planner_node', 'planner_node', start_order=35,
               node_class='wirefish_planner.planner_node:PlannerNode',
               parameters={'rest_at_start': 'false'}, fed_by=('bridge_node',)),
-    NodeEntry('wirefish_cpg', 'tuner_node', 'tuner_node', start_order=40,
-              node_class='wirefish_cpg.tuner_node:TunerNode', own_executor=True, role=SHORE),
+    NodeEntry('wirefish_tuner', 'tuner_node', 'tuner_node', start_order=40,
+              node_class='wirefish_tuner.tuner_node:TunerNode', own_executor=True, role=SHORE),
     # The fish's side of the radio: the decimated copies the shore sees (config/crossing.yaml).
-    NodeEntry('wirefish_bringup', 'link_relay', 'link_relay', start_order=45, when=APART),
+    NodeEntry('wirefish_relay', 'link_relay', 'link_relay', start_order=45, when=APART),
     # `wirefish up --duration`. Restarted with --resume: a killed recorder's bag is reindexed
     # and the new one records on into its next split file (the run keeps one bag).
-    NodeEntry('wirefish_bringup', 'wirefish', 'wirefish_recorder', start_order=50, when=RECORD,
-              arguments=('record', '-o', '{bag}', '--namespace', '{recorded}', '--resume'),
+    NodeEntry('wirefish_bag', 'recorder', 'wirefish_recorder', start_order=50, when=RECORD,
+              arguments=('-o', '{bag}', '--namespace', '{recorded}', '--resume'),
               role=SHORE, ros_args=False),
     # `wirefish up --view`: the Foxglove WebSocket server over the graph and the dashboard.
     NodeEntry('wirefish_view', 'view_node', 'view_node', start_order=60, when=VIEW,
@@ -407,8 +407,8 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
             links=(Path(device),) if e.creates_link else ()))
     if composed:
         specs.append(NodeSpec(
-            'wirefish_bringup', 'wirefish', COMPOSED_NAME,
-            arguments=('compose', '--namespace', namespace, '--port', device,
+            'wirefish_launcher', 'compose', COMPOSED_NAME,
+            arguments=('--namespace', namespace, '--port', device,
                        '--params-file', params),
             restart=combined_policy([e.restart for e in composed]),
             ros_nodes=tuple(e.name for e in composed)))

@@ -11,7 +11,6 @@ from wirefish_cpg.cpg_node_parameters import SPECS
 from wirefish_cpg.cpg_parameter_names import (CPG_PARAMETER_NAMES, CPG_PARAMETERS, flat_values,
                                               parameters_from)
 from wirefish_cpg.oscillator import at_rest, CpgParameters
-from wirefish_cpg.wave_loss import PARAMETER_NAMES as TUNED_NAMES
 
 TURNING = CpgParameters(frequency_hz=2.5, amplitude=(0.3, -0.2), offset=(0.1, -0.05),
                         w12=1.5, w21=-2.0, phi12=-0.5, phi21=2.0, alpha=30.0)
@@ -55,10 +54,6 @@ def test_the_parameter_defaults_are_those_of_cpg_parameters():
 def test_every_cpg_parameter_is_a_node_parameter_in_the_mapping_order():
     assert tuple(spec.name for spec in CPG_PARAMETERS) == CPG_PARAMETER_NAMES
     assert set(CPG_PARAMETER_NAMES) <= set(SPECS)
-
-
-def test_the_tuned_position_names_are_cpg_parameter_names():
-    assert set(TUNED_NAMES) <= set(CPG_PARAMETER_NAMES)
 
 
 def test_a_missing_name_is_a_key_error_naming_it():

@@ -8,7 +8,7 @@ import pytest
 from wirefish_cpg.gait_library import (default_library_path, Gait, GaitLibrary, LibraryFile,
                                        load_library, save_library)
 from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.wave_loss import WaveSpec
+from wirefish_kinematics.wave_spec import WaveSpec
 
 GEOMETRY = {'l1': 0.08, 'l2': 0.1, 'l3': 0.06, 'r1': 0.02, 'r2': 0.012, 'rd1': 0.018,
             'rd2': 0.018}

@@ -23,7 +23,7 @@ import numpy as np
 from wirefish_cpg.gait_library import Gait, GaitLibrary
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import stable_phase_difference
-from wirefish_cpg.wave_loss import WaveSpec
+from wirefish_kinematics.wave_spec import WaveSpec
 
 # Coupling (1/s) of interpolated gaits: half the paper's bound; locks at ~5 (R1 + R2) 1/s.
 CANONICAL_COUPLING = 5.0

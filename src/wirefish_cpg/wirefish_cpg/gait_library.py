@@ -35,7 +35,7 @@ from pathlib import Path
 import tempfile
 
 from wirefish_cpg.oscillator import CpgParameters
-from wirefish_cpg.wave_loss import WaveSpec
+from wirefish_kinematics.wave_spec import WaveSpec
 
 FILE_FORMAT = 'wirefish_gait_library'
 FILE_VERSION = 1
@@ -288,3 +288,21 @@ class LibraryFile:
             save_library(library, self.path)
             self._library, self._stamp = library, self._file_stamp()
         return library
+
+
+def tuner_library_path(params_file: Path) -> Path:
+    """Return the gait library a graph's tuner uses: the file's library_path, or the default."""
+    import yaml
+
+    try:
+        blocks = yaml.safe_load(Path(params_file).read_text())
+    except (OSError, yaml.YAMLError):
+        blocks = None
+    named: dict[bool, str] = {}  # the graph's /** block first: the tuner's own block overrides it
+    for key, block in (blocks.items() if isinstance(blocks, dict) else []):
+        values = block.get('ros__parameters') if isinstance(block, dict) else None
+        path = values.get('library_path') if isinstance(values, dict) else None
+        if isinstance(path, str) and path and (key == '/**' or str(key).endswith('tuner_node')):
+            named[key == '/**'] = path
+    chosen = named.get(False, named.get(True))
+    return Path(chosen) if chosen else default_library_path()

@@ -2,7 +2,7 @@
 The desired body wave of eq 23 as one type, and its wirefish_msgs/BodyWaveSpec converters.
 
 ``WaveSpec`` is the wave everywhere in Python: the kinematics node's overlay target (its
-``wave_*`` parameters or ``target_wave``), the tuner's fit target (``wirefish_cpg.wave_loss``
+``wave_*`` parameters or ``target_wave``), the tuner's fit target (``wirefish_tuner.wave_loss``
 re-exports it) and the analysis scripts. The message is its form on the wire. Message types
 only, no rclpy.
 """

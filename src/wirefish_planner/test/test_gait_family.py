@@ -99,7 +99,7 @@ def library_file(tmp_path_factory):
     """
     from wirefish_cpg.gait_family import scaled_wave
     from wirefish_cpg.gait_library import Gait, GaitLibrary, geometry_key, save_library
-    from wirefish_cpg.wave_loss import WaveSpec
+    from wirefish_kinematics.wave_spec import WaveSpec
     from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS
 
     geometry = {name: getattr(FishGeometry(), name) for name in BODY_WAVE_GEOMETRY_FIELDS}

@@ -39,9 +39,9 @@ from wirefish_cpg.gait_family import (family as library_members, FamilyMember,
 from wirefish_cpg.gait_library import load_library
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.table1_gait import one_locked_period, table1_locked_at
-from wirefish_cpg.wave_loss import WaveSpec
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import estimate_speed
+from wirefish_kinematics.wave_spec import WaveSpec
 
 FRONTIER_SAMPLES = 24  # frequencies scanned for the fastest feasible gait
 SPEED_TOLERANCE_M_S = 1e-5

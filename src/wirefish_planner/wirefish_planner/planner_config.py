@@ -15,9 +15,9 @@ from typing import Any, Mapping
 from wirefish_common.parameter_table import ParameterSpec
 from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES
 from wirefish_cpg.gait_library import default_library_path
-from wirefish_cpg.wave_loss import WaveSpec
 from wirefish_kinematics.node_parameters import (BODY_WAVE_GEOMETRY_FIELDS, geometry_from,
                                                  geometry_parameters)
+from wirefish_kinematics.wave_spec import WaveSpec
 from wirefish_planner.gait_family import (GaitFamily, GaitLimits, GaitPlanner, library_family,
                                           Table1Family)
 from wirefish_planner.planner_core import Planner, PlannerOutput, PlannerSettings

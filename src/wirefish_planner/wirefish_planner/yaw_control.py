@@ -21,7 +21,7 @@ The turn gain k is a parameter; ``identify_turn_gain`` estimates it (and a const
 disturbance d) from a run's steady stretches (``steady_means``: 1 s means where b held still;
 the transients after a change of b would bias k towards 0), r = k U b + d by least squares.
 `wirefish mission` fits it to per-leg means of the planner_state it recorded and judges the
-fit before calling it usable (``wirefish_planner.mission_report``).
+fit before calling it usable (``wirefish_operator.mission_report``).
 """
 
 from __future__ import annotations

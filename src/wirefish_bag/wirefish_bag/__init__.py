@@ -1,0 +1,1 @@
+"""Rosbag2 (MCAP) recording, recovery, replay and reports: the recorder and the bag verbs."""

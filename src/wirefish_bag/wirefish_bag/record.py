@@ -1,0 +1,120 @@
+"""`wirefish record`: record every wirefish topic and /diagnostics into a rosbag2 (MCAP) bag."""
+
+import argparse
+from datetime import datetime
+import math
+from pathlib import Path
+import sys
+
+from wirefish_bag.sequence_gaps import loss_line, recording_account, TopicAccount
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+from wirefish_cli.api import duration_s
+from wirefish_common.progress import Progress
+
+NOTHING_TIMEOUT_S = 30.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish record`."""
+    parser.add_argument('-o', '--output', type=Path, default=None,
+                        help='bag directory (default: out/bags/wirefish_<time>); must not exist '
+                        'unless --resume')
+    parser.add_argument('--resume', action='store_true',
+                        help='if the bag exists (left by a killed recorder), reindex it and '
+                        'record on into its next file')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('--duration', type=duration_s, default=None,
+                        help='record this many seconds from the first message received '
+                        '(default: until Ctrl-C)')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish record`; return the process exit code."""
+    import time
+
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    from wirefish_bag.recorder import BagRecorder
+    from wirefish_common.shutdown import SignalShutdown
+
+    try:
+        namespace = validate_namespace(args.namespace)
+    except ValueError as error:
+        print(f'wirefish record: {error}', file=sys.stderr)
+        return 2
+    bag_path = args.output or Path('out', 'bags',
+                                   datetime.now().strftime('wirefish_%Y%m%d_%H%M%S'))
+    if bag_path.exists() and not args.resume:
+        print(f'wirefish record: {bag_path} exists; choose a new -o (or --resume)',
+              file=sys.stderr)
+        return 2
+    bag_path.parent.mkdir(parents=True, exist_ok=True)
+    # Ctrl-C and SIGTERM set a flag the recording loop reads between two takes: the readers
+    # are drained and the bag is closed cleanly.
+    signals = SignalShutdown()
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        recorder = BagRecorder(bag_path, namespace, resume=args.resume)
+    except (OSError, ValueError) as error:  # not a bag, or one that cannot be recovered
+        rclpy.try_shutdown()
+        print(f'wirefish record: {error}', file=sys.stderr)
+        return 2
+    started_ns = time.time_ns()
+    progress = (Progress(f'record {bag_path.name}', math.ceil(args.duration))
+                if args.duration is not None else None)
+
+    def stopped() -> bool:
+        if signals.requested:
+            return True
+        if args.duration is None or progress is None:
+            return False
+        now, first = time.time_ns(), recorder.first_message_ns
+        recorded_s = 0 if first is None else int((now - first) * 1e-9)
+        if recorded_s > progress.done:  # counted from the first message, as the duration is
+            progress.step(min(recorded_s, progress.total), f'{recorder_count()} messages')
+        # Discovery can take a few seconds on a loaded machine: the duration counts from
+        # the first message, with a bound for a graph that never publishes anything.
+        return (first is not None and now - first >= args.duration * 1e9) or \
+            now - started_ns >= (args.duration + NOTHING_TIMEOUT_S) * 1e9
+
+    def recorder_count() -> int:
+        return sum(account.count for account in recorder.accounts.values())
+
+    try:
+        recorder.record(stopped)
+    finally:
+        recorder.close()
+        accounts = dict(recorder.accounts)
+        recorder.destroy_node()
+        rclpy.try_shutdown()
+    print(recording_summary(bag_path, accounts), flush=True)
+    return 0
+
+
+def recording_summary(bag_path: Path, accounts: dict[str, TopicAccount]) -> str:
+    """
+    Return what was written, what never arrived and how late it came, per topic; then the loss.
+
+    'missing' counts the numbers absent from each publisher's sequence between its first and
+    last sample in the bag: every cause of loss (in transport, a reader's history overrun); not
+    checked on a topic where a second publisher appeared. 'lag' is the longest a message waited
+    between its publication and the bag.
+    """
+    checked = {t: a.sequence for t, a in accounts.items() if not a.sequence.ambiguous}
+    total_missing = sum(s.missing for s in checked.values())
+    lines = [f'wrote {sum(a.count for a in accounts.values())} messages on {len(accounts)} '
+             f"topics to {bag_path}; missing from the publishers' sequences: {total_missing}"]
+    for topic, account in sorted(accounts.items()):
+        missing = (f'missing {checked[topic].missing}' if topic in checked
+                   else 'several publishers: sequence not checked')
+        lag = 'latched' if account.latched else f'lag max {account.lag_max_ns * 1e-9:.2f} s'
+        lines.append(f'  {topic:<40} {account.count:>7} ({missing}, {lag})')
+    lines.append(loss_line(recording_account(accounts)))
+    return '\n'.join(lines)
+
+
+def main() -> int:
+    """Entry point of the ``recorder`` executable (the graph's registry starts it)."""
+    from wirefish_cli.api import verb_main
+    return verb_main(add_arguments, run, 'recorder', __doc__.strip().splitlines()[0])

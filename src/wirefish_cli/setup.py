@@ -1,0 +1,25 @@
+from setuptools import find_packages, setup
+
+package_name = 'wirefish_cli'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='wirefish maintainers',
+    maintainer_email='maintainers@wirefish.dev',
+    description='The wirefish command: its verbs come from the installed packages by entry point.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'wirefish = wirefish_cli.cli:main',
+        ],
+    },
+)

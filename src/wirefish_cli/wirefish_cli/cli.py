@@ -1,0 +1,63 @@
+"""
+The `wirefish` command: run, retune, record and inspect the fish without ros2cli.
+
+Every verb is also reachable on a full install (`ros2 run wirefish_cli wirefish ...`), beside
+the standard tools it stands in for on pip-only machines. The verbs come from the installed
+packages (``wirefish_cli.api.verbs``): a fish computer has `up`, a shore computer the rest.
+"""
+
+import argparse
+import ast
+import importlib
+import importlib.util
+from pathlib import Path
+import sys
+
+from wirefish_cli.api import run_verb, verbs
+
+
+def _first_line(doc: str | None) -> str:
+    """Return a docstring's first line without its leading `wirefish VERB ...`: name."""
+    line = (doc or '').strip().splitlines()[0] if (doc or '').strip() else ''
+    if line.startswith('`wirefish') and '`: ' in line:
+        line = line.split('`: ', 1)[1]
+    return line
+
+
+def _help_of(module_name: str) -> str:
+    """Return a verb's one-line help, the first line of its module's docstring, unimported."""
+    spec = importlib.util.find_spec(module_name)
+    if spec is None or spec.origin is None:
+        return f'(not importable: {module_name})'
+    return _first_line(ast.get_docstring(ast.parse(Path(spec.origin).read_text())))
+
+
+def build_parser(argv: list[str]) -> argparse.ArgumentParser:
+    """Return the parser; the chosen verb's module is imported, the others' docstrings read."""
+    parser = argparse.ArgumentParser(prog='wirefish', description=__doc__.strip().splitlines()[0])
+    commands = parser.add_subparsers(dest='command', required=True, metavar='COMMAND')
+    chosen = next((word for word in argv if not word.startswith('-')), None)
+    for name, module_name in verbs().items():
+        if name == chosen:
+            module = importlib.import_module(module_name)
+            help_text = _first_line(module.__doc__)
+            sub = commands.add_parser(name, help=help_text, description=help_text)
+            module.add_arguments(sub)
+            sub.set_defaults(run=module.run)
+        else:
+            commands.add_parser(name, help=_help_of(module_name))
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `wirefish` executable."""
+    argv = sys.argv[1:] if argv is None else argv
+    # Arguments after --ros-args belong to ROS, not to us (ros2 run passes them through).
+    if '--ros-args' in argv:
+        argv = argv[:argv.index('--ros-args')]
+    args = build_parser(argv).parse_args(argv)
+    return run_verb(args.run, args, f'wirefish {args.command}')
+
+
+if __name__ == '__main__':
+    sys.exit(main())

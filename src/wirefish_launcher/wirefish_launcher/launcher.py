@@ -1,0 +1,366 @@
+"""
+`wirefish up`: start one fish's whole graph, show its status, run until Ctrl-C, stop cleanly.
+
+The launcher for machines without `ros2 launch`; `launch/wirefish.launch.py` starts the same
+graph (see `wirefish_bringup.graph`) on a full install. A node that exits is restarted by its
+restart policy (graph.py) while the others run on; a second `wirefish up` in a namespace whose
+nodes are already discovered on this ROS domain refuses to start (--allow-duplicate overrides).
+"""
+
+import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
+from datetime import datetime
+import importlib.util
+import math
+import os
+from pathlib import Path
+import signal
+import sys
+import time
+
+from wirefish_bringup.dds_profile import graph_environment, write_profile
+from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
+                                    validate_namespace)
+from wirefish_cli.api import duration_s
+from wirefish_common.input_checks import params_file_problem, serial_port_problem
+from wirefish_common.progress import duration_text, Progress
+from wirefish_launcher.errors import QemuBoardError
+from wirefish_launcher.status_view import LiveStatus, TerminalBlock
+from wirefish_launcher.supervisor import Supervisor, wait_for_path
+
+STATUS_WINDOW_S = 3.0
+LIVE_REFRESH_S = 1.0  # how often the status is redrawn on a terminal
+STOP_GRACE_S = 10.0  # after a Ctrl-C during start-up, how long the nodes may take to be up
+DEVICE_TIMEOUT_S = 15.0
+# How long the processes may take to stop after the SIGINT, together: one fish's 6 stop well
+# within 5 s; a fleet's 19 on the loaded 2 cores needed more (a kinematics_node of 3 fish was
+# still stopping after 5 s), since each process needs CPU time to finish.
+STOP_TIMEOUT_S = 5.0
+STOP_S_PER_PROCESS = 1.0
+STOP_LOG_LINES = 60  # of a process that had to be killed: enough for its threads' stacks
+# Start-up may include restarts with back-off (1 + 2 + 4 s) of a node that fails at once.
+READY_TIMEOUT_S = 60.0
+# How long a new `wirefish up` listens for the registry's nodes already in its namespace (it
+# answers at once when one is found). Discovery of a running node on one host took 0 to 2.3 s
+# on the loaded 2-core machine (6 tries): twice that leaves a margin.
+DUPLICATE_CHECK_S = 4.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish up`."""
+    target = parser.add_mutually_exclusive_group()
+    target.add_argument('--sim', action='store_true', default=True,
+                        help='drive the virtual fish on a pseudo-terminal (default)')
+    target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
+    target.add_argument('--fish', choices=('sim', 'qemu'), default=None,
+                        help='sim: the virtual fish (as --sim); qemu: the firmware on an '
+                        'emulated STM32F405 (QEMU; built with make -C firmware qemu), the bridge '
+                        'on its pty (no physics: no sim/ground_truth)')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
+                        help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
+    parser.add_argument('--role', choices=ROLES, default=ALL,
+                        help='one side of a radio link: fish (virtual fish or port, bridge, '
+                        'CPG, kinematics, planner, link relay) or shore (tuner, recorder); '
+                        'all: both on this machine (default). See README: two hosts')
+    parser.add_argument('--fleet', type=fleet_size, default=None, metavar='N',
+                        help='N virtual fish, each its whole graph in <namespace>/fish_<i> with '
+                        'frames fish_<i>/...; one recorder of them all with --duration')
+    parser.add_argument('--frame-prefix', default='',
+                        help='prefix of the frame ids (fish_1 -> fish_1/base_link)')
+    parser.add_argument('--duration', type=duration_s, default=None,
+                        help='run this many seconds, record a bag and write a report')
+    parser.add_argument('--params-file', type=Path, default=None,
+                        help='parameter YAML (default: the installed config/wirefish.yaml)')
+    parser.add_argument('--out', type=Path, default=Path('out'),
+                        help='where run logs, bags and reports go (default: ./out)')
+    parser.add_argument('--single-process', action='store_true',
+                        help="run the fish's ROS nodes in one process (wirefish compose)")
+    parser.add_argument('--no-status', action='store_true',
+                        help='no status (topic rates, link, battery, planner mode; on a '
+                        'terminal kept up to date while the graph runs)')
+    parser.add_argument('--view', action='store_true',
+                        help='also the live view: Foxglove WebSocket server and dashboard '
+                        '(wirefish view; view_node parameters port, http_port)')
+    parser.add_argument('--allow-duplicate', action='store_true',
+                        help='start even if nodes of the graph already run in this namespace '
+                        '(e.g. a graph that just died is still discovered)')
+
+
+def fleet_size(text: str) -> int:
+    """Return a --fleet option: a whole number of fish >= 1 (argparse type)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a whole number of fish: {text!r}') from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f'a fleet has at least 1 fish, got {value}')
+    return value
+
+
+def _node_names(spec: NodeSpec, namespace: str) -> list[str]:
+    """Return the fully qualified names of the nodes ``spec`` hosts (a fleet's: per fish)."""
+    return [f'{(spec.namespace or namespace).rstrip("/")}/{name}' for name in spec.ros_nodes]
+
+
+def _registry_nodes(specs: list[NodeSpec], namespace: str) -> list[str]:
+    """Return the graph's node names relative to ``namespace`` (fish_1/cpg_node in a fleet)."""
+    prefix = namespace.rstrip('/') + '/'
+    return [name[len(prefix):] for spec in specs for name in _node_names(spec, namespace)]
+
+
+def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], supervisor: Supervisor,
+                show_status: bool, stop_requested: list,
+                timeout_s: float = READY_TIMEOUT_S, role: str = ALL,
+                live_views: list | None = None) -> str | None:
+    """
+    Wait until every node of the graph is on the ROS graph; return the status table or None.
+
+    A node is "up" once it is discoverable (its rclpy.init and constructor are done), so a
+    Ctrl-C after "running:" always reaches nodes that handle it cleanly. Exits while waiting
+    are answered by the restart policies; a node given up on is no longer waited for. The
+    status that measured the table is appended to ``live_views`` (the live view goes on with it).
+    """
+    from wirefish_launcher.monitor import discovered_nodes, settle_discovery
+
+    def expected() -> set[str]:
+        return {name for key, spec in supervisor.specs.items() if key not in supervisor.given_up
+                for name in _node_names(spec, namespace)}
+
+    def up() -> bool:  # discovered, and no process down (a node dying at start-up is seen)
+        return expected() <= discovered_nodes(node) and not supervisor.down()
+
+    deadline = time.monotonic() + timeout_s
+    while not up():
+        _report(supervisor.supervise())
+        if stop_requested and deadline > time.monotonic() + STOP_GRACE_S:
+            # A node interrupted while still importing dies of the SIGINT (exit -2, a
+            # KeyboardInterrupt trace): let every node finish starting, then stop them all.
+            print('wirefish up: stopping as soon as every node has started', file=sys.stderr)
+            deadline = time.monotonic() + STOP_GRACE_S
+        if time.monotonic() > deadline:
+            missing = ', '.join(sorted(expected() - discovered_nodes(node)))
+            return None if stop_requested else f'not up after {timeout_s:g} s: {missing}'
+        executor.spin_once(timeout_sec=0.1)
+    if stop_requested:
+        return None
+    if not show_status:
+        return ''
+    settle_discovery(node, executor, namespace, should_stop=lambda: bool(stop_requested))
+    # The shore watches what crosses the link only: measuring the fish's own streams would
+    # pull them over the radio.
+    watched = f'{namespace.rstrip("/")}/shore' if role == SHORE else namespace
+    live = LiveStatus(node, watched)
+    measured_until = time.monotonic() + STATUS_WINDOW_S
+    while time.monotonic() < measured_until and not stop_requested:
+        time.sleep(0.25)
+        live.refresh()
+    if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
+        return None
+    if live_views is not None:
+        live_views.append(live)
+    return '\n'.join([f'nodes: {", ".join(sorted(expected()))}', *live.lines()])
+
+
+def _report(lines: list[str]) -> None:
+    for line in lines:
+        print(f'wirefish up: {line}', file=sys.stderr, flush=True)
+
+
+_PROBES: list = []  # the launcher's own nodes on the graph: never torn down (_graph_probe)
+
+
+@contextmanager
+def _graph_probe(namespace: str) -> Iterator[tuple]:
+    """
+    Yield (node, executor) of the launcher's own look at the ROS graph; never destroyed.
+
+    Destroying a node is DDS work that can block the calling thread for good: eight graphs
+    starting at once left `wirefish up` in ``Node.destroy_node`` -> ``Publisher.destroy`` of
+    this probe (py-spy), its SIGINT and SIGTERM caught and never acted on, nothing stopped. So
+    the launcher makes no DDS call on its way out: the probe lives as long as the process, and
+    ``run`` leaves through ``os._exit`` once everything it started is stopped and reported
+    (the operating system closes the probe's sockets and shared memory).
+    """
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
+
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node('wirefish_status', namespace=namespace)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    _PROBES.append((node, executor))
+    yield node, executor
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish up`; return its exit code, or exit with it if the graph was probed."""
+    code = _run(args)
+    if _PROBES:  # no DDS teardown on the way out (see _graph_probe)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
+
+
+def _run(args: argparse.Namespace) -> int:
+    stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
+    run_dir = (args.out / f'run_{stamp}').resolve()
+    bag_path = run_dir / 'bag' if args.duration else None
+    try:
+        if bag_path is not None and importlib.util.find_spec('wirefish_bag') is None:
+            # A fish install has no bag library (the fish records nothing: the shore does).
+            raise ValueError('--duration records the run, which needs the wirefish_bag package '
+                             '(a shore install); this host has none')
+        namespace = validate_namespace(args.namespace)
+        qemu = args.fish == 'qemu'
+        sim = args.port is None and not qemu
+        if args.fleet is not None:
+            if args.port is not None or qemu or args.single_process or args.frame_prefix:
+                raise ValueError('--fleet starts virtual fish, one process per node, each '
+                                 'with frames fish_<i>/...: no --port, --single-process or '
+                                 '--frame-prefix with it')
+            from wirefish_bringup.fleet import fleet_graph
+            specs = fleet_graph(namespace, args.fleet, params_file=args.params_file,
+                                bag=bag_path, role=args.role)
+        else:
+            specs = fish_graph(namespace, sim=sim, port=args.port,
+                               params_file=args.params_file, single_process=args.single_process,
+                               bag=bag_path, role=args.role, frame_prefix=args.frame_prefix,
+                               qemu=qemu, view=args.view)
+            if qemu:
+                from wirefish_launcher.qemu_board import build_image
+                build_image()
+    except ValueError as error:
+        print(f'wirefish up: {error}', file=sys.stderr)
+        return 2
+    except QemuBoardError as error:
+        print(f'wirefish up: {error}', file=sys.stderr)
+        return 1
+    problem = ((serial_port_problem(args.port) if args.port is not None else None)
+               or (params_file_problem(args.params_file) if args.params_file else None))
+    if problem is not None:
+        print(f'wirefish up: {problem}', file=sys.stderr)
+        return 2
+    if args.port is not None and not Path(args.port).exists():
+        print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
+              'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
+    # The reply writers' profile must name the graph's own namespaces (dds_profile).
+    env, own_profile = graph_environment(
+        os.environ, {s.namespace for s in specs if s.namespace}, run_dir,
+        radio=args.role != ALL)
+    supervisor = Supervisor(run_dir / 'logs', env=env)
+    stop_requested = []
+
+    def request_stop(signum, _frame) -> None:
+        stop_requested.append(signum)
+
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
+    code = 0
+    codes: dict[str, int | None] = {}
+    try:
+        with _graph_probe(namespace) as (node, executor):
+            if not args.allow_duplicate:
+                from wirefish_launcher.monitor import registry_nodes_present
+                present = registry_nodes_present(node, executor, namespace,
+                                                 _registry_nodes(specs, namespace),
+                                                 DUPLICATE_CHECK_S,
+                                                 should_stop=lambda: bool(stop_requested))
+                if present:
+                    domain = os.environ.get('ROS_DOMAIN_ID', '0')
+                    print(f'wirefish up: namespace {namespace} is in use on ROS domain {domain} '
+                          f'({", ".join(present)} already running there): stop that graph, '
+                          'choose another --namespace, or pass --allow-duplicate',
+                          file=sys.stderr)
+                    return 1
+                if stop_requested:
+                    return 0
+            write_profile(env, own_profile)
+            for spec in specs:
+                proc = supervisor.start(spec)
+                for link in spec.links:
+                    if not wait_for_path(link, [proc], DEVICE_TIMEOUT_S):
+                        raise RuntimeError(f'{spec.name} did not open its pseudo-terminal:\n'
+                                           + supervisor.log_tail(spec.name))
+                    fish = 'emulated board' if qemu else 'virtual fish'
+                    print(f'{fish} on {link} -> {link.resolve()}')
+            print(f'started {len(supervisor.processes)} processes in {namespace}; '
+                  f'logs in {run_dir / "logs"}', flush=True)
+            if any('tuner_node' in spec.ros_nodes for spec in specs):
+                from wirefish_bringup.graph import default_params_file
+                from wirefish_cpg.gait_library import tuner_library_path
+                library = tuner_library_path(args.params_file or default_params_file())
+                print(f'gait library: {library}', flush=True)
+            live_views: list = []
+            status = _wait_ready(node, executor, namespace, specs, supervisor,
+                                 not args.no_status, stop_requested, role=args.role,
+                                 live_views=live_views)
+        if status and status.startswith('not up'):
+            raise RuntimeError(status)
+        # On a terminal the status is redrawn in place while the graph runs; else shown once.
+        live = live_views[0] if live_views and sys.stdout.isatty() else None
+        if live is None and live_views:
+            live_views[0].close()  # shown once: no more samples to keep
+        block = TerminalBlock(sys.stdout) if live is not None else None
+        if status and block is None:
+            print(status)
+        if stop_requested:
+            pass  # Ctrl-C during start-up: straight to stopping
+        elif bag_path is not None:
+            print(f'recording to {bag_path}; stopping after {args.duration:g} s')
+        else:
+            print('running: Ctrl-C stops everything', flush=True)
+        started = drawn = time.monotonic()
+        # A timed run off a terminal says how far it is (a line per 5 %, with the time left);
+        # on a terminal the live status's first line says it.
+        timed = (Progress('recording, seconds', math.ceil(args.duration), stream=sys.stdout)
+                 if args.duration is not None and block is None and not stop_requested
+                 else None)
+        while not stop_requested:
+            reports = supervisor.supervise()
+            if reports and block is not None:
+                block.forget()  # the reports stay; the status goes on below them
+            _report(reports)
+            elapsed = time.monotonic() - started
+            if args.duration is not None and elapsed >= args.duration:
+                break
+            if timed is not None and int(elapsed) > timed.done:
+                timed.step(int(elapsed))
+            if live is not None and block is not None and (
+                    time.monotonic() - drawn >= LIVE_REFRESH_S or drawn == started):
+                live.refresh()
+                first = (status or '').splitlines()[:1]
+                if args.duration is not None:
+                    left = duration_text(args.duration - elapsed)
+                    first = [f'{first[0] if first else "running"}; stopping in {left}']
+                block.draw([*first, *live.lines()])
+                drawn = time.monotonic()
+            time.sleep(0.1)
+    except (RuntimeError, FileNotFoundError) as error:
+        print(f'wirefish up: {error}', file=sys.stderr)
+        code = 1
+    finally:
+        stop_timeout_s = max(STOP_TIMEOUT_S, STOP_S_PER_PROCESS * len(supervisor.processes))
+        codes = supervisor.stop(timeout_s=stop_timeout_s)
+    summary = supervisor.summary()
+    if summary:
+        print(f'wirefish up: {summary}', file=sys.stderr)
+    for name in supervisor.overran:  # its log ends with its threads' stacks (SignalShutdown)
+        end = ('was killed' if codes[name] is None
+               else f'exited with code {codes[name]} after a SIGTERM')
+        print(f'wirefish up: {name} still ran {stop_timeout_s:g} s after the SIGINT and {end}; '
+              f'the end of its log:\n'
+              f'{supervisor.log_tail(name, lines=STOP_LOG_LINES) or "(empty)"}',
+              file=sys.stderr)
+    unclean = {name: rc for name, rc in codes.items() if rc != 0}
+    if unclean:
+        print(f'wirefish up: processes that did not exit cleanly: {unclean}', file=sys.stderr)
+        code = code or 1
+    print(f'stopped {len(codes)} processes: '
+          + ', '.join(f'{name}={rc}' for name, rc in codes.items()))
+    if bag_path is not None and bag_path.exists():
+        from wirefish_bag.run_bag import close_run_bag
+        close_run_bag(bag_path, run_dir / 'report' if code == 0 else None)
+    return code

@@ -1,0 +1,279 @@
+"""
+`wirefish mission FILE`: drive the planner through timed cmd_vel legs, record, plot the path.
+
+FILE is a mission YAML (``wirefish_operator.mission_plan``) or the name of a shipped one
+(``square``). The legs go to ``<namespace>/cmd_vel`` at 20 Hz once the planner answers; the
+whole namespace is recorded into a rosbag2 (MCAP) bag (``wirefish_bag.recorder``, as
+`wirefish record`); afterwards the report PNG (x-y path from sim/ground_truth with heading
+arrows, speed and yaw rate against the setpoints) and the closure error are written and printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections import deque
+from dataclasses import dataclass
+from datetime import datetime
+import math
+from pathlib import Path
+import shutil
+import sys
+
+CMD_RATE_HZ = 20.0
+DISCOVERY_TIMEOUT_S = 30.0
+HINT_AFTER_S = 5.0  # of waiting for the graph, before saying what is waited for
+REST_HOLD_S = 1.0  # how long the ground truth's speed stays below REST_SPEED: at rest
+REST_WAIT_S = 20.0  # how much longer than the mission's rest_s leg 1 waits for it
+SHIPPED = ('square',)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of `wirefish mission`."""
+    from wirefish_cli.api import duration_s
+    from wirefish_bringup.graph import DEFAULT_NAMESPACE
+
+    parser.add_argument('mission',
+                        help=f'mission YAML file, or a shipped one: {", ".join(SHIPPED)}')
+    parser.add_argument('--namespace', default=DEFAULT_NAMESPACE, help='ROS namespace')
+    parser.add_argument('-o', '--output', type=Path, default=None,
+                        help='directory for the bag and the PNG '
+                        '(default: out/missions/<name>_<time>); must not exist')
+    parser.add_argument('--wait', type=duration_s, default=DISCOVERY_TIMEOUT_S,
+                        help="how long to wait for the graph's planner_state and ground truth "
+                        '(s, default %(default)g)')
+
+
+def mission_path(text: str) -> Path:
+    """Return the YAML of ``text``: a file, or a shipped mission's name."""
+    path = Path(text)
+    if path.exists() or text not in SHIPPED:
+        return path
+    from ament_index_python.packages import get_package_share_directory
+    return Path(get_package_share_directory('wirefish_operator'), 'missions', f'{text}.yaml')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run `wirefish mission`; return the exit code."""
+    from wirefish_cli.api import INTERRUPTED
+    from wirefish_bringup.graph import validate_namespace
+    from wirefish_common.progress import end_line
+    from wirefish_operator.mission_plan import load_mission
+
+    try:
+        mission = load_mission(mission_path(args.mission))
+        namespace = validate_namespace(args.namespace)
+    except ValueError as error:
+        print(f'wirefish mission: {error}', file=sys.stderr)
+        return 2
+    out = args.output or Path('out', 'missions',
+                              datetime.now().strftime(f'{mission.name}_%Y%m%d_%H%M%S'))
+    if out.exists():
+        print(f'wirefish mission: {out} exists; choose a new -o', file=sys.stderr)
+        return 2
+    created = [d for d in (out, *out.parents) if not d.exists()]
+    out.mkdir(parents=True)
+    bag_path = out / 'bag'
+    t0, problem, interrupted, turn_gain = _drive(mission, namespace, bag_path, args.wait)
+    if t0 is None:  # no leg was sent: nothing to keep
+        shutil.rmtree(out, ignore_errors=True)
+        for directory in created[1:]:
+            if directory.exists() and not any(directory.iterdir()):
+                directory.rmdir()
+    if problem is not None:
+        end_line()
+        print(f'wirefish mission: {problem}', file=sys.stderr)
+        return INTERRUPTED if interrupted else 1
+    return _report(mission, namespace, bag_path, out, t0 or 0.0, turn_gain)
+
+
+@dataclass
+class _Run:
+    """
+    Where a mission run is (node clock s): resting since, the first leg's start, a problem.
+
+    ``turn_gain`` is the planner's own parameter, for judging the gain the run identifies.
+    """
+
+    rest_from: float | None = None
+    t0: float | None = None
+    problem: str | None = None
+    done: bool = False
+    turn_gain: float | None = None
+
+
+def _drive(mission, namespace: str, bag_path: Path,
+           wait_s: float) -> tuple[float | None, str | None, bool, float | None]:
+    """
+    Send the legs, record; return (first leg's start, node clock s; problem; Ctrl-C; turn_gain).
+
+    The start is None when no leg was sent (no graph within ``wait_s``, or interrupted first).
+    Before leg 1 the fish is brought to rest (cmd_vel 0 for at least the mission's rest_s,
+    until the ground truth's speed stayed below the report's REST_SPEED for a second, at most
+    REST_WAIT_S more): a fish that still swims its start-up gait would start leg 1 moving.
+    """
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from rcl_interfaces.msg import ParameterType
+    from rcl_interfaces.srv import GetParameters
+    import rclpy
+    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from rclpy.signals import SignalHandlerOptions
+    from wirefish_bag.recorder import BagRecorder
+    from wirefish_common.progress import Progress
+    from wirefish_common.shutdown import SignalShutdown
+    from wirefish_msgs.msg import PlannerState
+    from wirefish_operator.mission_report import REST_SPEED
+
+    signals = SignalShutdown()  # Ctrl-C stops the legs, the fish rests, the bag is closed
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node('wirefish_mission', namespace=namespace)
+    # The recorder's line per topic would flood the mission's console: its warnings only.
+    rclpy.logging.set_logger_level('wirefish_recorder', rclpy.logging.LoggingSeverity.WARN)
+    recorder = BagRecorder(bag_path, namespace)
+    signals.attach(node)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    recorder.start_thread()  # takes its messages itself, beside the executor
+    reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+    publisher = node.create_publisher(Twist, 'cmd_vel', reliable)
+    heard: list[PlannerState] = []
+    node.create_subscription(PlannerState, 'planner_state', heard.append, reliable)
+    speeds: deque[tuple[float, float]] = deque()  # (node clock s, |surge speed| m/s), last 1 s
+
+    def on_truth(message: Odometry) -> None:
+        speeds.append((now(), abs(message.twist.twist.linear.x)))
+
+    node.create_subscription(Odometry, 'sim/ground_truth', on_truth, reliable)
+    parameters = node.create_client(GetParameters, 'planner_node/get_parameters')
+    answer: list = []
+    truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
+    run = _Run()
+    started = node.get_clock().now().nanoseconds * 1e-9
+    hinted: list[float] = []
+    progress: list[Progress] = []  # once the first leg is timed
+
+    def now() -> float:
+        return node.get_clock().now().nanoseconds * 1e-9
+
+    def at_rest(t: float) -> bool:
+        while speeds and speeds[0][0] < t - REST_HOLD_S:
+            speeds.popleft()
+        return bool(speeds) and t - speeds[0][0] > 0.9 * REST_HOLD_S and all(
+            speed < REST_SPEED for _, speed in speeds)
+
+    def rest(t: float) -> None:
+        publisher.publish(Twist())
+        if answer and answer[0].done() and answer[0].result() is not None:
+            values = answer[0].result().values
+            double = values and values[0].type == ParameterType.PARAMETER_DOUBLE
+            run.turn_gain = values[0].double_value if double else None
+        waited = t - (run.rest_from or t)
+        if waited < mission.rest_s or not (at_rest(t) or waited > mission.rest_s + REST_WAIT_S):
+            return
+        if not at_rest(t):
+            print(f'wirefish mission: the fish did not come to rest within '
+                  f'{mission.rest_s + REST_WAIT_S:g} s; leg 1 starts anyway', file=sys.stderr)
+        run.t0 = t
+        progress.append(Progress(f'mission {mission.name}',
+                                 math.ceil(mission.duration_s + mission.coast_s)))
+
+    def tick() -> None:
+        t = now()
+        if run.rest_from is not None and run.t0 is None:
+            rest(t)
+            return
+        if run.t0 is None:
+            if heard and recorder.count(truth_topic) > 0:
+                run.rest_from = t
+                print(f'mission {mission.name}: {len(mission.legs)} legs, '
+                      f'{mission.duration_s:.1f} s, recording to {bag_path}; the fish comes to '
+                      'rest first', flush=True)
+                if parameters.service_is_ready():
+                    request = GetParameters.Request(names=['turn_gain'])
+                    answer.append(parameters.call_async(request))
+            elif t - started > wait_s:
+                run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
+                               f'within {wait_s:g} s: are the graph and the planner running? '
+                               f'(wirefish up --namespace {namespace}); nothing was written')
+                rclpy.try_shutdown()
+            elif t - started > HINT_AFTER_S and not hinted:
+                hinted.append(t)
+                print(f'wirefish mission: waiting for planner_state and sim/ground_truth '
+                      f'under {namespace} (is the graph running?)', file=sys.stderr, flush=True)
+            return
+        command = mission.command_at(t - run.t0)
+        elapsed = int(t - run.t0)
+        if elapsed > progress[0].done:
+            progress[0].step(elapsed, _phase(mission, t - run.t0))
+        if command is not None:
+            msg = Twist()
+            msg.linear.x, msg.angular.z = command
+            publisher.publish(msg)
+        elif t - run.t0 > mission.duration_s + mission.coast_s:
+            run.done = True
+            rclpy.try_shutdown()
+
+    node.create_timer(1.0 / CMD_RATE_HZ, tick)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        recorder.close()
+        executor.shutdown()
+        recorder.destroy_node()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    interrupted = run.problem is None and not run.done
+    if interrupted:
+        run.problem = (f'interrupted (Ctrl-C); the bag so far is in {bag_path}'
+                       if run.t0 is not None
+                       else 'interrupted (Ctrl-C) before the first leg; nothing was written')
+    return run.t0, run.problem, interrupted, run.turn_gain
+
+
+def _phase(mission, t: float) -> str:
+    """Return what the mission does ``t`` s after the first leg's start, for its progress."""
+    if t < 0.0:
+        return 'at rest before leg 1'
+    for number, (start, leg) in enumerate(zip(mission.leg_starts(), mission.legs), start=1):
+        if t < start + leg.duration_s:
+            return (f'leg {number}/{len(mission.legs)}: {leg.speed:.2f} m/s, '
+                    f'{leg.yaw_rate:+.2f} rad/s')
+    return 'coasting, recording'
+
+
+def _report(mission, namespace: str, bag_path: Path, out: Path, t0: float,
+            turn_gain: float | None) -> int:
+    import numpy as np
+    from wirefish_bag.bagfile import read_bag
+    from wirefish_operator.mission_report import (plot_mission, summarise, summary_text,
+                                                  Track, turn_gain_text)
+
+    topic = f'{namespace.rstrip("/")}/sim/ground_truth'
+    state_topic = f'{namespace.rstrip("/")}/planner_state'
+    bag = read_bag(bag_path, [topic, state_topic])
+    # Header stamps, not the bag's receive times: the recorder takes its backlog in batches.
+    rows = [(_stamp(m) - t0, m.pose.pose.position.x, m.pose.pose.position.y,
+             2.0 * math.atan2(m.pose.pose.orientation.z, m.pose.pose.orientation.w),
+             m.twist.twist.linear.x, m.twist.twist.angular.z)
+            for _, m in bag.messages.get(topic, [])]
+    if len(rows) < 2:
+        print(f'wirefish mission: the bag {bag_path} has no {topic}: the report needs the '
+              "virtual fish's ground truth", file=sys.stderr)
+        return 1
+    data = np.array(rows)
+    track = Track(*(data[:, i] for i in range(6)))
+    summary = summarise(track, mission)
+    png = plot_mission(track, mission, summary, out / f'{mission.name}.png')
+    print(summary_text(mission, summary))
+    states = [(_stamp(m) - t0, m) for _, m in bag.messages.get(state_topic, [])]
+    print(turn_gain_text(states, mission, turn_gain))
+    print(f'bag: {bag_path}\nreport: {png}')
+    return 0
+
+
+def _stamp(message) -> float:
+    """Return a message's header stamp (s)."""
+    return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9

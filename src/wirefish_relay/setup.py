@@ -1,0 +1,26 @@
+from setuptools import find_packages, setup
+
+package_name = 'wirefish_relay'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', ['config/crossing.yaml']),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='wirefish maintainers',
+    maintainer_email='maintainers@wirefish.dev',
+    description="The fish's side of the radio link: the decimated copies the shore sees.",
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'link_relay = wirefish_relay.link_relay:main',
+        ],
+    },
+)
