@@ -43,7 +43,8 @@ test: setup  ## the whole suite, lint included
 # simulated sweeps of minutes) are left to `make test`, their lint is not.
 FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 	src/wirefish_analysis/test/test_flake8.py src/wirefish_analysis/test/test_pep257.py \
-	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py
+	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py \
+	test/test_host_closure.py test/test_package_size.py
 
 # pytest-xdist workers: one per core of the 2-core reference machine.
 FAST_JOBS ?= 2
@@ -55,7 +56,7 @@ lint: setup  ## flake8, pep257, mypy (mypy.ini) and the package.xml dependency c
 	@$(WFENV) python -m pytest -m linter $(PYTEST_ARGS)
 
 bench: setup  ## benchmarks: rewrites BENCHMARKS.md
-	@$(WFENV) python -m wirefish_analysis.bench
+	@$(WFENV) python -m wirefish_bench.bench
 
 shell: setup  ## an interactive shell with the workspace sourced
 	@$(WFENV) bash -i

@@ -25,7 +25,6 @@ setup(
             'fig11 = wirefish_analysis.fig11:main',
             'servo_calibration = wirefish_analysis.servo_calibration:main',
             'plot_body_wave = wirefish_analysis.plot_body_wave:main',
-            'bench = wirefish_analysis.bench:main',
         ],
         # Subcommands of the `wirefish` command that live here (see wirefish_cli.cli).
         'wirefish.commands': [

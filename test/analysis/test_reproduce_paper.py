@@ -5,8 +5,8 @@ import subprocess
 import sys
 
 import pytest
-from wirefish_analysis import bench_retune
 from wirefish_analysis.reproduce_paper import PAPER_RMSE_DEG
+from wirefish_bench import bench_retune
 
 
 @pytest.fixture(scope='module')

@@ -166,7 +166,8 @@ def _up_recording(spawn, python, namespace: str, out: Path, duration_s: int
     lines = _read_until(launcher, 'recording to', 120.0)
     assert lines and lines[-1].startswith('recording to'), ''.join(lines)
     bag = Path(lines[-1].split()[2].rstrip(';'))
-    (recorder,) = [p for p in descendants(launcher.pid) if 'record' in p.cmdline()]
+    (recorder,) = [p for p in descendants(launcher.pid)
+                   if any(Path(arg).name == 'recorder' for arg in p.cmdline()[:2])]
     assert _wait_flushed(bag, 60.0), 'recorder never flushed'
     return launcher, bag, recorder
 

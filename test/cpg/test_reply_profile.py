@@ -37,8 +37,8 @@ def test_fresh_clients_of_a_restarted_server_are_all_answered(ros_env, monkeypat
     env = probe.server_environment(profile=True, domain=int(ros_env['ROS_DOMAIN_ID']))
     batch = probe.Batch(calls=20, restart_every=10, deadline_s=10.0, find_s=30.0)
     with open(tmp_path / 'server.log', 'w') as log:
-        tally = probe.run_batch(probe.server_command(server), getattr(probe, call), batch,
-                                env, log)
+        tally = probe.run_batch(probe.server_command(server),
+                                (probe.fresh_call, getattr(probe, call)), batch, env, log)
     assert tally.no_service == 0
     assert tally.unanswered == 0
     assert tally.answered == 20

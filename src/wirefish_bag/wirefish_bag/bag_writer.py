@@ -13,7 +13,7 @@ first appear in, so every chunk that survives carries what is needed to read its
 Why ``mcap`` rather than foxglove-sdk's writer (its Rust core costs ~1 us a message here
 against ~5 us): its ``Channel.log`` takes no sequence number, and a bag keeps each message's
 DDS publication sequence number, which is how its gaps are counted. Either is < 3 % of what
-taking the message from the middleware costs (wirefish_analysis.bench_recorder). Chunks stay
+taking the message from the middleware costs (wirefish_bench.bench_recorder). Chunks stay
 uncompressed, as rosbag2 writes them by default.
 """
 

@@ -14,7 +14,7 @@ wake-up per period and a take per message, so a recorder that was starved for a 
 its backlog in one batch instead of falling further behind. A best-effort reader's history
 holds QUEUE_DEPTH samples (10 s of the 100 Hz streams): far more than a period or a stall
 (the recorder before this loop fell behind under load until that history overflowed). Writing
-stays in the loop: ``mcap``'s encoder costs ~4 us a message (wirefish_analysis.bench_recorder);
+stays in the loop: ``mcap``'s encoder costs ~4 us a message (wirefish_bench.bench_recorder);
 a writer thread would only add GIL hand-overs.
 
 What arrived is flushed to the file every FLUSH_PERIOD_S, so a SIGKILL loses at most that much:

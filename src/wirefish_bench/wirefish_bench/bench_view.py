@@ -8,7 +8,7 @@ among them. In each window: the view_node process's CPU, the rest of the graph's
 browser's (chromium and its children), and the rates of servo_cmd and imu/data as a separate
 ROS subscriber receives them (header stamps in the window); a third window without the
 browser again says how much the machine's own noise moves them. ``python -m
-wirefish_analysis.bench_view`` prints the JSON.
+wirefish_bench.bench_view`` prints the JSON.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ Latency of the bridge's two paths, over a real pty and real DDS (a benchmark, no
     side of the pty (this process plays the fish: it holds the pty master);
 (b) telemetry: TELEMETRY bytes written on the fish's side -> ``imu/data`` received here.
 bridge_node runs as its own process (the installed executable). ``python -m
-wirefish_analysis.bench_links`` prints the JSON.
+wirefish_bench.bench_links`` prints the JSON.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import tty
 
 import numpy as np
 
-from wirefish_analysis.bench_graph import ros_session
+from wirefish_bench.bench_graph import ros_session
 
 
 def _percentiles(samples_s: list[float]) -> dict:

@@ -10,7 +10,7 @@ objective integrates eq 1 particle by particle (plain RK4 loop, 2 ms step, 3 s t
 Both final positions are then scored with the exact loss, so "equal or better final loss" is
 judged on one ruler. pyswarms draws from NumPy's global RNG, so the baseline seeds it.
 
-``python -m wirefish_analysis.bench_retune`` prints the figures as JSON.
+``python -m wirefish_bench.bench_retune`` prints the figures as JSON.
 
 Gait library rows: ``library_answer`` times the same goal twice through a real
 tuner_node process and its retune_gait action (the first fits, the rest come from the

@@ -1,7 +1,7 @@
 """BENCHMARKS.md rows of the gait library: its answer and `wirefish gaits build`."""
 
 import pytest
-from wirefish_analysis.bench_report import rows
+from wirefish_bench.bench_report import rows
 
 MACHINE = {'machine': {}}
 

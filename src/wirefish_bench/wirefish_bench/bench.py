@@ -76,7 +76,7 @@ def one_fish(repeats: int, duration_s: float, domain_id: int, single_process: bo
     onboard-CPU verdict (the ratio of the two executors); the median of alternated windows
     does not drift with the load of the moment. The median run carries every run's figure.
     """
-    from wirefish_analysis import bench_graph
+    from wirefish_bench import bench_graph
 
     runs: dict[str, list[dict]] = {e: [] for e in EXECUTORS}
     for _ in range(repeats):
@@ -103,7 +103,7 @@ def _run(name: str, func, *args, **kwargs):
 
 def run_all(quick: bool = False) -> dict:
     """Run every benchmark; ``quick`` shortens the windows (for trying the harness)."""
-    from wirefish_analysis import bench_graph
+    from wirefish_bench import bench_graph
 
     scale = 0.2 if quick else 1.0
     results: dict = {'machine': machine()}
@@ -111,7 +111,7 @@ def run_all(quick: bool = False) -> dict:
                                 DOMAIN, e)
                            for r in (100.0, 200.0, 500.0, 1000.0) for e in EXECUTORS]
     try:
-        from wirefish_analysis import bench_links
+        from wirefish_bench import bench_links
         results['links_by_executor'] = {
             e: _run(f'command/telemetry latency ({e})', bench_links.run, domain_id=DOMAIN,
                     executor=e)
@@ -120,7 +120,7 @@ def run_all(quick: bool = False) -> dict:
         results['links_by_executor'] = {e: {'error': f'not available: {error}'}
                                         for e in EXECUTORS}
     try:
-        from wirefish_analysis import bench_retune
+        from wirefish_bench import bench_retune
         results['retune'] = _run('retune', bench_retune.run)
         # The same wave again comes from the gait library; the default gait family.
         results['retune_library'] = _run('retune answered from the library',
@@ -128,21 +128,21 @@ def run_all(quick: bool = False) -> dict:
         results['gaits_build'] = _run('wirefish gaits build', bench_retune.gaits_build)
     except ImportError as error:
         results['retune'] = {'error': f'not available: {error}'}
-    from wirefish_analysis import bench_radio_link
+    from wirefish_bench import bench_radio_link
     # What crosses fish -> shore, two network namespaces (root only; else the reason).
     results['radio_link'] = _run('radio link', bench_radio_link.run, domain_id=DOMAIN)
-    from wirefish_analysis import bench_firmware  # cycles per frame, flash and RAM
+    from wirefish_bench import bench_firmware  # cycles per frame, flash and RAM
     results['firmware'] = _run('firmware cycles and size', bench_firmware.run)
     results['kinematics_cpu'] = [
         _run(f'kinematics {s} x {r} ({e})', bench_graph.kinematics_cpu, s, r, 10.0 * scale,
              DOMAIN, e)
         for s, r in ((50, 50.0), (500, 200.0)) for e in EXECUTORS]
     results['recording'] = _run('recording', recording, 60.0 * scale, DOMAIN)
-    from wirefish_analysis import bench_recorder  # the recorder before and after its mcap rewrite
+    from wirefish_bench import bench_recorder  # the recorder before and after its mcap rewrite
     results['recorder_cpu'] = _run('recorder CPU, old and new', bench_recorder.run, DOMAIN)
-    from wirefish_analysis import bench_view  # the view server with one browser connected
+    from wirefish_bench import bench_view  # the view server with one browser connected
     results['view_cpu'] = _run('view server with one browser', bench_view.run, DOMAIN)
-    from wirefish_analysis import bench_old_new  # CPG timing, virtual fish, intakes: old vs new
+    from wirefish_bench import bench_old_new  # CPG timing, virtual fish, intakes: old vs new
     results['old_new'] = _run('old vs new: CPG timing, virtual fish, servo intakes',
                               bench_old_new.run, domain_id=DOMAIN)
     results['fleet'] = []
@@ -158,7 +158,7 @@ def run_all(quick: bool = False) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmarks, write the JSON and BENCHMARKS.md."""
-    from wirefish_analysis.bench_report import render_markdown
+    from wirefish_bench.bench_report import render_markdown
 
     parser = argparse.ArgumentParser(prog='wirefish-bench', description=__doc__.strip())
     parser.add_argument('--quick', action='store_true', help='short windows (harness check)')

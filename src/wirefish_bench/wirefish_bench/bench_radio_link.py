@@ -10,7 +10,7 @@ rate at which each copy arrived in the shaped window. Both DDS discoveries are m
 multicast (SUBNET) and static peers (LOCALHOST + ROS_STATIC_PEERS). No cmd_vel is sent (the
 two-host test drives from shore: +4.6 kB/s shore -> fish at 20 Hz).
 
-``python -m wirefish_analysis.bench_radio_link`` prints the figures as JSON; ``row(result)`` is
+``python -m wirefish_bench.bench_radio_link`` prints the figures as JSON; ``row(result)`` is
 the BENCHMARKS.md row.
 """
 

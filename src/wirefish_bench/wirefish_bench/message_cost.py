@@ -3,7 +3,7 @@ What one ROS message, timer tick or publish costs a Python process here (not a t
 
 docs/PROFILING.md builds its cost model of a fish's graph from these figures: each probe is a
 process of its own on the events executor (the graph's default), measured with psutil over a
-window after a warm-up. ``python -m wirefish_analysis.message_cost`` prints the JSON: CPU in %
+window after a warm-up. ``python -m wirefish_bench.message_cost`` prints the JSON: CPU in %
 of one core per process of each probe, and the same per event in microseconds.
 """
 
@@ -21,7 +21,7 @@ import psutil
 RATE_HZ = 200.0  # servo_cmd's rate before its default became 100 Hz
 TICK_HZ = 50.0  # kinematics_node's body_wave tick
 WARM_UP_S = 4.0
-MODULE = 'wirefish_analysis.message_cost'  # each probe runs as its own process
+MODULE = 'wirefish_bench.message_cost'  # each probe runs as its own process
 # The probes' own topic: not one of the graph's (CONTRACTS.md lists those).
 PROBE_TOPIC = 'cost_probe'
 

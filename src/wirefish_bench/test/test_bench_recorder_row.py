@@ -1,7 +1,7 @@
 """The recorder benchmark's row: its verdict follows the CPU ratio and the loss."""
 
 import pytest
-from wirefish_analysis.bench_recorder import row
+from wirefish_bench.bench_recorder import row
 
 
 def _result(old_cpu: float, new_cpu: float, new_missing: int) -> dict:

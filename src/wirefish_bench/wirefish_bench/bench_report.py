@@ -1,10 +1,10 @@
-"""Render benchmark results (the dict of `wirefish_analysis.bench`) as BENCHMARKS.md."""
+"""Render benchmark results (the dict of `wirefish_bench.bench`) as BENCHMARKS.md."""
 
-from wirefish_analysis.bench_firmware import row as firmware_row
-from wirefish_analysis.bench_old_new import rows as old_new_rows
-from wirefish_analysis.bench_radio_link import row as radio_row
-from wirefish_analysis.bench_recorder import row as recorder_row
-from wirefish_analysis.bench_view import row as view_row
+from wirefish_bench.bench_firmware import row as firmware_row
+from wirefish_bench.bench_old_new import rows as old_new_rows
+from wirefish_bench.bench_radio_link import row as radio_row
+from wirefish_bench.bench_recorder import row as recorder_row
+from wirefish_bench.bench_view import row as view_row
 
 
 def _fmt(value, spec: str = '.3g') -> str:
@@ -286,7 +286,7 @@ def render_markdown(results: dict) -> str:
     """Return the whole BENCHMARKS.md text."""
     m = results['machine']
     lines = ['# Benchmarks', '',
-             'Written by `make bench` (`python -m wirefish_analysis.bench`); figures from one '
+             'Written by `make bench` (`python -m wirefish_bench.bench`); figures from one '
              'run.',
              f'Machine: {m["cpu"]}, {m["cores"]} cores, Python {m["python"]}, numpy '
              f'{m["numpy"]}, kernel {m["kernel"]}; {m["date"]}'

@@ -1,7 +1,7 @@
 """bench_old_new's BENCHMARKS.md rows from given figures (pure: no processes)."""
 
 import pytest
-from wirefish_analysis.bench_old_new import rows
+from wirefish_bench.bench_old_new import rows
 
 
 def _result(new_p99_ms):

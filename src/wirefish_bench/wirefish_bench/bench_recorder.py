@@ -10,7 +10,7 @@ workspace). A second figure is the encoders alone: CPU per message written of th
 hand-written writer, ``mcap``'s Writer (the recorder's) and foxglove-sdk's, on the same
 serialised servo_cmd and imu/data messages with a flush every 200 messages (why the recorder
 does not use the cheapest one: wirefish_bag.bag_writer). ``python -m
-wirefish_analysis.bench_recorder`` prints the JSON.
+wirefish_bench.bench_recorder`` prints the JSON.
 """
 
 from __future__ import annotations
@@ -36,11 +36,11 @@ WINDOW_S = 30.0
 GOAL_RATIO = 0.5
 WRITER_MESSAGES = 40000
 WRITER_FLUSH_EVERY = 200
-MODULE = 'wirefish_analysis.bench_recorder'
+MODULE = 'wirefish_bench.bench_recorder'
 
 
 def _workspace() -> Path:
-    from wirefish_analysis.bench import WORKSPACE
+    from wirefish_bench.bench import WORKSPACE
     return WORKSPACE
 
 

@@ -1,7 +1,7 @@
 """The firmware's BENCHMARKS.md row: its verdict follows the flash and RAM budget."""
 
 import pytest
-from wirefish_analysis.bench_firmware import row
+from wirefish_bench.bench_firmware import row
 
 CYCLES = {'counter': 'tsc', 'repeats': 5,
           **{name: {'median': 400, 'worst': 700, 'raw_max': 10**7, 'runs': 20000}

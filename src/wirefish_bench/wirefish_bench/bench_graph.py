@@ -2,7 +2,7 @@
 Benchmarks of the running graph: publish-rate jitter, node CPU, recording loss, many fish.
 
 Each function starts real node processes (own ROS domain), measures from the receiving side
-and returns plain figures; `wirefish_analysis.bench` runs them all and writes BENCHMARKS.md.
+and returns plain figures; `wirefish_bench.bench` runs them all and writes BENCHMARKS.md.
 ``executor`` ('events' or 'classic', None: the nodes' default) is passed to the node
 processes as WIREFISH_EXECUTOR, so one run measures both side by side.
 Nothing here asserts: these are measurements, not tests.

@@ -1,6 +1,6 @@
 """The 1-fish rows of `make bench`: the median of alternated runs, every run's figure kept."""
 
-from wirefish_analysis import bench, bench_graph
+from wirefish_bench import bench, bench_graph
 
 
 def test_each_executor_gets_its_median_run_and_the_runs_alternate(monkeypatch):

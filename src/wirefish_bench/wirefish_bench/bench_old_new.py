@@ -59,7 +59,7 @@ def _with_path(entry: str | None) -> dict[str, str]:
 
 def cpg_period_error(repeats: int, domain_id: int) -> dict:
     """Alternate the old and the new cpg_node at 100 Hz (events); return each one's runs."""
-    from wirefish_analysis import bench_graph
+    from wirefish_bench import bench_graph
 
     runs: dict[str, list[dict]] = {'old': [], 'new': []}
     saved = os.environ.get('PYTHONPATH', '')
@@ -124,7 +124,7 @@ def simulators() -> dict:
 
 def intakes() -> dict:
     """Return each servo intake's subscriber CPU, old and new: message_cost at 200 Hz."""
-    from wirefish_analysis import message_cost
+    from wirefish_bench import message_cost
 
     probes = {**message_cost.run(WINDOW_S, only='tick')['probes'],
               **message_cost.run(WINDOW_S, only='servo pair')['probes']}
@@ -174,7 +174,7 @@ def rows(result: dict) -> list[tuple[str, str, str, str, str]]:
         '(bridge)', '—',
         f'kinematics: old {tick:.2f} %, new {batch:.2f} %; bridge: old {msg:.2f} %, new '
         f'{raw:.2f} %', '—',
-        'python -m wirefish_analysis.message_cost probes (one process each, events executor, '
+        'python -m wirefish_bench.message_cost probes (one process each, events executor, '
         f'{WINDOW_S:g} s after 4 s)'))
     return table
 

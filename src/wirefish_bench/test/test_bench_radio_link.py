@@ -1,6 +1,6 @@
 """The radio-link benchmark's BENCHMARKS.md row."""
 
-from wirefish_analysis.bench_radio_link import row
+from wirefish_bench.bench_radio_link import row
 
 
 def _mode(fish_to_shore: float) -> dict:

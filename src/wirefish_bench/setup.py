@@ -1,0 +1,26 @@
+from setuptools import find_packages, setup
+
+package_name = 'wirefish_bench'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='wirefish maintainers',
+    maintainer_email='maintainers@wirefish.dev',
+    description=('The benchmarks of make bench: each figure old against new in one run, '
+                 'written to BENCHMARKS.md.'),
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'bench = wirefish_bench.bench:main',
+        ],
+    },
+)

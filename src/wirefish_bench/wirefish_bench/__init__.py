@@ -1,0 +1,1 @@
+"""The benchmarks of `make bench`: each figure old against new in one run, into BENCHMARKS.md."""
