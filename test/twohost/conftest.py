@@ -25,10 +25,10 @@ def hosts(request: pytest.FixtureRequest, tmp_path) -> Iterator[Hosts]:
     """
     Yield a fish host and a shore host joined by a veth pair; remove both at the end.
 
-    DDS discovery across the pair is multicast unless the test asks for ``netns.STATIC``
-    (``@pytest.mark.parametrize('hosts', [STATIC], indirect=True)``).
+    DDS discovery across the pair is multicast unless the test asks for ``Discovery.STATIC``
+    (``@pytest.mark.parametrize('hosts', [Discovery.STATIC], indirect=True)``).
     """
-    from wirefish_launcher.netns import MULTICAST, root_problem, TwoHosts
+    from wirefish_launcher.netns import Discovery, root_problem, TwoHosts
 
     problem = root_problem()
     if problem is not None:
@@ -39,7 +39,7 @@ def hosts(request: pytest.FixtureRequest, tmp_path) -> Iterator[Hosts]:
     link.remove()  # a pair of the same token left by a killed run
     link.create()
     hosts = Hosts(link, DOMAIN_BASE + 19, f'/h{DOMAIN_BASE}_twohost', tmp_path,
-                  discovery=getattr(request, 'param', MULTICAST))
+                  discovery=getattr(request, 'param', Discovery.MULTICAST))
     try:
         yield hosts
     finally:

@@ -20,8 +20,8 @@ import time
 import numpy as np
 import pytest
 from twohost.link_hosts import wait_for
+from wirefish_bringup.graph import Role
 from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
-from wirefish_launcher.netns import FISH, SHORE
 from wirefish_relay.crossing import default_crossing_file, load_crossing
 
 pytestmark = pytest.mark.ros
@@ -82,9 +82,9 @@ def _max_gap(probe, topic: str, start: float, end: float) -> float:
 
 def _retune(hosts, frequency_hz: float) -> float:
     """Run `wirefish retune --apply` on the shore; return the frequency the fit applied."""
-    done = hosts.run(SHORE, ['wirefish', 'retune', '--apply', '--namespace', hosts.namespace,
-                             '--freq', str(frequency_hz), '--iterations', '30', '--swarm', '20',
-                             '--timeout', '60'], timeout_s=90.0)
+    done = hosts.run(Role.SHORE, ['wirefish', 'retune', '--apply', '--namespace',
+                                  hosts.namespace, '--freq', str(frequency_hz), '--iterations',
+                                  '30', '--swarm', '20', '--timeout', '60'], timeout_s=90.0)
     print(done.stdout[-1200:], done.stderr[-600:])
     assert done.returncode == 0, 'the retune called from shore failed'
     return float(re.search(r'^frequency_hz\s+([0-9.]+)', done.stdout, re.M).group(1))
@@ -97,10 +97,10 @@ def _applied(fish, frequency_hz: float, after: float) -> bool:
 
 def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
     link = hosts.link
-    hosts.up(FISH, 'fish')
-    hosts.up(SHORE, 'shore')
-    fish = hosts.probe(FISH, *FISH_TOPICS)
-    shore = hosts.probe(SHORE, *SHORE_TOPICS)
+    hosts.up(Role.FISH, 'fish')
+    hosts.up(Role.SHORE, 'shore')
+    fish = hosts.probe(Role.FISH, *FISH_TOPICS)
+    shore = hosts.probe(Role.SHORE, *SHORE_TOPICS)
     started = time.monotonic()
     wait_for(lambda: _count(shore, 'shore/imu/data') > 0
              and _count(shore, 'shore/speed_estimate') > 0, UP_TIMEOUT_S,
@@ -123,7 +123,7 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
              "the fit in the shore's copy of cpg_params")
 
     # The fit is a manual override (the planner does not drive it); the shore hands it back.
-    handed = hosts.run(SHORE, ['wirefish', 'hand-back', '--namespace', hosts.namespace],
+    handed = hosts.run(Role.SHORE, ['wirefish', 'hand-back', '--namespace', hosts.namespace],
                        timeout_s=30.0)
     assert handed.returncode == 0, handed.stderr
 
@@ -180,9 +180,9 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
         if shaped:
             link.shape('100kbit', '16kbit', '400ms')
             time.sleep(3.0)  # queues settle under the new limit
-        tx0, t0 = (link.tx_bytes(FISH), link.tx_bytes(SHORE)), time.monotonic()
+        tx0, t0 = (link.tx_bytes(Role.FISH), link.tx_bytes(Role.SHORE)), time.monotonic()
         time.sleep(RATE_WINDOW_S)
-        tx1, t1 = (link.tx_bytes(FISH), link.tx_bytes(SHORE)), time.monotonic()
+        tx1, t1 = (link.tx_bytes(Role.FISH), link.tx_bytes(Role.SHORE)), time.monotonic()
         rates = {row.topic: _rate(shore, row.shore_topic, t0, t1) for row in CROSSING}
         sources = {row.topic: _rate(fish, row.topic, t0, t1) for row in CROSSING
                    if row.topic in FISH_SOURCES}
@@ -196,7 +196,7 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
         print(f'{"100 kbit/s tbf" if shaped else "unshaped":>15}: fish->shore '
               f'{figures[shaped][0]:.0f} B/s, shore->fish {figures[shaped][1]:.0f} B/s; '
               + ', '.join(f'{topic} {hz:.1f} Hz' for topic, hz in rates.items()))
-    qdisc = link.qdisc(FISH)
+    qdisc = link.qdisc(Role.FISH)
     print(qdisc)
     dropped = int(re.search(r'dropped (\d+)', qdisc).group(1))
     print(f'tbf on the fish side: {dropped} packets dropped in {RATE_WINDOW_S + 3:g} s')

@@ -32,11 +32,11 @@ LIMIT_BYTES_S = 100_000 / 8
 
 
 def _window(link, seconds: float) -> dict:
-    from wirefish_launcher.netns import FISH, SHORE
+    from wirefish_bringup.graph import Role
 
-    before, t0 = (link.tx_bytes(FISH), link.tx_bytes(SHORE)), time.monotonic()
+    before, t0 = (link.tx_bytes(Role.FISH), link.tx_bytes(Role.SHORE)), time.monotonic()
     time.sleep(seconds)
-    after, t1 = (link.tx_bytes(FISH), link.tx_bytes(SHORE)), time.monotonic()
+    after, t1 = (link.tx_bytes(Role.FISH), link.tx_bytes(Role.SHORE)), time.monotonic()
     return {'fish_to_shore_B_s': (after[0] - before[0]) / (t1 - t0),
             'shore_to_fish_B_s': (after[1] - before[1]) / (t1 - t0), 'start': t0, 'end': t1}
 
@@ -52,7 +52,8 @@ def _wait_for_line(proc: subprocess.Popen, start: str, what: str) -> None:
 def measure(discovery: str, domain_id: int, subnet: int) -> dict:
     """Return the bytes crossing each way, unshaped and under the limit, for one discovery."""
     from wirefish_bag.bagfile import read_bag
-    from wirefish_launcher.netns import FISH, SHORE, TwoHosts
+    from wirefish_bringup.graph import Role
+    from wirefish_launcher.netns import TwoHosts
 
     link = TwoHosts(f'b{os.getpid() % 10**6:x}', subnet)
     out = Path(tempfile.mkdtemp(prefix='wirefish_bench_radio_'))
@@ -61,7 +62,7 @@ def measure(discovery: str, domain_id: int, subnet: int) -> dict:
     link.remove()
     link.create()
     try:
-        def up(side: str, *extra: str) -> subprocess.Popen:
+        def up(side: Role, *extra: str) -> subprocess.Popen:
             env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                        **link.ros_environment(side, discovery))
             proc = subprocess.Popen(
@@ -72,18 +73,18 @@ def measure(discovery: str, domain_id: int, subnet: int) -> dict:
             procs.append(proc)
             return proc
 
-        fish = up(FISH)
-        _wait_for_line(fish, 'running:', FISH)
-        shore = up(SHORE, '--duration', str(duration))
-        _wait_for_line(shore, 'recording to', SHORE)
+        fish = up(Role.FISH)
+        _wait_for_line(fish, 'running:', Role.FISH)
+        shore = up(Role.SHORE, '--duration', str(duration))
+        _wait_for_line(shore, 'recording to', Role.SHORE)
         time.sleep(SETTLE_S)
         unshaped = _window(link, WINDOW_S)
         link.shape(LIMIT, '16kbit', '400ms')
         time.sleep(3.0)
         shaped = _window(link, WINDOW_S)
-        drops = link.qdisc(FISH)
+        drops = link.qdisc(Role.FISH)
         shore.wait(timeout=duration + 60)
-        bag = next((out / SHORE).glob('run_*/bag'))
+        bag = next((out / Role.SHORE).glob('run_*/bag'))
         messages = read_bag(bag).messages
         start_ns, end_ns = shaped['start'], shaped['end']
         rates = {}
@@ -109,12 +110,12 @@ def measure(discovery: str, domain_id: int, subnet: int) -> dict:
 
 def run(domain_id: int = 101, subnet: int = 250) -> dict:
     """Measure both discoveries; without root say why nothing was measured."""
-    from wirefish_launcher.netns import MULTICAST, root_problem, STATIC
+    from wirefish_launcher.netns import Discovery, root_problem
 
     problem = root_problem()
     if problem is not None:
         return {'error': problem}
-    return {mode: measure(mode, domain_id, subnet) for mode in (MULTICAST, STATIC)}
+    return {mode: measure(mode, domain_id, subnet) for mode in Discovery}
 
 
 def row(result: dict) -> tuple[str, str, str, str, str]:

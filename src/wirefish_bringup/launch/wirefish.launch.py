@@ -19,17 +19,18 @@ from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
 from wirefish_bringup.dds_profile import (profile_path, PROFILES_VARIABLE, TRANSPORTS,
                                           TRANSPORTS_VARIABLE)
-from wirefish_bringup.graph import ALL, DEFAULT_NAMESPACE, fish_graph, ROLES
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, Role
 
 
 def _shutdown_after_last_retry(spec):
     """Return an on_exit callback: Shutdown once the node's respawn retries are spent."""
-    exits = [0]
+    exits = 0
 
     def on_exit(_event, _context):
-        exits[0] += 1
-        if exits[0] > spec.restart.max_restarts:
-            return [Shutdown(reason=f'{spec.name} (required) exited {exits[0]} times')]
+        nonlocal exits
+        exits += 1
+        if exits > spec.restart.max_restarts:
+            return [Shutdown(reason=f'{spec.name} (required) exited {exits} times')]
         return None
     return on_exit
 
@@ -74,7 +75,8 @@ def generate_launch_description():
                               description='ROS namespace of every node and topic of the fish'),
         DeclareLaunchArgument('params_file', default_value='',
                               description='parameter YAML (default: config/wirefish.yaml)'),
-        DeclareLaunchArgument('role', default_value=ALL, choices=list(ROLES),
+        DeclareLaunchArgument('role', default_value=Role.ALL.value,
+                              choices=[role.value for role in Role],
                               description='fish: the nodes that keep the fish swimming (and '
                               'the link relay to shore); shore: tuner (and recorder); all: both'),
         DeclareLaunchArgument('frame_prefix', default_value='',

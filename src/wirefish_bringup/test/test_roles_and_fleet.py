@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 from wirefish_bringup.fleet import fleet_graph, fleet_namespaces
-from wirefish_bringup.graph import entries, FISH, fish_graph, SHORE
+from wirefish_bringup.graph import entries, fish_graph, Role
 
 
 def _names(specs):
@@ -17,20 +17,21 @@ def _option(spec, name: str) -> str:
 
 
 def test_the_fish_role_holds_what_keeps_the_fish_swimming_and_the_relay():
-    assert _names(fish_graph('/w', role=FISH)) == [
+    assert _names(fish_graph('/w', role=Role.FISH)) == [
         'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'tf_node', 'planner_node',
         'link_relay']
 
 
 def test_the_shore_role_holds_the_tuner_and_the_recorder_of_the_shore_copies():
-    specs = fish_graph('/w', role=SHORE, bag=Path('/tmp/b'))
+    specs = fish_graph('/w', role=Role.SHORE, bag=Path('/tmp/b'))
     assert _names(specs) == ['tuner_node', 'wirefish_recorder']
     assert _option(specs[-1], '--namespace') == '/w/shore'
 
 
 def test_both_roles_together_are_the_one_host_graph_without_a_relay():
     together = set(_names(fish_graph('/w')))
-    apart = set(_names(fish_graph('/w', role=FISH))) | set(_names(fish_graph('/w', role=SHORE)))
+    apart = (set(_names(fish_graph('/w', role=Role.FISH)))
+             | set(_names(fish_graph('/w', role=Role.SHORE))))
     assert apart - together == {'link_relay'}
 
 
@@ -78,7 +79,7 @@ def test_a_fleets_virtual_fish_are_one_process_first_with_each_fishs_link_and_na
 
 
 def test_the_shore_side_of_a_fleet_has_no_virtual_fish():
-    assert 'fish_sim' not in _names(fleet_graph('/tank', 2, role=SHORE))
+    assert 'fish_sim' not in _names(fleet_graph('/tank', 2, role=Role.SHORE))
 
 
 def test_a_fleet_recording_is_one_recorder_of_the_base_namespace():

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from wirefish_bringup.graph import (ALL, entry, fish_graph, NodeSpec, RECORD, sim_tty_link,
-                                    validate_namespace)
+from wirefish_bringup.graph import (entry, fish_graph, NodeSpec, Role, sim_tty_link,
+                                    validate_namespace, When)
 
 SIMULATOR = 'fish_sim'  # the registry entry of the virtual fish
 
@@ -56,7 +56,7 @@ def fleet_simulator(base: str, names: list[str], params_file: str) -> NodeSpec:
 
 
 def fleet_graph(base: str, count: int, *, params_file: Path | str | None = None,
-                bag: Path | None = None, role: str = ALL) -> list[NodeSpec]:
+                bag: Path | None = None, role: str = Role.ALL) -> list[NodeSpec]:
     """
     Return the processes of a fleet of virtual fish: the virtual fish, each graph, a recorder.
 
@@ -75,5 +75,5 @@ def fleet_graph(base: str, count: int, *, params_file: Path | str | None = None,
         specs.insert(0, fleet_simulator(base, names, str(simulators[0].params_file)))
     if bag is not None:
         specs += [s for s in fish_graph(base, sim=True, params_file=params_file, bag=bag)
-                  if entry(s.name).when == RECORD]
+                  if entry(s.name).when == When.RECORD]
     return specs

@@ -21,6 +21,7 @@ retries are spent.
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+import enum
 import math
 from pathlib import Path
 import re
@@ -33,17 +34,30 @@ DEFAULT_NAMESPACE = '/wirefish'
 PARAMS_FILE_NAME = 'wirefish.yaml'
 _NAMESPACE_PATTERN = re.compile(r'^(/[A-Za-z][A-Za-z0-9_]*)+$|^/$')
 
-# When an entry is part of the graph: always, only with the virtual fish, only when recording,
-# only when the fish runs apart from its shore (role fish: the link relay, see crossing.py).
-ALWAYS, SIM, RECORD, APART = 'always', 'sim', 'record', 'apart'
-# Only with the emulated board: the firmware's ARM build in QEMU (`wirefish up --fish qemu`).
-QEMU = 'qemu'
-# Only with the live view (`wirefish up --view`): the Foxglove server and the dashboard.
-VIEW = 'view'
-# Which side of the radio link an entry runs on. The fish side is everything that
-# keeps the fish safe and swimming without shore; the shore side only tunes, records, drives.
-FISH, SHORE, ALL = 'fish', 'shore', 'all'
-ROLES = (FISH, SHORE, ALL)
+
+class When(enum.Enum):
+    """When an entry is part of the graph (it never leaves the registry: a plain Enum)."""
+
+    ALWAYS = 'always'
+    SIM = 'sim'  # only with the virtual fish
+    RECORD = 'record'  # only when recording
+    # Only when the fish runs apart from its shore (role fish: the link relay, see crossing.py).
+    APART = 'apart'
+    QEMU = 'qemu'  # only with the emulated board: the firmware's ARM build in QEMU (--fish qemu)
+    VIEW = 'view'  # only with the live view (`wirefish up --view`): Foxglove server, dashboard
+
+
+class Role(enum.StrEnum):
+    """
+    Which side of the radio link an entry runs on (`wirefish up --role`, the launch argument).
+
+    The fish side is everything that keeps the fish safe and swimming without shore; the shore
+    side only tunes, records, drives. ALL: both sides on one machine.
+    """
+
+    FISH = 'fish'
+    SHORE = 'shore'
+    ALL = 'all'
 
 
 @dataclass(frozen=True)
@@ -136,7 +150,7 @@ class NodeEntry:
     name: str
     start_order: int
     node_class: str | None = None
-    when: str = ALWAYS
+    when: When = When.ALWAYS
     arguments: tuple[str, ...] = ()
     parameters: Mapping[str, str] = field(default_factory=dict)
     ros_args: bool = True
@@ -146,16 +160,16 @@ class NodeEntry:
     rates_hz: Mapping[str, float] = field(default_factory=dict)
     min_rates_hz: Mapping[str, float] = field(default_factory=dict)
     fed_by: tuple[str, ...] = ()
-    role: str = FISH
+    role: Role = Role.FISH
     frames: bool = False
 
 
 NODES: tuple[NodeEntry, ...] = (
-    NodeEntry('wirefish_sim', 'fish_sim', 'fish_sim', start_order=0, when=SIM,
+    NodeEntry('wirefish_sim', 'fish_sim', 'fish_sim', start_order=0, when=When.SIM,
               arguments=('--link', '{device}', '--ros'), creates_link=True, frames=True,
               restart=RestartPolicy(required=True), rates_hz={'sim/ground_truth': 50.0}),
     # The firmware on an emulated STM32F405 (qemu_board): no physics, so no sim/ground_truth.
-    NodeEntry('wirefish_launcher', 'qemu_board', 'qemu_fish', start_order=0, when=QEMU,
+    NodeEntry('wirefish_launcher', 'qemu_board', 'qemu_fish', start_order=0, when=When.QEMU,
               arguments=('--link', '{device}'), creates_link=True, ros_args=False,
               restart=RestartPolicy(required=True)),
     NodeEntry('wirefish_bridge', 'bridge_node', 'bridge_node', start_order=10,
@@ -179,17 +193,18 @@ NODES: tuple[NodeEntry, ...] = (
               node_class='wirefish_planner.planner_node:PlannerNode',
               parameters={'rest_at_start': 'false'}, fed_by=('bridge_node',)),
     NodeEntry('wirefish_tuner', 'tuner_node', 'tuner_node', start_order=40,
-              node_class='wirefish_tuner.tuner_node:TunerNode', own_executor=True, role=SHORE),
+              node_class='wirefish_tuner.tuner_node:TunerNode', own_executor=True,
+              role=Role.SHORE),
     # The fish's side of the radio: the decimated copies the shore sees (config/crossing.yaml).
-    NodeEntry('wirefish_relay', 'link_relay', 'link_relay', start_order=45, when=APART),
+    NodeEntry('wirefish_relay', 'link_relay', 'link_relay', start_order=45, when=When.APART),
     # `wirefish up --duration`. Restarted with --resume: a killed recorder's bag is reindexed
     # and the new one records on into its next split file (the run keeps one bag).
-    NodeEntry('wirefish_bag', 'recorder', 'wirefish_recorder', start_order=50, when=RECORD,
+    NodeEntry('wirefish_bag', 'recorder', 'wirefish_recorder', start_order=50, when=When.RECORD,
               arguments=('-o', '{bag}', '--namespace', '{recorded}', '--resume'),
-              role=SHORE, ros_args=False),
+              role=Role.SHORE, ros_args=False),
     # `wirefish up --view`: the Foxglove WebSocket server over the graph and the dashboard.
-    NodeEntry('wirefish_view', 'view_node', 'view_node', start_order=60, when=VIEW,
-              role=SHORE, frames=True),
+    NodeEntry('wirefish_view', 'view_node', 'view_node', start_order=60, when=When.VIEW,
+              role=Role.SHORE, frames=True),
 )
 
 # The process that hosts every entry with a node_class in single-process mode.
@@ -286,7 +301,7 @@ def sim_tty_link(namespace: str) -> Path:
     return Path('/tmp', f'wirefish-{token}-tty')
 
 
-def entries(*, sim: bool, record: bool = False, role: str = ALL,
+def entries(*, sim: bool, record: bool = False, role: str = Role.ALL,
             qemu: bool = False, view: bool = False) -> list[NodeEntry]:
     """
     Return the registry entries of a graph, in start order.
@@ -296,12 +311,14 @@ def entries(*, sim: bool, record: bool = False, role: str = ALL,
     role only: with both sides on one host nothing crosses a radio. ``qemu``: with the
     emulated board (the firmware in QEMU) as the fish; ``view``: with the live view.
     """
-    if role not in ROLES:
-        raise ValueError(f'unknown role {role!r}: choose one of {", ".join(ROLES)}')
-    active = {ALWAYS, *([SIM] if sim else []), *([QEMU] if qemu else []),
-              *([RECORD] if record else []), *([VIEW] if view else []),
-              *([APART] if role == FISH else [])}
-    return sorted((e for e in NODES if e.when in active and role in (ALL, e.role)),
+    try:
+        role = Role(role)
+    except ValueError:
+        raise ValueError(f'unknown role {role!r}: choose one of {", ".join(Role)}') from None
+    active = {When.ALWAYS, *([When.SIM] if sim else []), *([When.QEMU] if qemu else []),
+              *([When.RECORD] if record else []), *([When.VIEW] if view else []),
+              *([When.APART] if role == Role.FISH else [])}
+    return sorted((e for e in NODES if e.when in active and role in (Role.ALL, e.role)),
                   key=lambda e: e.start_order)
 
 
@@ -350,7 +367,7 @@ def expected_rates(*, sim: bool = True) -> tuple[dict[str, float], dict[str, flo
 
 def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
                port: str | None = None, params_file: Path | str | None = None,
-               single_process: bool = False, bag: Path | None = None, role: str = ALL,
+               single_process: bool = False, bag: Path | None = None, role: str = Role.ALL,
                frame_prefix: str = '', qemu: bool = False,
                view: bool = False) -> list[NodeSpec]:
     """
@@ -378,7 +395,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     params = str(params_file or default_params_file())
     device = str(sim_tty_link(namespace)) if sim else str(port)
     # The shore alone records what crosses the link (shore/...), never the fish's fast streams.
-    recorded = f'{namespace.rstrip("/")}/shore' if role == SHORE else namespace
+    recorded = f'{namespace.rstrip("/")}/shore' if role == Role.SHORE else namespace
     values = {'device': device, 'namespace': namespace, 'recorded': recorded,
               **({'bag': str(bag)} if bag else {})}
     specs: list[NodeSpec] = []
@@ -386,7 +403,7 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     prefix_problem = frame_prefix_problem(frame_prefix)
     if prefix_problem is not None:
         raise ValueError(prefix_problem)
-    if single_process and (role != ALL or frame_prefix):
+    if single_process and (role != Role.ALL or frame_prefix):
         raise ValueError('the single-process mode hosts one whole fish (wirefish compose): '
                          'a role or a frame prefix needs one process per node')
     with_prefix = {'frame_prefix': frame_prefix} if frame_prefix else {}

@@ -11,22 +11,23 @@ import argparse
 from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import datetime
+import enum
 import importlib.util
 import math
 import os
 from pathlib import Path
-import signal
 import sys
 import time
 
 from wirefish_bringup.dds_profile import graph_environment, write_profile
-from wirefish_bringup.graph import (ALL, DEFAULT_NAMESPACE, fish_graph, NodeSpec, ROLES, SHORE,
+from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, Role,
                                     validate_namespace)
 from wirefish_cli.api import duration_s
 from wirefish_common.input_checks import params_file_problem, serial_port_problem
 from wirefish_common.progress import duration_text, Progress
 from wirefish_launcher.errors import QemuBoardError
 from wirefish_launcher.status_view import LiveStatus, TerminalBlock
+from wirefish_launcher.stop_flag import stop_on_signals, StopFlag
 from wirefish_launcher.supervisor import Supervisor, wait_for_path
 
 STATUS_WINDOW_S = 3.0
@@ -47,19 +48,26 @@ READY_TIMEOUT_S = 60.0
 DUPLICATE_CHECK_S = 4.0
 
 
+class Fish(enum.StrEnum):
+    """What `wirefish up --fish` drives: the virtual fish or the firmware on an emulated board."""
+
+    SIM = 'sim'
+    QEMU = 'qemu'
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish up`."""
     target = parser.add_mutually_exclusive_group()
     target.add_argument('--sim', action='store_true', default=True,
                         help='drive the virtual fish on a pseudo-terminal (default)')
     target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
-    target.add_argument('--fish', choices=('sim', 'qemu'), default=None,
+    target.add_argument('--fish', choices=list(Fish), default=None,
                         help='sim: the virtual fish (as --sim); qemu: the firmware on an '
                         'emulated STM32F405 (QEMU; built with make -C firmware qemu), the bridge '
                         'on its pty (no physics: no sim/ground_truth)')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
                         help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
-    parser.add_argument('--role', choices=ROLES, default=ALL,
+    parser.add_argument('--role', choices=list(Role), default=Role.ALL,
                         help='one side of a radio link: fish (virtual fish or port, bridge, '
                         'CPG, kinematics, planner, link relay) or shore (tuner, recorder); '
                         'all: both on this machine (default). See README: two hosts')
@@ -110,16 +118,17 @@ def _registry_nodes(specs: list[NodeSpec], namespace: str) -> list[str]:
 
 
 def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], supervisor: Supervisor,
-                show_status: bool, stop_requested: list,
-                timeout_s: float = READY_TIMEOUT_S, role: str = ALL,
-                live_views: list | None = None) -> str | None:
+                show_status: bool, stop: StopFlag,
+                timeout_s: float = READY_TIMEOUT_S, role: str = Role.ALL
+                ) -> tuple[str | None, LiveStatus | None]:
     """
-    Wait until every node of the graph is on the ROS graph; return the status table or None.
+    Wait until every node of the graph is on the ROS graph; return (status table, its status).
 
     A node is "up" once it is discoverable (its rclpy.init and constructor are done), so a
     Ctrl-C after "running:" always reaches nodes that handle it cleanly. Exits while waiting
     are answered by the restart policies; a node given up on is no longer waited for. The
-    status that measured the table is appended to ``live_views`` (the live view goes on with it).
+    table is None after a stop request, '' without ``show_status``; the status that measured
+    it comes with it (the live view goes on with it), None when there is no table.
     """
     from wirefish_launcher.monitor import discovered_nodes, settle_discovery
 
@@ -133,33 +142,32 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
     deadline = time.monotonic() + timeout_s
     while not up():
         _report(supervisor.supervise())
-        if stop_requested and deadline > time.monotonic() + STOP_GRACE_S:
+        if stop.requested and deadline > time.monotonic() + STOP_GRACE_S:
             # A node interrupted while still importing dies of the SIGINT (exit -2, a
             # KeyboardInterrupt trace): let every node finish starting, then stop them all.
             print('wirefish up: stopping as soon as every node has started', file=sys.stderr)
             deadline = time.monotonic() + STOP_GRACE_S
         if time.monotonic() > deadline:
             missing = ', '.join(sorted(expected() - discovered_nodes(node)))
-            return None if stop_requested else f'not up after {timeout_s:g} s: {missing}'
+            return (None if stop.requested else f'not up after {timeout_s:g} s: {missing}',
+                    None)
         executor.spin_once(timeout_sec=0.1)
-    if stop_requested:
-        return None
+    if stop.requested:
+        return None, None
     if not show_status:
-        return ''
-    settle_discovery(node, executor, namespace, should_stop=lambda: bool(stop_requested))
+        return '', None
+    settle_discovery(node, executor, namespace, should_stop=lambda: stop.requested)
     # The shore watches what crosses the link only: measuring the fish's own streams would
     # pull them over the radio.
-    watched = f'{namespace.rstrip("/")}/shore' if role == SHORE else namespace
+    watched = f'{namespace.rstrip("/")}/shore' if role == Role.SHORE else namespace
     live = LiveStatus(node, watched)
     measured_until = time.monotonic() + STATUS_WINDOW_S
-    while time.monotonic() < measured_until and not stop_requested:
+    while time.monotonic() < measured_until and not stop.requested:
         time.sleep(0.25)
         live.refresh()
-    if stop_requested:  # Ctrl-C while the table was measured: stop now, no table
-        return None
-    if live_views is not None:
-        live_views.append(live)
-    return '\n'.join([f'nodes: {", ".join(sorted(expected()))}', *live.lines()])
+    if stop.requested:  # Ctrl-C while the table was measured: stop now, no table
+        return None, None
+    return '\n'.join([f'nodes: {", ".join(sorted(expected()))}', *live.lines()]), live
 
 
 def _report(lines: list[str]) -> None:
@@ -214,7 +222,7 @@ def _run(args: argparse.Namespace) -> int:
             raise ValueError('--duration records the run, which needs the wirefish_bag package '
                              '(a shore install); this host has none')
         namespace = validate_namespace(args.namespace)
-        qemu = args.fish == 'qemu'
+        qemu = args.fish == Fish.QEMU
         sim = args.port is None and not qemu
         if args.fleet is not None:
             if args.port is not None or qemu or args.single_process or args.frame_prefix:
@@ -249,15 +257,9 @@ def _run(args: argparse.Namespace) -> int:
     # The reply writers' profile must name the graph's own namespaces (dds_profile).
     env, own_profile = graph_environment(
         os.environ, {s.namespace for s in specs if s.namespace}, run_dir,
-        radio=args.role != ALL)
+        radio=args.role != Role.ALL)
     supervisor = Supervisor(run_dir / 'logs', env=env)
-    stop_requested = []
-
-    def request_stop(signum, _frame) -> None:
-        stop_requested.append(signum)
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
+    stop = stop_on_signals()
     code = 0
     codes: dict[str, int | None] = {}
     try:
@@ -267,7 +269,7 @@ def _run(args: argparse.Namespace) -> int:
                 present = registry_nodes_present(node, executor, namespace,
                                                  _registry_nodes(specs, namespace),
                                                  DUPLICATE_CHECK_S,
-                                                 should_stop=lambda: bool(stop_requested))
+                                                 should_stop=lambda: stop.requested)
                 if present:
                     domain = os.environ.get('ROS_DOMAIN_ID', '0')
                     print(f'wirefish up: namespace {namespace} is in use on ROS domain {domain} '
@@ -275,7 +277,7 @@ def _run(args: argparse.Namespace) -> int:
                           'choose another --namespace, or pass --allow-duplicate',
                           file=sys.stderr)
                     return 1
-                if stop_requested:
+                if stop.requested:
                     return 0
             write_profile(env, own_profile)
             for spec in specs:
@@ -293,20 +295,18 @@ def _run(args: argparse.Namespace) -> int:
                 from wirefish_cpg.gait_library import tuner_library_path
                 library = tuner_library_path(args.params_file or default_params_file())
                 print(f'gait library: {library}', flush=True)
-            live_views: list = []
-            status = _wait_ready(node, executor, namespace, specs, supervisor,
-                                 not args.no_status, stop_requested, role=args.role,
-                                 live_views=live_views)
+            status, measured = _wait_ready(node, executor, namespace, specs, supervisor,
+                                           not args.no_status, stop, role=args.role)
         if status and status.startswith('not up'):
             raise RuntimeError(status)
         # On a terminal the status is redrawn in place while the graph runs; else shown once.
-        live = live_views[0] if live_views and sys.stdout.isatty() else None
-        if live is None and live_views:
-            live_views[0].close()  # shown once: no more samples to keep
+        live = measured if sys.stdout.isatty() else None
+        if live is None and measured is not None:
+            measured.close()  # shown once: no more samples to keep
         block = TerminalBlock(sys.stdout) if live is not None else None
         if status and block is None:
             print(status)
-        if stop_requested:
+        if stop.requested:
             pass  # Ctrl-C during start-up: straight to stopping
         elif bag_path is not None:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
@@ -316,9 +316,9 @@ def _run(args: argparse.Namespace) -> int:
         # A timed run off a terminal says how far it is (a line per 5 %, with the time left);
         # on a terminal the live status's first line says it.
         timed = (Progress('recording, seconds', math.ceil(args.duration), stream=sys.stdout)
-                 if args.duration is not None and block is None and not stop_requested
+                 if args.duration is not None and block is None and not stop.requested
                  else None)
-        while not stop_requested:
+        while not stop.requested:
             reports = supervisor.supervise()
             if reports and block is not None:
                 block.forget()  # the reports stay; the status goes on below them

@@ -21,14 +21,26 @@ between them past the veth, so a cut link would not cut.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import enum
 import json
 import os
 import re
 import shutil
 import subprocess
 
-FISH, SHORE = 'fish', 'shore'
-MULTICAST, STATIC = 'multicast', 'static'
+from wirefish_bringup.graph import Role
+
+# The two hosts are the two roles of a graph apart (each runs `wirefish up --role <side>`).
+SIDES = (Role.FISH, Role.SHORE)
+
+
+class Discovery(enum.StrEnum):
+    """How DDS discovers across the link (`wirefish twohost --discovery`)."""
+
+    MULTICAST = 'multicast'
+    STATIC = 'static'
+
+
 _TOKEN = re.compile(r'^[a-z0-9]{1,8}$')  # wf + token + one letter fits IFNAMSIZ (15)
 COMMAND_TIMEOUT_S = 10.0
 MULTICAST_ROUTE = '224.0.0.0/4'  # IPv4 multicast, routed over the veth (see create())
@@ -74,28 +86,29 @@ class TwoHosts:
         if not 0 <= self.subnet <= 255:
             raise ValueError(f'subnet {self.subnet}: 0 to 255 (10.213.<subnet>.0/24)')
 
-    def namespace(self, side: str) -> str:
-        """Return the network namespace of ``side`` (FISH or SHORE)."""
-        return f'wf{self.token}{"f" if side == FISH else "s"}'
+    def namespace(self, side: Role) -> str:
+        """Return the network namespace of ``side`` (Role.FISH or Role.SHORE)."""
+        return f'wf{self.token}{"f" if side == Role.FISH else "s"}'
 
-    def device(self, side: str) -> str:
+    def device(self, side: Role) -> str:
         """Return the veth end inside ``side``'s namespace."""
-        return f'wf{self.token}{"a" if side == FISH else "b"}'
+        return f'wf{self.token}{"a" if side == Role.FISH else "b"}'
 
-    def address(self, side: str) -> str:
+    def address(self, side: Role) -> str:
         """Return the IPv4 address of ``side``."""
-        return f'10.213.{self.subnet}.{1 if side == FISH else 2}'
+        return f'10.213.{self.subnet}.{1 if side == Role.FISH else 2}'
 
     @staticmethod
-    def other(side: str) -> str:
+    def other(side: Role) -> Role:
         """Return the other side."""
-        return SHORE if side == FISH else FISH
+        return Role.SHORE if side == Role.FISH else Role.FISH
 
-    def exec_prefix(self, side: str) -> list[str]:
+    def exec_prefix(self, side: Role) -> list[str]:
         """Return the command prefix that runs a program on ``side``'s host."""
         return ['ip', 'netns', 'exec', self.namespace(side)]
 
-    def ros_environment(self, side: str, discovery: str = MULTICAST) -> dict[str, str]:
+    def ros_environment(self, side: Role, discovery: str = Discovery.MULTICAST
+                        ) -> dict[str, str]:
         """
         Return the DDS settings of ``side``'s processes.
 
@@ -104,10 +117,11 @@ class TwoHosts:
         other host> (unicast, for links that carry no multicast; Fast DDS then announces every
         participant to each participant port the peer may use, see the README's figures).
         """
-        if discovery not in (MULTICAST, STATIC):
-            raise ValueError(f'discovery {discovery!r}: {MULTICAST} or {STATIC}')
+        if discovery not in tuple(Discovery):
+            raise ValueError(f'discovery {discovery!r}: {Discovery.MULTICAST} or '
+                             f'{Discovery.STATIC}')
         env = {'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4', 'ROS_STATIC_PEERS': ''}
-        if discovery == MULTICAST:
+        if discovery == Discovery.MULTICAST:
             return {**env, 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}
         return {**env, 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST',
                 'ROS_STATIC_PEERS': self.address(self.other(side))}
@@ -115,12 +129,12 @@ class TwoHosts:
     def create(self) -> None:
         """Make both namespaces, the veth pair between them, addresses, routes; bring all up."""
         try:
-            for side in (FISH, SHORE):
+            for side in SIDES:
                 _run('ip', 'netns', 'add', self.namespace(side))
-            _run('ip', 'link', 'add', self.device(FISH), 'netns', self.namespace(FISH),
-                 'type', 'veth', 'peer', 'name', self.device(SHORE),
-                 'netns', self.namespace(SHORE))
-            for side in (FISH, SHORE):
+            _run('ip', 'link', 'add', self.device(Role.FISH), 'netns', self.namespace(Role.FISH),
+                 'type', 'veth', 'peer', 'name', self.device(Role.SHORE),
+                 'netns', self.namespace(Role.SHORE))
+            for side in SIDES:
                 ns = self.namespace(side)
                 _run('ip', '-n', ns, 'addr', 'add', f'{self.address(side)}/24',
                      'dev', self.device(side))
@@ -133,15 +147,15 @@ class TwoHosts:
 
     def remove(self) -> None:
         """Delete both namespaces (their veth ends go with them); what is not there is skipped."""
-        for side in (FISH, SHORE):
+        for side in SIDES:
             _run('ip', 'netns', 'delete', self.namespace(side), check=False)
 
     def exists(self) -> list[str]:
         """Return which of this pair's namespaces exist now."""
         listed = _run('ip', 'netns', 'list').stdout.split()
-        return [self.namespace(s) for s in (FISH, SHORE) if self.namespace(s) in listed]
+        return [self.namespace(s) for s in SIDES if self.namespace(s) in listed]
 
-    def _route_multicast(self, side: str) -> None:
+    def _route_multicast(self, side: Role) -> None:
         # A real host sends multicast along its default route; a fresh namespace has only the
         # veth's subnet route, so every multicast send fails (ENETUNREACH) and Fast DDS
         # discovers nothing across the pair, with static peers too (its participant announces
@@ -150,7 +164,7 @@ class TwoHosts:
              'dev', self.device(side))
 
     def _set_links(self, state: str) -> None:
-        for side in (FISH, SHORE):
+        for side in SIDES:
             _run('ip', '-n', self.namespace(side), 'link', 'set', self.device(side), state)
             if state == 'up':
                 self._route_multicast(side)
@@ -166,23 +180,23 @@ class TwoHosts:
     def shape(self, rate: str = '100kbit', burst: str = '16kbit', latency: str = '400ms'
               ) -> None:
         """Limit both ends' egress with a token bucket (tc tbf): a Bluetooth-like serial link."""
-        for side in (FISH, SHORE):
+        for side in SIDES:
             _run('ip', 'netns', 'exec', self.namespace(side), 'tc', 'qdisc', 'replace', 'dev',
                  self.device(side), 'root', 'tbf', 'rate', rate, 'burst', burst,
                  'latency', latency)
 
     def unshape(self) -> None:
         """Remove the token-bucket limits (back to the veth's own qdisc)."""
-        for side in (FISH, SHORE):
+        for side in SIDES:
             _run('ip', 'netns', 'exec', self.namespace(side), 'tc', 'qdisc', 'del', 'dev',
                  self.device(side), 'root', check=False)
 
-    def qdisc(self, side: str) -> str:
+    def qdisc(self, side: Role) -> str:
         """Return `tc -s qdisc show` of ``side``'s veth end (drops, overlimits...)."""
         return _run('ip', 'netns', 'exec', self.namespace(side), 'tc', '-s', 'qdisc', 'show',
                     'dev', self.device(side)).stdout
 
-    def tx_bytes(self, side: str) -> int:
+    def tx_bytes(self, side: Role) -> int:
         """Return the bytes ``side``'s veth end has transmitted (towards the other side)."""
         out = _run('ip', '-n', self.namespace(side), '-j', '-s', 'link', 'show',
                    'dev', self.device(side)).stdout

@@ -17,10 +17,10 @@ import subprocess
 import sys
 import time
 
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, Role, validate_namespace
 from wirefish_cli.api import duration_s
-from wirefish_launcher.netns import (FISH, MULTICAST, NetnsError, root_problem, SHORE, STATIC,
-                                     TwoHosts)
+from wirefish_launcher.netns import Discovery, NetnsError, root_problem, SIDES, TwoHosts
+from wirefish_launcher.stop_flag import stop_on_signals
 
 STOP_TIMEOUT_S = 30.0  # each side's `wirefish up` stops its own processes first
 
@@ -32,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='names the pair wf<token>f / wf<token>s (default: from the PID)')
     parser.add_argument('--subnet', type=int, default=0,
                         help='addresses 10.213.<subnet>.1 (fish) and .2 (shore); default 0')
-    parser.add_argument('--discovery', choices=(MULTICAST, STATIC), default=MULTICAST,
+    parser.add_argument('--discovery', choices=list(Discovery), default=Discovery.MULTICAST,
                         help='DDS discovery across the link: multicast (SUBNET) or static '
                         'peers (LOCALHOST + ROS_STATIC_PEERS)')
     parser.add_argument('--rate', default=None,
@@ -46,13 +46,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def instructions(link: TwoHosts, domain: str, discovery: str) -> str:
     """Return what a person types to look at, cut and shape the pair."""
     lines = []
-    for side in (FISH, SHORE):
+    for side in SIDES:
         env = ' '.join(f'{k}={v}' for k, v in
                        {'ROS_DOMAIN_ID': domain, **link.ros_environment(side, discovery)}.items()
                        if v)
         lines.append(f'{side:>5} host {link.address(side)}: ip netns exec '
                      f'{link.namespace(side)} env {env} bash')
-    fish_ns, fish_dev = link.namespace(FISH), link.device(FISH)
+    fish_ns, fish_dev = link.namespace(Role.FISH), link.device(Role.FISH)
     lines += [f'cut the link:    ip -n {fish_ns} link set {fish_dev} down   (up: restore)',
               f'shape the link:  ip netns exec {fish_ns} tc qdisc replace dev {fish_dev} root '
               'tbf rate 100kbit burst 16kbit latency 400ms',
@@ -73,15 +73,13 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish twohost: {error}', file=sys.stderr)
         return 2
     domain = os.environ.get('ROS_DOMAIN_ID', '0')
-    stop = []
-    signal.signal(signal.SIGINT, lambda *_: stop.append(1))
-    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
-    sides: dict[str, subprocess.Popen] = {}
+    stop = stop_on_signals()
+    sides: dict[Role, subprocess.Popen] = {}
     try:
         link.create()
         if args.rate:
             link.shape(args.rate)
-        for side in (FISH, SHORE):
+        for side in SIDES:
             env = dict(os.environ, ROS_DOMAIN_ID=domain,
                        **link.ros_environment(side, args.discovery))
             sides[side] = subprocess.Popen(
@@ -90,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
                  str(args.out)], env=env, start_new_session=True)
         print(instructions(link, domain, args.discovery), flush=True)
         started = time.monotonic()
-        while not stop and all(p.poll() is None for p in sides.values()):
+        while not stop.requested and all(p.poll() is None for p in sides.values()):
             if args.duration is not None and time.monotonic() - started >= args.duration:
                 break
             time.sleep(0.2)
@@ -101,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
         codes = {side: _stop(proc) for side, proc in sides.items()}
         link.remove()
     print('stopped: ' + ', '.join(f'{side} side {code}' for side, code in codes.items())
-          + f'; removed {link.namespace(FISH)} and {link.namespace(SHORE)}')
+          + f'; removed {link.namespace(Role.FISH)} and {link.namespace(Role.SHORE)}')
     return 0 if all(code == 0 for code in codes.values()) else 1
 
 
