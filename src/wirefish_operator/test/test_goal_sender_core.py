@@ -1,9 +1,10 @@
 """The decision of GoalSender: what the answers and the server's active goals say."""
 
 import pytest
-from wirefish_operator.goal_sender import ACCEPTED, goal_outcome, REJECTED, WAITING
+from wirefish_operator.goal_sender import goal_outcome, GoalOutcome
 
 A, B = b'a' * 16, b'b' * 16
+ACCEPTED, REJECTED, WAITING = GoalOutcome.ACCEPTED, GoalOutcome.REJECTED, GoalOutcome.WAITING
 
 
 @pytest.mark.parametrize('answers, active, expected', [

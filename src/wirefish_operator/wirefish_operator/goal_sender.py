@@ -24,17 +24,42 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+import enum
 import time
-from typing import Any
+from typing import Protocol, TYPE_CHECKING
 import uuid
 
-ACCEPTED, REJECTED, WAITING = 'accepted', 'rejected', 'waiting'
+if TYPE_CHECKING:
+    from rclpy.action import ActionClient
+    from rclpy.action.client import ClientGoalHandle
+    from rclpy.node import Node
+    from rclpy.subscription import Subscription
+    from rclpy.task import Future
+
 ANSWER_WAIT_S = 3.0
 MAX_SENDS = 3
 
 
+class GoalOutcome(enum.Enum):
+    """What the answers so far say of a goal (the sender's own decision: a plain Enum)."""
+
+    ACCEPTED = 'accepted'
+    REJECTED = 'rejected'
+    WAITING = 'waiting'
+
+
+class _ActionMessages(Protocol):
+    FeedbackMessage: type  # the action's feedback topic type (goal id and feedback)
+
+
+class ActionType(Protocol):
+    """An action type as rosidl generates it (e.g. ``wirefish_msgs.action.RetuneGait``)."""
+
+    Impl: type[_ActionMessages]
+
+
 def goal_outcome(answers: dict[bytes, bool | None], active: set[bytes]
-                 ) -> tuple[str, bytes | None]:
+                 ) -> tuple[GoalOutcome, bytes | None]:
     """
     Return (ACCEPTED, id), (REJECTED, None) or (WAITING, None) for the goals sent so far.
 
@@ -45,13 +70,13 @@ def goal_outcome(answers: dict[bytes, bool | None], active: set[bytes]
     """
     for goal_id, accepted in answers.items():
         if accepted:
-            return ACCEPTED, goal_id
+            return GoalOutcome.ACCEPTED, goal_id
     for goal_id in answers:
         if goal_id in active:
-            return ACCEPTED, goal_id
+            return GoalOutcome.ACCEPTED, goal_id
     if answers and all(accepted is False for accepted in answers.values()):
-        return REJECTED, None
-    return WAITING, None
+        return GoalOutcome.REJECTED, None
+    return GoalOutcome.WAITING, None
 
 
 @dataclass
@@ -63,17 +88,17 @@ class GoalSender:
     ``node``), ``spin_once`` spins the node for at most the given seconds.
     """
 
-    node: Any  # rclpy Node
-    client: Any  # rclpy ActionClient
+    node: Node
+    client: ActionClient
     spin_once: Callable[[float], None]
     action_name: str
-    action_type: Any
+    action_type: ActionType
     answer_wait_s: float = ANSWER_WAIT_S
     max_sends: int = MAX_SENDS
     active: set[bytes] = field(default_factory=set)
     resent: int = 0
     _sent: set[bytes] = field(default_factory=set)
-    _feedback_callback: Callable | None = None
+    _feedback_callback: Callable[[object], None] | None = None
 
     def __post_init__(self) -> None:
         """Subscribe to the action's status (latched: the array comes at once) and feedback."""
@@ -88,7 +113,7 @@ class GoalSender:
         def on_status(message: GoalStatusArray) -> None:
             self.active.update(bytes(s.goal_info.goal_id.uuid) for s in message.status_list
                                if s.status in running)
-        self._status = self.node.create_subscription(
+        self._status: Subscription = self.node.create_subscription(
             GoalStatusArray, f'{self.action_name}/_action/status', on_status,
             qos_profile_action_status_default)
 
@@ -99,11 +124,12 @@ class GoalSender:
                 if self._feedback_callback is not None:
                     self._feedback_callback(message)
         # Every iteration's feedback kept (rclpy's default depth of 10 drops a fast fit's).
-        self._feedback = self.node.create_subscription(
+        self._feedback: Subscription = self.node.create_subscription(
             self.action_type.Impl.FeedbackMessage, f'{self.action_name}/_action/feedback',
             on_feedback, reliable(1000))
 
-    def send(self, goal, feedback_callback: Callable, deadline: float):
+    def send(self, goal: object, feedback_callback: Callable[[object], None],
+             deadline: float) -> ClientGoalHandle | None:
         """
         Return the goal's ClientGoalHandle (accepted or not), or None if none by ``deadline``.
 
@@ -113,19 +139,19 @@ class GoalSender:
         from unique_identifier_msgs.msg import UUID
 
         self._feedback_callback = feedback_callback
-        futures: dict[bytes, Any] = {}  # goal id -> the rclpy Future of its answer
+        futures: dict[bytes, Future] = {}  # goal id -> the answer's future
         sent_at = 0.0
         while time.monotonic() < deadline:
             answers = {goal_id: (future.result().accepted if future.done() else None)
                        for goal_id, future in futures.items()}
             outcome, adopted = goal_outcome(answers, self.active)
-            if outcome == ACCEPTED and adopted is not None:
+            if outcome is GoalOutcome.ACCEPTED and adopted is not None:
                 future = futures[adopted]
                 if future.done():
                     return future.result()
                 return ClientGoalHandle(self.client, UUID(uuid=list(adopted)),
                                         _AcceptedAnswer())
-            if outcome == REJECTED:
+            if outcome is GoalOutcome.REJECTED:
                 return next(iter(futures.values())).result()
             unanswered = not futures or answers[next(reversed(futures))] is None
             if unanswered and len(futures) < self.max_sends and (

@@ -18,6 +18,11 @@ import math
 from pathlib import Path
 import shutil
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from rclpy.task import Future
+    from wirefish_common.progress import Progress
 
 CMD_RATE_HZ = 20.0
 DISCOVERY_TIMEOUT_S = 30.0
@@ -91,7 +96,10 @@ class _Run:
     """
     Where a mission run is (node clock s): resting since, the first leg's start, a problem.
 
-    ``turn_gain`` is the planner's own parameter, for judging the gain the run identifies.
+    ``turn_gain`` is the planner's own parameter, for judging the gain the run identifies
+    (``turn_gain_answer``: the planner's answer to the question); ``planner_heard``: a
+    planner_state came; ``hinted``: what is waited for was said; ``progress``: the legs'
+    progress, from the first leg's start.
     """
 
     rest_from: float | None = None
@@ -99,6 +107,10 @@ class _Run:
     problem: str | None = None
     done: bool = False
     turn_gain: float | None = None
+    turn_gain_answer: Future | None = None
+    planner_heard: bool = False
+    hinted: bool = False
+    progress: Progress | None = None
 
 
 def _drive(mission, namespace: str, bag_path: Path,
@@ -137,8 +149,12 @@ def _drive(mission, namespace: str, bag_path: Path,
     recorder.start_thread()  # takes its messages itself, beside the executor
     reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     publisher = node.create_publisher(Twist, 'cmd_vel', reliable)
-    heard: list[PlannerState] = []
-    node.create_subscription(PlannerState, 'planner_state', heard.append, reliable)
+    run = _Run()
+
+    def on_state(_message: PlannerState) -> None:
+        run.planner_heard = True
+
+    node.create_subscription(PlannerState, 'planner_state', on_state, reliable)
     speeds: deque[tuple[float, float]] = deque()  # (node clock s, |surge speed| m/s), last 1 s
 
     def on_truth(message: Odometry) -> None:
@@ -146,12 +162,8 @@ def _drive(mission, namespace: str, bag_path: Path,
 
     node.create_subscription(Odometry, 'sim/ground_truth', on_truth, reliable)
     parameters = node.create_client(GetParameters, 'planner_node/get_parameters')
-    answer: list = []
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
-    run = _Run()
     started = node.get_clock().now().nanoseconds * 1e-9
-    hinted: list[float] = []
-    progress: list[Progress] = []  # once the first leg is timed
 
     def now() -> float:
         return node.get_clock().now().nanoseconds * 1e-9
@@ -164,8 +176,9 @@ def _drive(mission, namespace: str, bag_path: Path,
 
     def rest(t: float) -> None:
         publisher.publish(Twist())
-        if answer and answer[0].done() and answer[0].result() is not None:
-            values = answer[0].result().values
+        answer = run.turn_gain_answer
+        if answer is not None and answer.done() and answer.result() is not None:
+            values = answer.result().values
             double = values and values[0].type == ParameterType.PARAMETER_DOUBLE
             run.turn_gain = values[0].double_value if double else None
         waited = t - (run.rest_from or t)
@@ -175,8 +188,8 @@ def _drive(mission, namespace: str, bag_path: Path,
             print(f'wirefish mission: the fish did not come to rest within '
                   f'{mission.rest_s + REST_WAIT_S:g} s; leg 1 starts anyway', file=sys.stderr)
         run.t0 = t
-        progress.append(Progress(f'mission {mission.name}',
-                                 math.ceil(mission.duration_s + mission.coast_s)))
+        run.progress = Progress(f'mission {mission.name}',
+                                math.ceil(mission.duration_s + mission.coast_s))
 
     def tick() -> None:
         t = now()
@@ -184,28 +197,28 @@ def _drive(mission, namespace: str, bag_path: Path,
             rest(t)
             return
         if run.t0 is None:
-            if heard and recorder.count(truth_topic) > 0:
+            if run.planner_heard and recorder.count(truth_topic) > 0:
                 run.rest_from = t
                 print(f'mission {mission.name}: {len(mission.legs)} legs, '
                       f'{mission.duration_s:.1f} s, recording to {bag_path}; the fish comes to '
                       'rest first', flush=True)
                 if parameters.service_is_ready():
                     request = GetParameters.Request(names=['turn_gain'])
-                    answer.append(parameters.call_async(request))
+                    run.turn_gain_answer = parameters.call_async(request)
             elif t - started > wait_s:
                 run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
                                f'within {wait_s:g} s: are the graph and the planner running? '
                                f'(wirefish up --namespace {namespace}); nothing was written')
                 rclpy.try_shutdown()
-            elif t - started > HINT_AFTER_S and not hinted:
-                hinted.append(t)
+            elif t - started > HINT_AFTER_S and not run.hinted:
+                run.hinted = True
                 print(f'wirefish mission: waiting for planner_state and sim/ground_truth '
                       f'under {namespace} (is the graph running?)', file=sys.stderr, flush=True)
             return
         command = mission.command_at(t - run.t0)
         elapsed = int(t - run.t0)
-        if elapsed > progress[0].done:
-            progress[0].step(elapsed, _phase(mission, t - run.t0))
+        if run.progress is not None and elapsed > run.progress.done:
+            run.progress.step(elapsed, _phase(mission, t - run.t0))
         if command is not None:
             msg = Twist()
             msg.linear.x, msg.angular.z = command

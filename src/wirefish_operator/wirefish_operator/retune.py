@@ -9,6 +9,7 @@ applies nothing) and exits 130.
 """
 
 import argparse
+from dataclasses import dataclass
 import math
 import sys
 import time
@@ -91,6 +92,15 @@ def result_table(result) -> str:
     return '\n'.join(f'{name:<{width}}  {value}' for name, value in rows)
 
 
+@dataclass
+class _FeedbackSeen:
+    """What the goal's feedback has shown so far (its callback runs on the main thread)."""
+
+    drawn: bool = False  # a progress bar is on the terminal's line (end it before printing)
+    last_iteration: int = -1
+    first: tuple[float, int] | None = None  # (when, iteration) of the first feedback
+
+
 def goal_of(args: argparse.Namespace, goal_type):
     """Return the action goal of the command-line options."""
     goal = goal_type()
@@ -126,22 +136,21 @@ def run(args: argparse.Namespace) -> int:
     # The goal's feedback is taken by the GoalSender (every iteration, also after the result).
     client = ActionClient(node, RetuneGait, 'retune_gait')
     terminal = sys.stderr.isatty()
-    drawn = [False]
-    last_iteration = [-1]
-    first: list[tuple[float, int]] = []  # (when, iteration) of the first feedback
+    seen = _FeedbackSeen()
 
     def on_feedback(message) -> None:
         f = message.feedback
-        last_iteration[0] = f.iteration
-        if not first:
-            first.append((time.monotonic(), f.iteration))
+        seen.last_iteration = f.iteration
+        if seen.first is None:
+            seen.first = (time.monotonic(), f.iteration)
+        first_at, first_iteration = seen.first
         # The PSO may stop early (stalled): the estimate is for all its iterations.
-        estimate = estimate_text(f.iteration - first[0][1], f.max_iterations - first[0][1],
-                                 time.monotonic() - first[0][0])
+        estimate = estimate_text(f.iteration - first_iteration, f.max_iterations - first_iteration,
+                                 time.monotonic() - first_at)
         if terminal:
             print('\r' + progress_line(f.iteration, f.best_loss, f.max_iterations, estimate),
                   end='', file=sys.stderr, flush=True)
-            drawn[0] = True
+            seen.drawn = True
         else:
             print(feedback_line(f.iteration, f.best_loss, f.max_iterations, f.rmse_theta_deg,
                                 estimate), file=sys.stderr, flush=True)
@@ -179,9 +188,9 @@ def run(args: argparse.Namespace) -> int:
             return 1
         result = result_future.result().result
         # The result can overtake the last feedback: draw it before the table.
-        spin_until(lambda: last_iteration[0] >= result.iterations,
+        spin_until(lambda: seen.last_iteration >= result.iterations,
                    time.monotonic() + (FEEDBACK_DRAIN_S if result.iterations else 0.0))
-        if drawn[0]:
+        if seen.drawn:
             print(file=sys.stderr)
         if not result.success:  # nothing was fitted or applied: the reason is the answer
             print(f'wirefish retune: {result.message}', file=sys.stderr)
@@ -192,7 +201,7 @@ def run(args: argparse.Namespace) -> int:
                   'does not drive it until `wirefish hand-back`', file=sys.stderr)
         return 0 if math.isfinite(result.loss) else 1
     except KeyboardInterrupt:
-        if drawn[0]:
+        if seen.drawn:
             print(file=sys.stderr)
         if handle is not None and handle.accepted:
             canceling = handle.cancel_goal_async()
