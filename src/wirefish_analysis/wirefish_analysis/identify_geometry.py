@@ -219,13 +219,14 @@ def identify(rng: np.random.Generator, options: PsoOptions = PsoOptions(max_iter
                 progress.step(first + options.swarm_size * (iteration + 1),
                               f'search {index + 1}/{starts}, swarm: best {loss:.4g}')
 
-        polish_steps = [0]
+        polish_steps = 0
 
         def polish_step(_x: np.ndarray) -> None:
-            polish_steps[0] += 1
+            nonlocal polish_steps
+            polish_steps += 1
             if progress is not None:
                 progress.step(first + options.swarm_size * (options.max_iterations + 1)
-                              + polish_steps[0], f'search {index + 1}/{starts}, polish')
+                              + polish_steps, f'search {index + 1}/{starts}, polish')
 
         swarm = minimise(swarm_objective, LOWER[:6], UPPER[:6], child, options,
                          callback=swarm_step)

@@ -17,9 +17,18 @@ A recording's account of each topic (``TopicAccount``) is kept in the bag as str
 """
 
 from dataclasses import dataclass, field
+import enum
 
-MISSING_KEY = 'missing'  # numbers absent from the publisher's sequence ('unchecked': several)
-LAG_KEY = 'lag_max_s'  # the most a message waited between its publication and the bag
+
+class AccountKey(enum.StrEnum):
+    """The figures of a topic's account, each kept in custom_data as ``<key>:<topic>``."""
+
+    MISSING = 'missing'  # numbers absent from the publisher's sequence (UNCHECKED: several)
+    LAG_MAX = 'lag_max_s'  # the most a message waited between its publication and the bag
+
+
+# The MISSING figure of a topic that several writers published on (their sequences interleave:
+# no count). One word among counts, not a family of values: a plain string.
 UNCHECKED = 'unchecked'
 
 
@@ -66,10 +75,10 @@ def recording_account(accounts: dict[str, TopicAccount]) -> dict[str, str]:
     recording = {}
     for topic, account in sorted(accounts.items()):
         sequence = account.sequence
-        recording[f'{MISSING_KEY}:{topic}'] = (UNCHECKED if sequence.ambiguous
-                                               else str(sequence.missing))
+        recording[f'{AccountKey.MISSING}:{topic}'] = (UNCHECKED if sequence.ambiguous
+                                                      else str(sequence.missing))
         if not account.latched:
-            recording[f'{LAG_KEY}:{topic}'] = f'{account.lag_max_ns * 1e-9:.3f}'
+            recording[f'{AccountKey.LAG_MAX}:{topic}'] = f'{account.lag_max_ns * 1e-9:.3f}'
     return recording
 
 
@@ -82,10 +91,10 @@ def merged_recording(parts: list[dict[str, str]]) -> dict[str, str]:
             old = merged.get(key)
             if old is None:
                 merged[key] = value
-            elif kind == MISSING_KEY:
+            elif kind == AccountKey.MISSING:
                 merged[key] = (UNCHECKED if UNCHECKED in (old, value)
                                else str(int(old) + int(value)))
-            elif kind == LAG_KEY:
+            elif kind == AccountKey.LAG_MAX:
                 merged[key] = str(max(float(old), float(value)))
     return merged
 
@@ -95,7 +104,7 @@ def recording_losses(custom_data: dict | None) -> dict[str, int]:
     losses = {}
     for key, value in (custom_data or {}).items():
         kind, _, topic = str(key).partition(':')
-        if kind == MISSING_KEY and str(value) != UNCHECKED:
+        if kind == AccountKey.MISSING and str(value) != UNCHECKED:
             losses[topic] = int(value)
     return losses
 
