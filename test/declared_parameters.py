@@ -9,7 +9,8 @@ from wirefish_common.parameter_table import ParameterSpec
 
 SRC = Path(__file__).resolve().parents[1] / 'src'
 # Entries without a node class: where the table their process declares comes from.
-_TABLES_OF_PROCESSES = {'fish_sim': ('wirefish_kinematics.node_parameters', 'geometry_parameters')}
+_TABLES_OF_PROCESSES = {'fish_sim': ('wirefish_kinematics.geometry_parameters',
+                                     'geometry_parameters')}
 
 
 def tables_declared_in(module: str) -> list[tuple[str, str]]:

@@ -10,7 +10,7 @@ from hypothesis import given, strategies as st
 import numpy as np
 import pytest
 import serial
-from wirefish_bridge.bridge_parameters import check_combination, PARAMETERS
+from wirefish_bridge.bridge_node_parameters import check_combination, PARAMETERS
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy, \
     rpy_from_quaternion

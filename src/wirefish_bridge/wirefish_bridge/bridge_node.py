@@ -44,8 +44,8 @@ from rclpy.parameter import Parameter
 from rclpy.timer import Timer
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
-from wirefish_bridge.bridge_parameters import (check_combination, LINK_PARAMETERS,
-                                               PARAMETERS, SPECS)
+from wirefish_bridge.bridge_node_parameters import (check_combination, LINK_PARAMETERS,
+                                                    PARAMETERS, SPECS)
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.decimator import Decimator

@@ -4,7 +4,7 @@ import ast
 from pathlib import Path
 
 import pytest
-from wirefish_bridge.bridge_parameters import SPECS as BRIDGE_SPECS
+from wirefish_bridge.bridge_node_parameters import SPECS as BRIDGE_SPECS
 from wirefish_bringup.graph import (combined_policy, composable_entries, entries, expected_rates,
                                     FISH, fish_graph, NODES, NodeSpec, RestartBudget,
                                     RestartPolicy, SHORE, sim_tty_link, validate_namespace)

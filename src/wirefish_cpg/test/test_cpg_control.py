@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from wirefish_common.parameter_table import update_problem
 from wirefish_cpg.cpg_control import CpgTargets, TargetSource
-from wirefish_cpg.cpg_node_parameters import NODE_PARAMETERS, SPECS
-from wirefish_cpg.cpg_parameter_names import flat_values, parameters_from
+from wirefish_cpg.cpg_node_parameters import (flat_values, NODE_PARAMETERS, parameters_from,
+                                              SPECS)
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_cpg.table1_gait import table1_locked_at
 

@@ -23,7 +23,7 @@ from collections.abc import Mapping
 import enum
 
 from wirefish_common.parameter_table import ParameterSpec, update_problem
-from wirefish_cpg.cpg_parameter_names import parameters_from
+from wirefish_cpg.cpg_node_parameters import parameters_from
 from wirefish_cpg.oscillator import CpgParameters
 
 

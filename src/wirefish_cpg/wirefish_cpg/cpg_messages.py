@@ -17,7 +17,7 @@ def flat_message_values(msg: CpgParams) -> dict[str, float]:
     """
     Return a CpgParams' fields by the CPG's flat parameter names, unjudged (NaN stays NaN).
 
-    The inverse of ``to_message`` on the names of ``cpg_parameter_names``: the CPG judges a
+    The inverse of ``to_message`` on the flat names of ``cpg_node_parameters``: the CPG judges a
     cpg_command's values exactly as a parameter set of those names.
     """
     return {'frequency_hz': float(msg.frequency_hz),

@@ -43,8 +43,8 @@ from wirefish_common.qos import COMMAND, LATCHED, SENSOR_DATA
 from wirefish_common.servo_joints import servo_joint_state
 from wirefish_cpg.cpg_control import CpgTargets, TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values, to_message
-from wirefish_cpg.cpg_node_parameters import NODE_PARAMETERS, SPECS
-from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES, parameters_from
+from wirefish_cpg.cpg_node_parameters import (CPG_PARAMETER_NAMES, NODE_PARAMETERS,
+                                              parameters_from, SPECS)
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import at_rest, CpgIntegrator
 from wirefish_cpg.servo_limit import clamp_to_limit

@@ -59,8 +59,8 @@ def scale_of(wave: WaveSpec, reference: WaveSpec) -> float | None:
     return scale
 
 
-def family(library: GaitLibrary, reference: WaveSpec, geometry: dict[str, float],
-           mode: str = 'phase_free') -> list[FamilyMember]:
+def family_members(library: GaitLibrary, reference: WaveSpec, geometry: dict[str, float],
+                   mode: str = 'phase_free') -> list[FamilyMember]:
     """Return the library's gaits of the reference's family on ``geometry``, by (f, s)."""
     members = []
     for gait in library.for_geometry(geometry):

@@ -21,7 +21,7 @@ Publishes (frame ``tail_base`` = C0 of paper section 3.1)
     ``speed_estimate`` (wirefish_msgs/SpeedEstimate, reliable) once per completed tail beat
     (stamped at the end of the period), eqs 16-22; all zeros while the tail is at rest
     (``tail_beat_tracker`` decides when).
-Parameters: ``node_parameters``.
+Parameters: ``kinematics_node_parameters``.
 """
 
 from __future__ import annotations
@@ -39,15 +39,17 @@ from wirefish_common.batch_intake import BatchIntake
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.joint_state_cdr import CdrError, read_joint_state
 from wirefish_common.node_main import run_node
+from wirefish_common.parameter_table import validate_update
 from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_sample
 from wirefish_kinematics.desired_wave import desired_wave_at_phase
 from wirefish_kinematics.geometry import GEOMETRY_FIELDS
+from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_kinematics.kinematics_messages import (body_wave_markers, body_wave_message, FRAME,
                                                      speed_estimate_message, to_stamp)
-from wirefish_kinematics.node_parameters import (declare, geometry_from, markers_every,
-                                                 NODE_PARAMETERS, SPECS, validate_update,
-                                                 wave_from, WAVE_PARAMETER_NAMES)
+from wirefish_kinematics.kinematics_node_parameters import (declare, markers_every,
+                                                            NODE_PARAMETERS, SPECS, wave_from,
+                                                            WAVE_PARAMETER_NAMES)
 from wirefish_kinematics.tail_beat_tracker import TailBeatTracker
 from wirefish_kinematics.tail_shape import tail_shape
 from wirefish_kinematics.wave_spec import wave_from_message

@@ -166,7 +166,7 @@ def plot(args: argparse.Namespace) -> int:
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    from wirefish_cpg.gait_family import family
+    from wirefish_cpg.gait_family import family_members
     from wirefish_cpg.gait_library import load_library
     from wirefish_tuner.retune_core import RetuneSettings
 
@@ -175,7 +175,7 @@ def plot(args: argparse.Namespace) -> int:
     except (OSError, ValueError) as error:
         print(f'wirefish gaits: {error}', file=sys.stderr)
         return 1
-    members = family(library, reference_of(args), RetuneSettings().geometry_fields())
+    members = family_members(library, reference_of(args), RetuneSettings().geometry_fields())
     if not members:
         print('wirefish gaits: no gait of this reference wave in the library '
               '(wirefish gaits build)', file=sys.stderr)

@@ -16,9 +16,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
-from wirefish_planner.gait_family import GaitLimits, GaitPlanner, Table1Family
-from wirefish_planner.planner_config import default_values, planner_from
+from wirefish_planner.gait_choice import GaitLimits, GaitPlanner, Table1Family
+from wirefish_planner.planner_config import planner_from
 from wirefish_planner.planner_core import Planner
+from wirefish_planner.planner_node_parameters import default_values
 from wirefish_sim.faults import disturb, Disturbance
 from wirefish_sim.virtual_fish import SimConfig, VirtualFish
 

@@ -142,7 +142,8 @@ def test_the_command_topic_is_in_the_cpg_nodes_namespace(name, topic):
 @pytest.fixture(scope='module')
 def turn_and_hold(closed_loop):
     """One in-process drive with a 0.05 rad/s current: straight, left, right, straight."""
-    from wirefish_planner.planner_config import default_values, planner_from
+    from wirefish_planner.planner_config import planner_from
+    from wirefish_planner.planner_node_parameters import default_values
 
     leg = closed_loop.Leg
     legs = [leg(6.0, 0.2), leg(8.0, 0.2, 0.2), leg(8.0, 0.2, -0.2), leg(16.0, 0.2)]
@@ -170,7 +171,7 @@ def test_in_process_servo_commands_never_step(turn_and_hold):
 
 
 def test_the_default_turn_gain_is_what_the_in_process_fish_identifies(turn_and_hold):
-    from wirefish_planner.planner_config import default_values
+    from wirefish_planner.planner_node_parameters import default_values
     from wirefish_planner.yaw_control import identify_turn_gain, steady_means
 
     tr = turn_and_hold

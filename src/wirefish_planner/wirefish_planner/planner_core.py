@@ -12,7 +12,7 @@ Modes
     ``straight``  angular.z = 0 without heading hold: the yaw-rate PI tracks 0.
     ``open_loop`` ``yaw_control`` off, or no IMU sample for ``imu_timeout_s``: the feed-forward
                   offset of angular.z alone.
-Speed: ``GaitPlanner.choose`` (eq 18 inverted, ``gait_family``); turning: ``yaw_control``.
+Speed: ``GaitPlanner.choose`` (eq 18 inverted, ``gait_choice``); turning: ``yaw_control``.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from wirefish_planner.gait_family import GaitChoice, GaitPlanner
+from wirefish_planner.gait_choice import GaitChoice, GaitPlanner
 from wirefish_planner.yaw_control import (feedforward_offset, heading_rate_reference,
                                           PeriodMean, wrap_angle, YawGains, YawRatePi)
 

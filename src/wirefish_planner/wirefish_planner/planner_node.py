@@ -14,7 +14,7 @@ Drives
     cpg_node (``cpg_node_name``) by its control topic: ``cpg_command`` (wirefish_msgs/CpgCommand,
     reliable, keep last 1) in the CPG node's namespace, the whole target set at every control
     tick (no request in flight: a lost message is superseded by the next, a restarted CPG gets
-    the next one): the gait (eq 18 inverted, ``gait_family``) and the offsets b_1 = b_2
+    the next one): the gait (eq 18 inverted, ``gait_choice``) and the offsets b_1 = b_2
     (``yaw_control``). Every change goes through the CPG's smooth convergence, never a servo
     step. At rest (no cmd_vel yet, or none for ``cmd_vel_timeout_s``) the amplitudes and offsets
     are 0, the frequency and couplings those the CPG runs (``rest_at_start`` false: nothing is
@@ -23,7 +23,7 @@ Drives
     One owner of the gait: while the CPG is under a manual override (its parameters were set,
     e.g. a retune applied) the planner sends nothing and says so (mode ``manual``); a refused
     command is said in planner_state's note and on /diagnostics.
-Parameters: ``PLANNER_PARAMETERS`` (each with a range; an invalid set changes nothing).
+Parameters: ``planner_node_parameters`` (each with a range; an invalid set changes nothing).
 """
 
 from __future__ import annotations
@@ -43,11 +43,11 @@ from wirefish_cpg.cpg_control import TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values
 from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
 from wirefish_planner.planner_config import (command_targets, cpg_topic, cpg_values,
-                                             planner_from, PLANNER_PARAMETERS, values_changed)
+                                             planner_from, values_changed)
 from wirefish_planner.planner_core import ignored_fields, PlannerOutput
+from wirefish_planner.planner_node_parameters import PLANNER_PARAMETERS, SPECS
 from wirefish_planner.yaw_control import yaw_from_quaternion
 
-SPECS = {spec.name: spec for spec in PLANNER_PARAMETERS}
 DIAGNOSTICS_PERIOD_S = 1.0
 WARN_THROTTLE_S = 2.0
 

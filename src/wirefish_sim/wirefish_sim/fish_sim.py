@@ -126,7 +126,7 @@ class GroundTruthPublisher:
         from wirefish_common.frames import declare_frame_prefix, prefixed
         from wirefish_common.parameter_table import declare
         from wirefish_common.qos import RELIABLE
-        from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
+        from wirefish_kinematics.geometry_parameters import geometry_from, geometry_parameters
 
         self._rclpy = rclpy
         rclpy.init(args=ros_args, signal_handler_options=SignalHandlerOptions.NO)

@@ -18,7 +18,7 @@ Publishes
 Parameters: ``odom_source`` (``auto``: ground truth once sim/ground_truth is heard, dead
 reckoning until then; ``ground_truth``; ``dead_reckoning``), ``odom_rate_hz``, ``imu_x``,
 ``imu_y``, ``imu_z`` (the IMU in base_link, m), the geometry (l1, l2, l3, body_length: the
-graph's ``/**`` block) and ``frame_prefix``.
+graph's ``/**`` block) and ``frame_prefix``; the table is ``tf_node_parameters``.
 """
 
 from __future__ import annotations
@@ -35,40 +35,20 @@ from sensor_msgs.msg import Imu
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.parameter_table import declare, validate_update
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
-from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.node_parameters import geometry_from, geometry_parameters
+from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
 from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, quaternion_yaw,
                                 tail_base_in_base_link, tail_frames)
 from wirefish_tf.tf_messages import tf_message, transform
+from wirefish_tf.tf_node_parameters import (consistent_geometry, GEOMETRY_NAMES, SPECS,
+                                            TF_PARAMETERS)
 
 # tf2_ros's TransformBroadcaster and StaticTransformBroadcaster profiles.
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 TF_STATIC_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
-GEOMETRY_NAMES = ('l1', 'l2', 'l3', 'body_length')
-TF_PARAMETERS = geometry_parameters(GEOMETRY_NAMES) + (
-    ParameterSpec('odom_source', OdomSource.AUTO.value,
-                  'Source of odom -> base_link: auto (ground truth once sim/ground_truth is '
-                  'heard, else dead reckoning), ground_truth, dead_reckoning'),
-    ParameterSpec('odom_rate_hz', 50.0, 'Most dead-reckoned odom -> base_link a second (Hz)',
-                  0.0, 1000.0, low_exclusive=True),
-    ParameterSpec('imu_x', -0.12, 'IMU position in base_link, x (m); estimate', -2.0, 2.0),
-    ParameterSpec('imu_y', 0.0, 'IMU position in base_link, y (m); estimate', -1.0, 1.0),
-    ParameterSpec('imu_z', 0.0, 'IMU position in base_link, z (m); estimate', -1.0, 1.0),
-)
-SPECS = {spec.name: spec for spec in TF_PARAMETERS}
-
-
-def _consistent(values: dict[str, object]) -> FishGeometry:
-    """Return the geometry of ``values``; raise ValueError for an unknown ``odom_source``."""
-    source = values.get('odom_source', OdomSource.AUTO.value)
-    if source not in {s.value for s in OdomSource}:
-        raise ValueError(f'odom_source must be one of {", ".join(s.value for s in OdomSource)},'
-                         f' got {source!r}')
-    return geometry_from(values, GEOMETRY_NAMES)
 
 
 def _seconds(stamp: Time) -> float:
@@ -81,7 +61,7 @@ class TfNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters; wire /tf, /tf_static and the subscriptions."""
         super().__init__('tf_node', **kwargs)
-        declare(self, TF_PARAMETERS, _consistent)
+        declare(self, TF_PARAMETERS, consistent_geometry)
         prefix = declare_frame_prefix(self)
         self._frame = {frame: prefixed(prefix, frame.value) for frame in Frame}
         self._values = {s.name: self.get_parameter(s.name).value for s in TF_PARAMETERS}
@@ -105,7 +85,7 @@ class TfNode(Node):
 
     # --- parameters -----------------------------------------------------------------------
     def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        return validate_update(SPECS, self._values, parameters, _consistent)
+        return validate_update(SPECS, self._values, parameters, consistent_geometry)
 
     def _apply(self, parameters: list[Parameter]) -> None:
         names = {p.name for p in parameters if p.name in SPECS}

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from wirefish_cpg.gait_family import (family, interpolated_parameters, locked_form,
+from wirefish_cpg.gait_family import (family_members, interpolated_parameters, locked_form,
                                       nearest_gait, scaled_wave)
 from wirefish_cpg.gait_library import Gait, GaitLibrary
 from wirefish_cpg.steady_state import stable_phase_difference
@@ -38,13 +38,13 @@ def test_the_family_holds_scaled_waves_of_the_reference_on_its_geometry(grid_lib
     other_fish = Gait(wave=REFERENCE, geometry=tuple(sorted({**FIELDS, 'l2': 0.12}.items())),
                       params=other_shape.params, loss=1.0, rmse_theta_deg=(1.0, 1.0))
     library = grid_library.with_gait(other_shape).with_gait(other_fish)
-    members = family(library, REFERENCE, FIELDS)
+    members = family_members(library, REFERENCE, FIELDS)
     assert [(m.frequency_hz, m.scale) for m in members] == [
         (1.0, 0.8), (1.0, 1.2), (1.5, 0.8), (1.5, 1.2)]
 
 
 def test_the_nearest_gait_is_the_closest_grid_point(grid_library):
-    members = family(grid_library, REFERENCE, FIELDS)
+    members = family_members(grid_library, REFERENCE, FIELDS)
     best = nearest_gait(members, 1.4, 0.85)
     assert (best.frequency_hz, best.scale) == (1.5, 0.8)
     with pytest.raises(ValueError, match='empty'):
@@ -52,7 +52,7 @@ def test_the_nearest_gait_is_the_closest_grid_point(grid_library):
 
 
 def test_canonical_coupling_locks_at_the_blended_phase_difference(grid_library):
-    members = family(grid_library, REFERENCE, FIELDS)
+    members = family_members(grid_library, REFERENCE, FIELDS)
     params = interpolated_parameters(members, 1.25, 1.0)
     r1, r2 = params.amplitude
     delta = stable_phase_difference(r1, r2, params.w12, params.w21, params.phi12,
@@ -62,7 +62,7 @@ def test_canonical_coupling_locks_at_the_blended_phase_difference(grid_library):
 
 
 def test_an_interpolated_gait_follows_the_wave_about_as_well_as_a_direct_fit(grid_library):
-    members = family(grid_library, REFERENCE, FIELDS)
+    members = family_members(grid_library, REFERENCE, FIELDS)
     target = scaled_wave(REFERENCE, 1.25, 1.0)
     problem = WaveFitProblem(wave=target, geometry=GEOMETRY)
     blended = swing_angle_rmse_deg(
@@ -80,12 +80,12 @@ def test_the_locked_form_folds_signs_without_changing_the_gait(grid_library):
 @pytest.mark.parametrize('frequency, scale', [(0.9, 1.0), (1.2, 1.3)])
 def test_interpolation_outside_the_grid_is_refused(grid_library, frequency, scale):
     with pytest.raises(ValueError, match='outside the family grid'):
-        interpolated_parameters(family(grid_library, REFERENCE, FIELDS), frequency, scale)
+        interpolated_parameters(family_members(grid_library, REFERENCE, FIELDS), frequency, scale)
 
 
 @pytest.mark.parametrize('frequency, scale', [(1.0, 0.8), (1.5, 1.2), (1.25, 0.8), (1.0, 1.0)])
 def test_a_query_on_a_grid_line_blends_within_the_family(grid_library, frequency, scale):
-    members = family(grid_library, REFERENCE, FIELDS)
+    members = family_members(grid_library, REFERENCE, FIELDS)
     r1, r2, _ = locked_form(interpolated_parameters(members, frequency, scale))
     corners = np.array([locked_form(m.gait.params)[:2] for m in members])
     # A blend is a convex combination: each amplitude within the corners' (never a zero gait).

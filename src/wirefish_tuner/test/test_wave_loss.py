@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from wirefish_cpg.cpg_parameter_names import CPG_PARAMETER_NAMES
+from wirefish_cpg.cpg_node_parameters import CPG_PARAMETER_NAMES
 from wirefish_cpg.from_rest import phases_from_rest
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import stable_phase_difference, steady_state_phases

@@ -26,7 +26,7 @@ import numpy as np
 from wirefish_cpg.gait_library import Gait, GaitLibrary
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS
+from wirefish_kinematics.geometry_parameters import BODY_WAVE_GEOMETRY_FIELDS
 from wirefish_tuner.feasibility import fit_rejection, FitLimits, wave_infeasibility
 from wirefish_tuner.pso import PsoOptions
 from wirefish_tuner.tuning import fit_gait

@@ -32,7 +32,6 @@ the wave the CPG runs, only once a fit was applied.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 import threading
 
@@ -44,64 +43,23 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, ParameterSpec, validate_update
+from wirefish_common.parameter_table import declare, validate_update
 from wirefish_common.qos import LATCHED, reliable
 from wirefish_cpg.cpg_messages import to_message
-from wirefish_cpg.gait_library import default_library_path, Gait, GaitLibrary, LibraryFile
+from wirefish_cpg.gait_library import Gait, GaitLibrary, LibraryFile
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS, geometry_parameters
+from wirefish_kinematics.geometry_parameters import BODY_WAVE_GEOMETRY_FIELDS
 from wirefish_msgs.action import RetuneGait as RetuneGaitAction
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
 from wirefish_tuner.answered_service import paced
 from wirefish_tuner.feasibility import FitLimits
 from wirefish_tuner.pso import PsoOptions
-from wirefish_tuner.retune_core import (FitCancelled, gait_of, MAX_ITERATIONS, MAX_SWARM_SIZE,
-                                        retune, RetuneOrder, RetuneOutcome, RetuneProgress,
-                                        RetuneSettings)
+from wirefish_tuner.retune_core import (FitCancelled, gait_of, retune, RetuneOrder, RetuneOutcome,
+                                        RetuneProgress, RetuneSettings)
+from wirefish_tuner.tuner_node_parameters import SPECS, TUNER_PARAMETERS
 
-# The fit needs the body wave's geometry only; its specs are the one geometry block's.
-GEOMETRY_FIELDS = BODY_WAVE_GEOMETRY_FIELDS
-_LIMITS = FitLimits()
-TUNER_PARAMETERS = (
-    ParameterSpec('cpg_node_name', 'cpg_node',
-                  'Name (relative or absolute) of the CPG node whose parameters apply sets'),
-    ParameterSpec('swarm_size', 40, 'Default PSO particles per run', 2, MAX_SWARM_SIZE),
-    ParameterSpec('max_iterations', 100, 'Default PSO iteration limit', 1, MAX_ITERATIONS),
-    ParameterSpec('stall_iterations', 20, 'Stop after this many iterations without gain', 1,
-                  5000),
-    ParameterSpec('stall_tolerance', 1e-6, 'Relative gain below which an iteration stalls',
-                  0.0, 1.0),
-    ParameterSpec('inertia', 0.7298, 'PSO inertia weight c_w, eq 26', 0.0, 2.0),
-    ParameterSpec('cognitive', 1.49618, 'PSO learning factor c_f1, eq 26', 0.0, 4.0),
-    ParameterSpec('social', 1.49618, 'PSO learning factor c_f2, eq 26', 0.0, 4.0),
-    ParameterSpec('weight_bound', 10.0, 'Search bound |w_ij| (1/s); paper: 10', 0.0, 10.0,
-                  low_exclusive=True),
-    ParameterSpec('phase_bound', math.pi, 'Search bound |phi_ij| (rad); paper: pi', 0.0,
-                  math.pi, low_exclusive=True),
-    ParameterSpec('amplitude_bound', math.pi / 2,
-                  'Search bound |R_i| (rad), also the servo range a wave may ask for; '
-                  'paper: pi/2', 0.0, math.pi / 2, low_exclusive=True),
-    ParameterSpec('servo_rate_limit_rad_s', _LIMITS.servo_rate_limit_rad_s,
-                  'Fastest servo rate a wave may ask for (rad/s); the virtual fish slews 9.1',
-                  0.0, 1000.0, low_exclusive=True),
-    ParameterSpec('min_frequency_hz', _LIMITS.min_frequency_hz,
-                  'Slowest tail beat a wave may ask for (Hz)', 0.0, 10.0, low_exclusive=True),
-    ParameterSpec('max_rmse_deg', _LIMITS.max_rmse_deg,
-                  'Largest swing-angle RMSE of a fit that may be used (deg); paper fit: 1.7',
-                  0.0, 90.0, low_exclusive=True),
-    ParameterSpec('alpha', 20.0, 'Convergence gain alpha given to fitted gaits (1/s)', 0.0,
-                  200.0, low_exclusive=True),
-    ParameterSpec('samples_per_period', 48, 'Quadrature points of the loss per period', 8,
-                  2000),
-    ParameterSpec('apply_timeout_s', 5.0, 'Wait for the CPG node to accept (s)', 0.1, 60.0),
-    ParameterSpec('library_path', str(default_library_path()),
-                  'Gait library file (YAML): read at start-up and when changed, every '
-                  'successful fit stored; default $ROS_HOME/wirefish/gaits.yaml or '
-                  '~/.ros/wirefish/gaits.yaml'),
-) + geometry_parameters(GEOMETRY_FIELDS)
-SPECS = {spec.name: spec for spec in TUNER_PARAMETERS}
 # A burst of requests must fit the service's own DDS queues while a fit holds the executor;
 # its clients' queues are protected by pacing the answers (answered_service).
 SERVICE_QOS = reliable(depth=1000)
@@ -181,7 +139,7 @@ class TunerNode(Node):
         """Return the fit settings of the current parameters (raises ValueError if invalid)."""
         value = self._value
         return RetuneSettings(
-            geometry=FishGeometry(**{name: value(name) for name in GEOMETRY_FIELDS}),
+            geometry=FishGeometry(**{name: value(name) for name in BODY_WAVE_GEOMETRY_FIELDS}),
             limits=FitLimits(servo_range_rad=value('amplitude_bound'),
                              servo_rate_limit_rad_s=value('servo_rate_limit_rad_s'),
                              min_frequency_hz=value('min_frequency_hz'),

@@ -25,7 +25,8 @@ The dashboard
     `make setup`) and ``/config.json`` (the WebSocket port and namespace); 0 serves none.
 Parameters: ``address`` (127.0.0.1; anything wider is logged as a warning), ``port``,
 ``http_port``, ``max_speed``, ``max_turn``, ``scene_rate_hz``, ``trail_length``,
-``discovery_period_s``, ``frame_prefix``, l1 and l2 (the graph's geometry block).
+``discovery_period_s``, ``frame_prefix``, l1 and l2 (the graph's geometry block); the table
+is ``view_node_parameters``.
 """
 
 from __future__ import annotations
@@ -53,22 +54,20 @@ from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, ParameterSpec
+from wirefish_common.parameter_table import declare
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
-from wirefish_kinematics.node_parameters import geometry_parameters
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
 from wirefish_view.client_input import check_advertised, cmd_vel_from_client
 from wirefish_view.errors import RefusedInput, UnknownType
 from wirefish_view.scene import fish_scene, tail_segments
 from wirefish_view.schemas import ros2msg_schema
+from wirefish_view.view_node_parameters import VIEW_PARAMETERS
 from wirefish_view.web import DashboardServer
 
 GLOBAL_TOPICS = ('/tf', '/tf_static', '/diagnostics')
 # tf2_ros's listener profile (matches tf_node's broadcaster).
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-# The arcs of the scene: the graph's geometry block (/**), as the kinematics reads it.
-TAIL_GEOMETRY = geometry_parameters(('l1', 'l2'))
 SERVICE_WAIT_S = 5.0
 # view/retune: state sent | running (iteration, max_iterations, best_loss) | rejected | done
 # (success, message, applied, loss, iterations, from_library, rmse_theta_deg).
@@ -82,23 +81,6 @@ RETUNE_PROGRESS_SCHEMA = json.dumps({
         'from_library': {'type': 'boolean'},
         'rmse_theta_deg': {'type': 'array', 'items': {'type': 'number'}}}}).encode()
 REFUSAL_LOG_PERIOD_S = 2.0
-VIEW_PARAMETERS = (
-    ParameterSpec('address', '127.0.0.1', 'Address the servers bind (127.0.0.1: this machine '
-                  'only; 0.0.0.0 any: a warning is logged). Read at start'),
-    ParameterSpec('port', 8765, 'Foxglove WebSocket port (0: any free one). Read at start',
-                  0, 65535),
-    ParameterSpec('http_port', 8080, 'Dashboard HTTP port (0: any free one; -1: none). Read '
-                  'at start', -1, 65535),
-    ParameterSpec('max_speed', 0.4, 'Largest cmd_vel linear.x a client may send (m/s)',
-                  0.0, 2.0, low_exclusive=True),
-    ParameterSpec('max_turn', 0.6, 'Largest |cmd_vel angular.z| a client may send (rad/s)',
-                  0.0, 5.0, low_exclusive=True),
-    ParameterSpec('scene_rate_hz', 10.0, 'Scene updates a second (Hz)', 0.0, 100.0,
-                  low_exclusive=True),
-    ParameterSpec('trail_length', 600, 'Positions kept in the trail', 2, 100000),
-    ParameterSpec('discovery_period_s', 1.0, 'Seconds between looks for new topics', 0.0,
-                  60.0, low_exclusive=True),
-)
 
 
 def is_loopback(address: str) -> bool:
@@ -130,9 +112,8 @@ class ViewNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, start the servers, wire discovery, scene and services."""
         super().__init__('view_node', **kwargs)
-        declare(self, VIEW_PARAMETERS + TAIL_GEOMETRY)
-        self._values = {s.name: self.get_parameter(s.name).value
-                        for s in VIEW_PARAMETERS + TAIL_GEOMETRY}
+        declare(self, VIEW_PARAMETERS)
+        self._values = {s.name: self.get_parameter(s.name).value for s in VIEW_PARAMETERS}
         prefix = declare_frame_prefix(self)
         self._frames = {f: prefixed(prefix, f) for f in ('odom', 'base_link', 'tail_base')}
         namespace = self.get_namespace().rstrip('/')

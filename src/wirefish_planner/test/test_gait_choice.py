@@ -5,7 +5,7 @@ import math
 import pytest
 from wirefish_cpg.table1_gait import locked_speed_estimate, table1_locked_at
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_planner.gait_family import GaitLimits, GaitPlanner, Table1Family
+from wirefish_planner.gait_choice import GaitLimits, GaitPlanner, Table1Family
 
 
 @pytest.mark.parametrize('target', [0.02, 0.05, 0.10, 0.20, 0.30, 0.35])
@@ -99,8 +99,8 @@ def library_file(tmp_path_factory):
     """
     from wirefish_cpg.gait_family import scaled_wave
     from wirefish_cpg.gait_library import Gait, GaitLibrary, geometry_key, save_library
+    from wirefish_kinematics.geometry_parameters import BODY_WAVE_GEOMETRY_FIELDS
     from wirefish_kinematics.wave_spec import WaveSpec
-    from wirefish_kinematics.node_parameters import BODY_WAVE_GEOMETRY_FIELDS
 
     geometry = {name: getattr(FishGeometry(), name) for name in BODY_WAVE_GEOMETRY_FIELDS}
     gaits = tuple(Gait(wave=scaled_wave(WaveSpec(), f, s), geometry=geometry_key(geometry),

@@ -34,8 +34,7 @@ from typing import Protocol
 
 import numpy as np
 from scipy.optimize import brentq
-from wirefish_cpg.gait_family import (family as library_members, FamilyMember,
-                                      interpolated_parameters)
+from wirefish_cpg.gait_family import family_members, FamilyMember, interpolated_parameters
 from wirefish_cpg.gait_library import load_library
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.table1_gait import one_locked_period, table1_locked_at
@@ -118,7 +117,7 @@ def library_family(path: Path, reference: WaveSpec, geometry: dict[str, float]
         library = load_library(path)
     except OSError as error:
         raise ValueError(f'gait library {path}: {error}') from error
-    return LibraryFamily(library_members(library, reference, geometry))
+    return LibraryFamily(family_members(library, reference, geometry))
 
 
 @dataclass(frozen=True)

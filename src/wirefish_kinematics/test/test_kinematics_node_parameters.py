@@ -5,10 +5,10 @@ import subprocess
 import sys
 
 import pytest
+from wirefish_common.parameter_table import check_value
 from wirefish_kinematics.geometry import FishGeometry, GEOMETRY_FIELDS
-from wirefish_kinematics.node_parameters import (BODY_WAVE_GEOMETRY_FIELDS, check_value,
-                                                 geometry_from, geometry_parameters, SPECS,
-                                                 wave_from, WAVE_PARAMETER_NAMES)
+from wirefish_kinematics.geometry_parameters import geometry_from
+from wirefish_kinematics.kinematics_node_parameters import SPECS, wave_from, WAVE_PARAMETER_NAMES
 from wirefish_kinematics.wave_spec import WaveSpec
 
 
@@ -41,22 +41,7 @@ def test_wave_defaults_are_wave_spec_defaults():
     assert wave_from(values) == WaveSpec()
 
 
-def test_the_geometry_block_declares_the_fields_asked_for_with_the_node_specs():
-    specs = geometry_parameters(BODY_WAVE_GEOMETRY_FIELDS)
-    assert tuple(spec.name for spec in specs) == BODY_WAVE_GEOMETRY_FIELDS
-    assert all(spec is SPECS[spec.name] for spec in specs)
-
-
-def test_the_geometry_block_refuses_a_name_that_is_no_geometry_field():
-    with pytest.raises(ValueError, match='wave_k'):
-        geometry_parameters(('l1', 'wave_k'))
-
-
-def test_a_partial_geometry_keeps_the_other_fields_at_their_defaults():
-    geometry = geometry_from({'l1': 0.09, 'rd2': 0.02}, ('l1', 'rd2'))
-    assert geometry == FishGeometry(l1=0.09, rd2=0.02)
-
-
 def test_the_parameter_module_imports_no_rclpy():
-    code = 'import sys, wirefish_kinematics.node_parameters; sys.exit("rclpy" in sys.modules)'
+    code = ('import sys, wirefish_kinematics.kinematics_node_parameters; '
+            'sys.exit("rclpy" in sys.modules)')
     assert subprocess.run([sys.executable, '-c', code]).returncode == 0
