@@ -1,10 +1,10 @@
-"""The two-host harness without root: names, addresses, DDS settings, the non-root refusal."""
+"""The two-host harness without root: names, addresses, each side's start, the root check."""
 
 import pytest
 from wirefish_bringup.graph import Role
 from wirefish_cli.cli import main
-from wirefish_launcher import netns
-from wirefish_launcher.netns import Discovery, TwoHosts
+from wirefish_launcher import netns, twohost
+from wirefish_launcher.netns import Discovery, SIDES, TwoHosts
 
 
 def test_every_name_carries_the_wf_prefix_and_the_token_and_fits_an_interface_name():
@@ -27,21 +27,79 @@ def test_a_token_or_subnet_that_would_not_fit_is_refused(token, subnet):
         TwoHosts(token, subnet)
 
 
-def test_static_discovery_names_the_other_host_as_peer_and_stays_local_otherwise():
-    env = TwoHosts('t', 3).ros_environment(Role.FISH, Discovery.STATIC)
-    assert env['ROS_STATIC_PEERS'] == '10.213.3.2'
-    assert env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST'
+class _Side:
+    """A stand-in for one side's `wirefish up` process: running until stopped, then 0."""
+
+    def __init__(self, args, env, **_popen) -> None:
+        self.args, self.env, self.pid, self.returncode = args, env, 0, None
+
+    def poll(self):
+        return self.returncode
+
+    def wait(self, timeout=None) -> int:
+        self.returncode = 0
+        return 0
 
 
-@pytest.mark.parametrize('discovery', [Discovery.MULTICAST, Discovery.STATIC])
-def test_both_discoveries_force_udp_so_a_cut_link_cuts(discovery):
-    env = TwoHosts('t').ros_environment(Role.SHORE, discovery)
-    assert env['FASTDDS_BUILTIN_TRANSPORTS'] == 'UDPv4'
+@pytest.fixture
+def started_sides(monkeypatch, capsys):
+    """
+    Return ``start(discovery)``: run `wirefish twohost` with the pair and its processes stood in.
+
+    It returns each side's stand-in process (its command line and environment), the caller's
+    environment holding the settings that would defeat the pair: shared memory on, a static peer
+    and localhost-only discovery.
+    """
+    monkeypatch.setattr(twohost, 'root_problem', lambda: None)
+    for action in ('create', 'remove', 'shape'):
+        monkeypatch.setattr(TwoHosts, action, lambda self, *args: None)
+    sides = []
+    monkeypatch.setattr(twohost.subprocess, 'Popen',
+                        lambda args, env, **kwargs: sides.append(_Side(args, env, **kwargs))
+                        or sides[-1])
+    monkeypatch.setattr(twohost.os, 'killpg', lambda pid, signum: None)
+    monkeypatch.setattr(twohost.signal, 'signal', lambda signum, handler: None)
+    monkeypatch.setenv('FASTDDS_BUILTIN_TRANSPORTS', 'SHM')
+    monkeypatch.setenv('ROS_STATIC_PEERS', '192.0.2.7')
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+
+    def start(discovery: Discovery) -> dict[Role, _Side]:
+        assert main(['twohost', '--token', 't', '--subnet', '3', '--discovery', discovery,
+                     '--duration', '0.01']) == 0, capsys.readouterr().err
+        return dict(zip(SIDES, sides, strict=True))
+
+    return start
 
 
-def test_multicast_discovery_clears_any_static_peer_of_the_callers_environment():
-    env = TwoHosts('t').ros_environment(Role.SHORE, Discovery.MULTICAST)
-    assert env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'SUBNET' and env['ROS_STATIC_PEERS'] == ''
+def test_each_side_runs_wirefish_up_in_its_role_inside_its_own_network_namespace(
+        started_sides):
+    link = TwoHosts('t', 3)
+    for side, proc in started_sides(Discovery.MULTICAST).items():
+        assert proc.args[:4] == ['ip', 'netns', 'exec', link.namespace(side)], side
+        assert proc.args[proc.args.index('--role') + 1] == side
+
+
+@pytest.mark.parametrize('discovery', list(Discovery))
+def test_no_side_inherits_the_callers_shared_memory_so_a_cut_link_cuts(started_sides,
+                                                                       discovery):
+    # Both network namespaces see one /dev/shm: Fast DDS's shared-memory transport would carry
+    # data past the veth pair.
+    for side, proc in started_sides(discovery).items():
+        assert 'SHM' not in proc.env['FASTDDS_BUILTIN_TRANSPORTS'], side
+
+
+def test_multicast_discovery_reaches_the_subnet_and_drops_the_callers_static_peer(
+        started_sides):
+    for side, proc in started_sides(Discovery.MULTICAST).items():
+        assert proc.env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'SUBNET', side
+        assert proc.env['ROS_STATIC_PEERS'] == '', side
+
+
+def test_static_discovery_gives_each_side_the_other_host_as_its_only_peer(started_sides):
+    link = TwoHosts('t', 3)
+    for side, proc in started_sides(Discovery.STATIC).items():
+        assert proc.env['ROS_STATIC_PEERS'] == link.address(TwoHosts.other(side)), side
+        assert proc.env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST', side  # no multicast
 
 
 def test_wirefish_twohost_says_it_needs_root_and_makes_nothing(monkeypatch, capsys):
