@@ -8,6 +8,7 @@ the files' summaries give.
 """
 
 import argparse
+import enum
 from pathlib import Path
 import sys
 
@@ -20,12 +21,19 @@ import yaml
 REINDEX_HINT = ' (a killed recording? `wirefish bag reindex BAG` repairs it)'
 
 
+class BagAction(enum.StrEnum):
+    """The actions of `wirefish bag`, as `ros2 bag` names them."""
+
+    REINDEX = 'reindex'
+    INFO = 'info'
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the sub-subcommands of `wirefish bag`."""
     actions = parser.add_subparsers(dest='action', required=True, metavar='ACTION')
-    for name, help_text in (('reindex', 'rebuild unfinished MCAP files and metadata.yaml'),
-                            ('info', 'files, duration and message counts of a bag')):
-        action = actions.add_parser(name, help=help_text, description=help_text)
+    for name, help_text in ((BagAction.REINDEX, 'rebuild unfinished MCAP files and metadata.yaml'),
+                            (BagAction.INFO, 'files, duration and message counts of a bag')):
+        action = actions.add_parser(name.value, help=help_text, description=help_text)
         action.add_argument('bag', type=Path, help='rosbag2 directory')
 
 
@@ -59,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
         print(f'wirefish bag {args.action}: {problem}', file=sys.stderr)
         return 2
     try:
-        if args.action == 'reindex':
+        if args.action == BagAction.REINDEX:
             for r in reindex(args.bag):
                 print(f'{r.name}: rebuilt from {r.chunks} intact chunks ({r.messages} messages);'
                       f' left out {r.damaged_chunks} damaged chunks, {r.orphan_messages} '

@@ -61,13 +61,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     target.add_argument('--sim', action='store_true', default=True,
                         help='drive the virtual fish on a pseudo-terminal (default)')
     target.add_argument('--port', help='serial device of a real fish, e.g. /dev/ttyUSB0')
-    target.add_argument('--fish', choices=list(Fish), default=None,
+    target.add_argument('--fish', choices=[fish.value for fish in Fish], default=None,
                         help='sim: the virtual fish (as --sim); qemu: the firmware on an '
                         'emulated STM32F405 (QEMU; built with make -C firmware qemu), the bridge '
                         'on its pty (no physics: no sim/ground_truth)')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
                         help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
-    parser.add_argument('--role', choices=list(Role), default=Role.ALL,
+    parser.add_argument('--role', choices=[role.value for role in Role],
+                        default=Role.ALL.value,
                         help='one side of a radio link: fish (virtual fish or port, bridge, '
                         'CPG, kinematics, planner, link relay) or shore (tuner, recorder); '
                         'all: both on this machine (default). See README: two hosts')

@@ -32,7 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='names the pair wf<token>f / wf<token>s (default: from the PID)')
     parser.add_argument('--subnet', type=int, default=0,
                         help='addresses 10.213.<subnet>.1 (fish) and .2 (shore); default 0')
-    parser.add_argument('--discovery', choices=list(Discovery), default=Discovery.MULTICAST,
+    parser.add_argument('--discovery', choices=[d.value for d in Discovery],
+                        default=Discovery.MULTICAST.value,
                         help='DDS discovery across the link: multicast (SUBNET) or static '
                         'peers (LOCALHOST + ROS_STATIC_PEERS)')
     parser.add_argument('--rate', default=None,

@@ -11,6 +11,7 @@ and exits 1. A relative node name is taken in ``--namespace`` (default /wirefish
 from __future__ import annotations
 
 import argparse
+import enum
 import sys
 
 SERVICE_WAIT_S = 10.0  # how long to wait for the node's parameter services
@@ -22,15 +23,23 @@ _VALUE_FIELDS = {1: 'bool_value', 2: 'integer_value', 3: 'double_value', 4: 'str
                  8: 'double_array_value', 9: 'string_array_value'}
 
 
+class ParamVerb(enum.StrEnum):
+    """The verbs of `wirefish param`, as `ros2 param` names them."""
+
+    LIST = 'list'
+    GET = 'get'
+    SET = 'set'
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare `wirefish param list | get | set` and their arguments."""
     from wirefish_bringup.graph import DEFAULT_NAMESPACE
 
     verbs = parser.add_subparsers(dest='verb', required=True, metavar='VERB')
-    helps = {'list': "a node's parameters", 'get': "one parameter's value",
-             'set': 'set one parameter (the node may refuse it, with its reason)'}
-    listing, get, put = (verbs.add_parser(name, help=text, description=text)
-                         for name, text in helps.items())
+    helps = {ParamVerb.LIST: "a node's parameters", ParamVerb.GET: "one parameter's value",
+             ParamVerb.SET: 'set one parameter (the node may refuse it, with its reason)'}
+    listing, get, put = (verbs.add_parser(verb.value, help=text, description=text)
+                         for verb, text in helps.items())
     for sub in (listing, get, put):
         sub.add_argument('node', help='node name (relative: in --namespace), e.g. cpg_node')
         sub.add_argument('--namespace', default=DEFAULT_NAMESPACE,
@@ -76,8 +85,9 @@ def run(args: argparse.Namespace) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     target = node_name(args.node, args.namespace)
-    kinds = {'list': (ListParameters, 'list_parameters'), 'get': (GetParameters, 'get_parameters'),
-             'set': (SetParameters, 'set_parameters')}
+    kinds = {ParamVerb.LIST: (ListParameters, 'list_parameters'),
+             ParamVerb.GET: (GetParameters, 'get_parameters'),
+             ParamVerb.SET: (SetParameters, 'set_parameters')}
     kind, service = kinds[args.verb]
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node('wirefish_param', start_parameter_services=False)
@@ -88,9 +98,9 @@ def run(args: argparse.Namespace) -> int:
                   f'answer within {SERVICE_WAIT_S:g} s)', file=sys.stderr)
             return 1
         request = kind.Request()
-        if args.verb == 'get':
+        if args.verb == ParamVerb.GET:
             request.names = [args.name]
-        elif args.verb == 'set':
+        elif args.verb == ParamVerb.SET:
             try:
                 request.parameters = [parameter_message(args.name, args.value)]
             except (TypeError, ValueError) as error:
@@ -109,11 +119,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _show(args: argparse.Namespace, response) -> int:
-    if args.verb == 'list':
+    if args.verb == ParamVerb.LIST:
         for name in sorted(response.result.names):
             print(f'  {name}')
         return 0
-    if args.verb == 'get':
+    if args.verb == ParamVerb.GET:
         if not response.values or response.values[0].type == 0:
             print(f'wirefish param get: {args.node} has no parameter {args.name}',
                   file=sys.stderr)

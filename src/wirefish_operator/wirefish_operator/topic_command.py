@@ -12,6 +12,7 @@ prints the rate every second, as ``ros2 topic hz`` does. A relative name is take
 from __future__ import annotations
 
 import argparse
+import enum
 import math
 import sys
 import time
@@ -20,16 +21,24 @@ DISCOVERY_S = 2.0  # how long to listen for the graph before answering
 WAIT_S = 10.0  # how long echo and hz wait for the topic to appear
 
 
+class TopicVerb(enum.StrEnum):
+    """The verbs of `wirefish topic`, as `ros2 topic` names them."""
+
+    LIST = 'list'
+    ECHO = 'echo'
+    HZ = 'hz'
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare `wirefish topic list | echo | hz` and their options."""
     from wirefish_bringup.graph import DEFAULT_NAMESPACE
 
     verbs = parser.add_subparsers(dest='verb', required=True, metavar='VERB')
-    helps = {'list': 'the topics on this ROS domain',
-             'echo': 'print the messages of a topic as YAML',
-             'hz': "print a topic's rate every second"}
-    listing, echo, hz = (verbs.add_parser(name, help=text, description=text)
-                         for name, text in helps.items())
+    helps = {TopicVerb.LIST: 'the topics on this ROS domain',
+             TopicVerb.ECHO: 'print the messages of a topic as YAML',
+             TopicVerb.HZ: "print a topic's rate every second"}
+    listing, echo, hz = (verbs.add_parser(verb.value, help=text, description=text)
+                         for verb, text in helps.items())
     listing.add_argument('-t', '--show-types', action='store_true', help='show each type too')
     listing.add_argument('--include-hidden-topics', action='store_true',
                          help='also topics with a token starting with _ (actions)')
@@ -124,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
     """Run `wirefish topic ...`; return the exit code."""
     probe = _Probe()
     try:
-        if args.verb == 'list':
+        if args.verb == TopicVerb.LIST:
             return _list(probe, args)
         topic = full_name(args.topic, args.namespace)
         type_name = probe.type_of(topic, WAIT_S)
@@ -132,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
             print(f'wirefish topic {args.verb}: no publisher of {topic} within {WAIT_S:g} s '
                   '(wirefish topic list shows what there is)', file=sys.stderr)
             return 1
-        return (_echo if args.verb == 'echo' else _hz)(probe, topic, type_name, args)
+        return (_echo if args.verb == TopicVerb.ECHO else _hz)(probe, topic, type_name, args)
     finally:
         probe.close()
 
