@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 from wirefish_bridge.bridge_node_parameters import SPECS as BRIDGE_SPECS
 from wirefish_bringup.graph import (combined_policy, composable_entries, entries, expected_rates,
-                                    FISH, fish_graph, NODES, NodeSpec, RestartBudget,
-                                    RestartPolicy, SHORE, sim_tty_link, validate_namespace)
+                                    fish_graph, NODES, NodeSpec, RestartBudget, RestartPolicy,
+                                    Role, sim_tty_link, validate_namespace)
 from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
 
 LAUNCH_FILE = Path(__file__).resolve().parents[1] / 'launch' / 'wirefish.launch.py'
@@ -215,5 +215,5 @@ def test_the_view_is_a_shore_process_started_only_when_asked():
     assert 'view_node' not in [s.name for s in fish_graph(sim=True, params_file='p.yaml')]
     with_view = fish_graph(sim=True, params_file='p.yaml', view=True)
     assert with_view[-1].name == 'view_node'
-    assert 'view_node' in [e.name for e in entries(sim=True, role=SHORE, view=True)]
-    assert 'view_node' not in [e.name for e in entries(sim=True, role=FISH, view=True)]
+    assert 'view_node' in [e.name for e in entries(sim=True, role=Role.SHORE, view=True)]
+    assert 'view_node' not in [e.name for e in entries(sim=True, role=Role.FISH, view=True)]
