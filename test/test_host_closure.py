@@ -14,7 +14,7 @@ from pathlib import Path
 
 from catkin_pkg.package import parse_package
 import pytest
-from wirefish_bringup.graph import FISH, NODES, SHORE
+from wirefish_bringup.graph import NODES, Role
 
 pytestmark = pytest.mark.linter
 WORKSPACE = Path(__file__).resolve().parents[1]
@@ -63,8 +63,7 @@ def closure(roots: set[str], manifests: Mapping[str, Path], host: str) -> set[st
 
 def role_packages(role: str) -> set[str]:
     """Return the packages of the registry's processes on one side of the link, and launching."""
-    side = FISH if role == 'fish' else SHORE
-    return {entry.package for entry in NODES if entry.role == side} | LAUNCHING | TOOLS[role]
+    return {entry.package for entry in NODES if entry.role == Role(role)} | LAUNCHING | TOOLS[role]
 
 
 @pytest.mark.parametrize('role', ['fish', 'shore'])
