@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 from wirefish_common.plotting import legend_beside, moving_mean
 from wirefish_operator.mission_plan import Mission
+from wirefish_planner.planner_core import PlannerMode
 from wirefish_planner.yaw_control import identify_turn_gain
 
 ARROW_EVERY_S = 1.0
@@ -33,7 +34,7 @@ REST_SPEED = 0.02  # m/s: below this (1 s mean) the fish has come to rest
 MIN_GAIN_LEGS = 4
 MIN_GAIN_R_SQUARED = 0.9
 MAX_GAIN_RELATIVE_ERROR = 0.2
-CLOSED_LOOP_MODES = ('turn', 'hold', 'straight')
+CLOSED_LOOP_MODES = (PlannerMode.TURN, PlannerMode.HOLD, PlannerMode.STRAIGHT)
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """
 The planner's rules (pure; no rclpy): cmd_vel in, gait and turning offset out.
 
-Modes
+Modes (``PlannerMode``, PlannerState.mode)
     ``rest``      no cmd_vel yet, the last one older than ``cmd_vel_timeout_s`` (judged by an
                   on-time step: see ``LATE_STEP_FRACTION``), or speed 0:
                   amplitudes and offsets go to 0 (the CPG converges there smoothly), the
@@ -12,12 +12,14 @@ Modes
     ``straight``  angular.z = 0 without heading hold: the yaw-rate PI tracks 0.
     ``open_loop`` ``yaw_control`` off, or no IMU sample for ``imu_timeout_s``: the feed-forward
                   offset of angular.z alone.
+    ``manual``    set by planner_node, not by these rules: the CPG is under a manual override.
 Speed: ``GaitPlanner.choose`` (eq 18 inverted, ``gait_choice``); turning: ``yaw_control``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+import enum
 import math
 
 from wirefish_planner.gait_choice import GaitChoice, GaitPlanner
@@ -30,6 +32,17 @@ SPEED_RESOLUTION_M_S = 0.001  # targets closer than this share a gait (no re-pla
 # was itself asleep (a loaded machine): what arrived meanwhile still waits in its queues, so
 # that step keeps the last judgement of the input and the next, on-time step judges it.
 LATE_STEP_FRACTION = 0.5
+
+
+class PlannerMode(enum.StrEnum):
+    """What the planner does (the module docstring); the values of PlannerState.mode."""
+
+    REST = 'rest'
+    TURN = 'turn'
+    HOLD = 'hold'
+    STRAIGHT = 'straight'
+    OPEN_LOOP = 'open_loop'
+    MANUAL = 'manual'
 
 
 @dataclass(frozen=True)
@@ -53,7 +66,7 @@ class PlannerSettings:
 class PlannerOutput:
     """What the planner wants now, and why (the content of PlannerState)."""
 
-    mode: str
+    mode: PlannerMode
     gait: GaitChoice
     offset: float
     yaw_rate_target: float
@@ -174,17 +187,17 @@ class Planner:
             if self._command_s is not None and not self._command_lapsed and \
                     self._yaw_rate_cmd != 0.0:
                 note = 'turning needs forward speed (r = k U b): resting'
-            mode = 'rest'
-            return PlannerOutput(mode, GaitChoice(0.0, None), 0.0, 0.0, self._measured_rate,
-                                 math.nan, self._wrapped_heading(), note)
+            return PlannerOutput(PlannerMode.REST, GaitChoice(0.0, None), 0.0, 0.0,
+                                 self._measured_rate, math.nan, self._wrapped_heading(), note)
         speed = self._choice.predicted_speed
         if self.settings.yaw_control and not self._imu_lapsed:
-            mode = 'turn' if self._yaw_rate_cmd != 0.0 else (
-                'hold' if not math.isnan(self._heading_target) else 'straight')
+            mode = PlannerMode.TURN if self._yaw_rate_cmd != 0.0 else (
+                PlannerMode.HOLD if not math.isnan(self._heading_target)
+                else PlannerMode.STRAIGHT)
             offset = self.pi.offset
             reference = self._reference
         else:
-            mode = 'open_loop'
+            mode = PlannerMode.OPEN_LOOP
             self.pi.reset()
             reference = self._yaw_rate_cmd
             limit = self.pi.gains.max_offset_rad

@@ -44,7 +44,7 @@ from wirefish_cpg.cpg_messages import flat_message_values
 from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
 from wirefish_planner.planner_config import (command_targets, cpg_topic, cpg_values,
                                              planner_from, values_changed)
-from wirefish_planner.planner_core import ignored_fields, PlannerOutput
+from wirefish_planner.planner_core import ignored_fields, PlannerMode, PlannerOutput
 from wirefish_planner.planner_node_parameters import PLANNER_PARAMETERS, SPECS
 from wirefish_planner.yaw_control import yaw_from_quaternion
 
@@ -193,7 +193,7 @@ class PlannerNode(Node):
         point = out.gait.point
         msg = PlannerState()
         msg.header.stamp = self.get_clock().now().to_msg()
-        msg.mode = 'manual' if self._manual() else out.mode
+        msg.mode = str(PlannerMode.MANUAL if self._manual() else out.mode)
         msg.target_speed = float(out.gait.target_speed)
         msg.predicted_speed = float(out.gait.predicted_speed)
         msg.clamp_reason = out.gait.clamp_reason
@@ -224,12 +224,13 @@ class PlannerNode(Node):
             level, message = DiagnosticStatus.WARN, f'nobody hears {self._command_pub.topic_name}'
         elif out is not None and out.gait.clamp_reason:
             level, message = DiagnosticStatus.WARN, f'speed clamped: {out.gait.clamp_reason}'
-        elif out is not None and out.mode == 'open_loop' and self._values['yaw_control']:
+        elif (out is not None and out.mode == PlannerMode.OPEN_LOOP
+              and self._values['yaw_control']):
             level, message = DiagnosticStatus.WARN, 'no imu/data: turning open loop'
         elif self._planner.gaits.family_note:
             level, message = DiagnosticStatus.WARN, self._planner.gaits.family_note
         values = {} if out is None else {
-            'mode': out.mode, 'target_speed': f'{out.gait.target_speed:.3f}',
+            'mode': str(out.mode), 'target_speed': f'{out.gait.target_speed:.3f}',
             'predicted_speed': f'{out.gait.predicted_speed:.3f}',
             'yaw_rate_target': f'{out.yaw_rate_target:.3f}',
             'yaw_rate_measured': f'{out.yaw_rate_measured:.3f}',
