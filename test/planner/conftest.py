@@ -18,7 +18,7 @@ import time
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 import pytest
 from ros_utils import stop_process
-from wirefish_common.executors import EVENTS, make_executor, spin_until_stopped, wake
+from wirefish_common.executors import ExecutorKind, make_executor, spin_until_stopped, wake
 
 NAMESPACE = '/h181_planner'
 YAW_DISTURBANCE_RAD_S = 0.05  # the current: 2.9 deg/s of yaw on a straight tail
@@ -121,7 +121,7 @@ class Driver:
         self._stopping = False
         # The events executor: a Python executor's wake-ups cost ~0.2 ms each, and at ~190
         # messages a second a loaded machine left this probe behind for most of a second.
-        self._executor = make_executor(EVENTS, context)
+        self._executor = make_executor(ExecutorKind.EVENTS, context)
         self._executor.add_node(self.node)
         self._spinner = threading.Thread(
             target=spin_until_stopped, args=(self._executor, lambda: self._stopping),

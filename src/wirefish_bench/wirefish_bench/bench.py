@@ -18,12 +18,11 @@ import tempfile
 import traceback
 
 import numpy as np
+from wirefish_bench.bench_report import EXECUTORS
 
 WORKSPACE = Path(__file__).resolve().parents[3] if (
     Path(__file__).resolve().parents[3] / 'Makefile').is_file() else Path.cwd()
 DOMAIN = int(os.environ.get('WIREFISH_BENCH_DOMAIN', '101'))
-# Every node benchmark runs on the old executor and the new one, side by side.
-EXECUTORS = ('classic', 'events')
 # The 1-fish rows (the onboard-CPU verdict) are the median of this many alternated runs.
 ONE_FISH_REPEATS = 3
 
@@ -84,7 +83,7 @@ def one_fish(repeats: int, duration_s: float, domain_id: int, single_process: bo
             runs[executor].append(bench_graph.fleet(1, duration_s, domain_id, single_process,
                                                     executor))
     medians = []
-    for executor, results in runs.items():
+    for results in runs.values():
         ordered = sorted(results, key=lambda r: r['onboard_cpu_percent_per_fish'])
         median = dict(ordered[len(ordered) // 2])
         median['onboard_cpu_percent_runs'] = [r['onboard_cpu_percent_per_fish'] for r in results]

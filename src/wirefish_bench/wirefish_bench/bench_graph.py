@@ -18,7 +18,7 @@ import numpy as np
 import psutil
 
 from wirefish_bringup.graph import fish_graph, NodeSpec
-from wirefish_common.executors import EVENTS, EXECUTOR_VARIABLE, make_executor
+from wirefish_common.executors import EXECUTOR_VARIABLE, ExecutorKind, make_executor
 from wirefish_launcher.supervisor import Supervisor, wait_for_path
 
 READY_TIMEOUT_S = 60.0
@@ -50,7 +50,7 @@ def ros_session(domain_id: int, executor_kind: str | None = None):
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
     node = rclpy.create_node('wirefish_bench', context=context)
-    executor = make_executor(executor_kind or EVENTS, context=context)
+    executor = make_executor(executor_kind or ExecutorKind.EVENTS, context=context)
     executor.add_node(node)
     try:
         yield node, executor

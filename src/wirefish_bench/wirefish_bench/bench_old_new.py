@@ -27,6 +27,7 @@ import tempfile
 import time
 
 import numpy as np
+from wirefish_common.executors import ExecutorKind
 
 CPG_COMMIT = '821c50c'  # before FixedRateLoop's SCHED_FIFO and GIL switch interval
 SIM_COMMIT = 'de0bafa'  # before fish_sim simulated N fish in one process
@@ -72,7 +73,7 @@ def cpg_period_error(repeats: int, domain_id: int) -> dict:
                     os.environ['PYTHONPATH'] = (os.pathsep.join([old, saved])
                                                 if which == 'old' else saved)
                     runs[which].append(bench_graph.cpg_rate(DEFAULT_RATE_HZ, WINDOW_S,
-                                                            domain_id, 'events'))
+                                                            domain_id, ExecutorKind.EVENTS))
         finally:
             os.environ['PYTHONPATH'] = saved
     return {which: {'source_p99_ms': [r['source_period_error_p99_ms'] for r in rs],

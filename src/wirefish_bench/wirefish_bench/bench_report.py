@@ -5,6 +5,7 @@ from wirefish_bench.bench_old_new import rows as old_new_rows
 from wirefish_bench.bench_radio_link import row as radio_row
 from wirefish_bench.bench_recorder import row as recorder_row
 from wirefish_bench.bench_view import row as view_row
+from wirefish_common.executors import ExecutorKind
 
 
 def _fmt(value, spec: str = '.3g') -> str:
@@ -27,8 +28,8 @@ def _verdict(measured, goal_ok) -> str:
     return 'met' if goal_ok else 'missed'
 
 
-# Each node figure on the classic executor and the events executor, from one run.
-EXECUTORS = ('classic', 'events')
+# Each node figure on the classic executor and the events executor (old, then new), one run.
+EXECUTORS = (ExecutorKind.CLASSIC, ExecutorKind.EVENTS)
 FLEET_HOW = 'all streaming after {ready} s; then 3 s warm-up, 10 s window; psutil CPU'
 
 
@@ -147,8 +148,9 @@ def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
         def onboard(single: bool, executor: str) -> float | None:
             r = one_fish[single].get(executor)
             return None if r is None else r['onboard_cpu_percent_per_fish']
-        old = onboard(False, 'classic')
-        new = [v for v in (onboard(False, 'events'), onboard(True, 'events')) if v is not None]
+        old = onboard(False, ExecutorKind.CLASSIC)
+        new = [v for v in (onboard(single, ExecutorKind.EVENTS) for single in (False, True))
+               if v is not None]
         best = min(new) if new else None
 
         def runs(single: bool, executor: str) -> str:

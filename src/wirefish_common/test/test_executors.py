@@ -1,8 +1,10 @@
 """The executor choice (WIREFISH_EXECUTOR) and the one spin loop, without ROS."""
 
 import pytest
-from wirefish_common.executors import (CLASSIC, EVENTS, executor_kind, EXECUTOR_VARIABLE,
+from wirefish_common.executors import (executor_kind, EXECUTOR_VARIABLE, ExecutorKind,
                                        make_executor, spin_until_stopped, wake)
+
+EVENTS, CLASSIC = ExecutorKind.EVENTS, ExecutorKind.CLASSIC
 
 
 @pytest.mark.parametrize(('environ', 'kind'), [

@@ -22,36 +22,45 @@ context is shut down after the loop, never under it.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+import enum
 import os
 from typing import Any
 
 EXECUTOR_VARIABLE = 'WIREFISH_EXECUTOR'
-EVENTS, CLASSIC = 'events', 'classic'
-EXECUTOR_KINDS = (EVENTS, CLASSIC)
+
+
+class ExecutorKind(enum.StrEnum):
+    """The executors a wirefish process spins on (the values of ``WIREFISH_EXECUTOR``)."""
+
+    EVENTS = 'events'  # the default
+    CLASSIC = 'classic'
+
+
 # The longest the loop goes without looking at its stop flag if nobody wakes it.
 SPIN_TIMEOUT_S = 0.1
 
 
-def executor_kind(environ: Mapping[str, str] | None = None) -> str:
+def executor_kind(environ: Mapping[str, str] | None = None) -> ExecutorKind:
     """Return the executor kind ``WIREFISH_EXECUTOR`` names (unset or empty: events)."""
     environ = os.environ if environ is None else environ
-    value = environ.get(EXECUTOR_VARIABLE, '').strip() or EVENTS
-    if value not in EXECUTOR_KINDS:
+    value = environ.get(EXECUTOR_VARIABLE, '').strip() or ExecutorKind.EVENTS
+    try:
+        return ExecutorKind(value)
+    except ValueError:
         raise ValueError(f'{EXECUTOR_VARIABLE}={value!r} is not an executor: expected one of '
-                         f'{", ".join(EXECUTOR_KINDS)}')
-    return value
+                         f'{", ".join(ExecutorKind)}') from None
 
 
 def make_executor(kind: str, context: Any = None) -> Any:
-    """Return a new executor of ``kind`` (``events`` or ``classic``) on ``context``."""
-    if kind == EVENTS:
+    """Return a new executor of ``kind`` (an ``ExecutorKind``) on ``context``."""
+    if kind == ExecutorKind.EVENTS:
         from rclpy.experimental import EventsExecutor
         return EventsExecutor(context=context)
-    if kind == CLASSIC:
+    if kind == ExecutorKind.CLASSIC:
         from rclpy.executors import SingleThreadedExecutor
         return SingleThreadedExecutor(context=context)
     raise ValueError(f'unknown executor kind {kind!r}: expected one of '
-                     f'{", ".join(EXECUTOR_KINDS)}')
+                     f'{", ".join(ExecutorKind)}')
 
 
 def spin_until_stopped(executor: Any, stopped: Callable[[], bool]) -> None:

@@ -17,6 +17,11 @@ import threading
 
 from wirefish_bringup.graph import (composable_entries, DEFAULT_NAMESPACE, default_params_file,
                                     resolve, ros_arguments, validate_namespace)
+from wirefish_common.executors import ExecutorKind
+
+# Beside the executors a node process may spin on (ExecutorKind), the one process of all the
+# nodes may spin on rclpy's MultiThreadedExecutor.
+MULTI = 'multi'
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,7 +30,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--port', required=True,
                         help="the fish's serial device (the nodes' {device} parameters)")
     parser.add_argument('--params-file', default=None, help='parameter YAML')
-    parser.add_argument('--executor', choices=('events', 'classic', 'multi'), default=None,
+    parser.add_argument('--executor', choices=[*(kind.value for kind in ExecutorKind), MULTI],
+                        default=None,
                         help='executor of the bridge, CPG and kinematics nodes: events '
                         '(rclpy.experimental.EventsExecutor), classic '
                         '(SingleThreadedExecutor) or multi (MultiThreadedExecutor); default: '
@@ -63,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     signals = SignalShutdown()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     nodes = []
-    executor = (MultiThreadedExecutor(num_threads=4) if kind == 'multi'
+    executor = (MultiThreadedExecutor(num_threads=4) if kind == MULTI
                 else make_executor(kind))
     signals.attach_executor(executor)
     # As in its own process (tuner_node.main): a multi-threaded executor, so the service that
