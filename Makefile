@@ -42,7 +42,8 @@ test: setup  ## the whole suite, lint included
 # package.xml check); no ROS process is started and the paper's experiments (wirefish_analysis:
 # simulated sweeps of minutes) are left to `make test`, their lint is not.
 FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
-	src/wirefish_analysis/test/test_flake8.py src/wirefish_analysis/test/test_pep257.py \
+	src/wirefish_analysis/test/test_analysis_flake8.py \
+	src/wirefish_analysis/test/test_analysis_pep257.py \
 	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py \
 	test/test_host_closure.py test/test_package_size.py
 
