@@ -30,15 +30,16 @@ from typing import Any
 import numpy as np
 from wirefish_common.plotting import legend_beside
 from wirefish_common.progress import end_line, Progress
+from wirefish_cpg.gait_library import FitMode
 from wirefish_cpg.oscillator import CpgParameters, NetworkArrays, simulate
 from wirefish_kinematics.body_wave import swing_angles
 from wirefish_kinematics.wire_coupling import bend_angles
 from wirefish_tuner.pso import PsoOptions
 from wirefish_tuner.tuning import fit_gait, FitResult
-from wirefish_tuner.wave_loss import (desired_swing_angles, FIT_MODES, literal_waveform_loss,
+from wirefish_tuner.wave_loss import (desired_swing_angles, literal_waveform_loss,
                                       literal_waveform_swing_rmse_deg, PARAMETER_NAMES,
-                                      position_of, swarm_loss, swarm_swing_rmse_deg,
-                                      THETA_BAR_DEFINITIONS, WaveFitProblem)
+                                      position_of, swarm_loss, swarm_swing_rmse_deg, ThetaBar,
+                                      WaveFitProblem)
 
 PAPER_RMSE_DEG = (1.7165, 1.2817)
 PAPER_LOSS = 4.6067  # Fig 6(a), units and window unstated
@@ -103,16 +104,16 @@ def mode_summary(mode: str, fit: FitResult, problem: WaveFitProblem) -> dict:
     rmse_history = swarm_swing_rmse_deg(history, problem, mode)
     at_paper = np.flatnonzero(np.all(rmse_history <= PAPER_RMSE_DEG, axis=1))
     best = fit.pso.best_position[None]
-    readings = loss_readings(fit.loss if mode == 'literal'
+    readings = loss_readings(fit.loss if mode == FitMode.LITERAL
                              else fit.loss * problem.wave.frequency_hz
                              * (problem.window_end_s - problem.window_start_s), problem)
     return {
         'mode': mode, 'iterations': fit.iterations, 'wall_s': fit.elapsed_s,
         'loss': fit.loss,
-        'loss_unit': 'm*s over [t_s, t_o]' if mode == 'literal' else 'm*s per period',
+        'loss_unit': 'm*s over [t_s, t_o]' if mode == FitMode.LITERAL else 'm*s per period',
         'loss_readings': readings,
         'rmse_theta_deg': {d: swarm_swing_rmse_deg(best, problem, mode, d)[0].tolist()
-                           for d in THETA_BAR_DEFINITIONS},
+                           for d in ThetaBar},
         'iteration_at_paper_rmse': int(at_paper[0]) if at_paper.size else None,
         'params': dict(zip(PARAMETER_NAMES, fit.pso.best_position.tolist())),
         'frequency_hz': fit.params.frequency_hz,
@@ -129,8 +130,8 @@ def table1_summary(problem: WaveFitProblem) -> dict:
         p = replace(problem, reverse_wave=reverse)
         out[sign] = {mode: {'loss': float(swarm_loss(table1, p, mode)[0]),
                             'rmse_theta_deg': {d: swarm_swing_rmse_deg(table1, p, mode, d)[0]
-                                               .tolist() for d in THETA_BAR_DEFINITIONS}}
-                     for mode in FIT_MODES}
+                                               .tolist() for d in ThetaBar}}
+                     for mode in FitMode}
     return out
 
 
@@ -140,15 +141,16 @@ def run(out_dir: Path, seed: int = 0,
     """
     Fit the section 5.2 case in both modes, write the figures into ``out_dir``.
 
-    ``progress`` (``len(FIT_MODES) * (max_iterations + 1)`` steps) is told after every PSO
+    ``progress`` (``len(FitMode) * (max_iterations + 1)`` steps) is told after every PSO
     iteration of each fit.
     """
     problem = WaveFitProblem()
-    fits = {}
-    for index, mode in enumerate(FIT_MODES):
+    fits: dict[str, FitResult] = {}
+    for index, mode in enumerate(FitMode):
         first = index * (options.max_iterations + 1)
 
-        def step(iteration: int, loss: float, _best, first: int = first, mode: str = mode):
+        def step(iteration: int, loss: float, _best, first: int = first,
+                 mode: FitMode = mode):
             if progress is not None:
                 progress.step(first + iteration + 1, f'{mode} fit: loss {loss:.4g}')
 
@@ -163,7 +165,7 @@ def run(out_dir: Path, seed: int = 0,
         'modes': {mode: mode_summary(mode, fit, problem) for mode, fit in fits.items()},
         'table1': table1_summary(problem),
     }
-    table1_literal = summary['table1']['tailward (-omega t)']['literal']['loss']
+    table1_literal = summary['table1']['tailward (-omega t)'][FitMode.LITERAL]['loss']
     summary['table1_literal_loss_readings'] = loss_readings(table1_literal, problem)
     out_dir.mkdir(parents=True, exist_ok=True)
     _plot(out_dir, fits, problem, summary)
@@ -188,7 +190,7 @@ def _plot(out_dir: Path, fits: dict[str, FitResult], problem: WaveFitProblem,
     fig.savefig(out_dir / 'fig6a.png', dpi=110, bbox_inches='tight')
     plt.close(fig)
 
-    literal = fits['literal']
+    literal = fits[FitMode.LITERAL]
     labels = ['$\\omega_{12}$', '$\\omega_{21}$', '$\\varphi_{12}$ (rad)',
               '$\\varphi_{21}$ (rad)', '$R_1$ (rad)', '$R_2$ (rad)']
     converged = int(np.argmax(literal.pso.loss_history <= literal.loss))
@@ -223,7 +225,7 @@ def _plot(out_dir: Path, fits: dict[str, FitResult], problem: WaveFitProblem,
     servo = angles[np.searchsorted(t, times - 1e-9)]
     beta1, beta2 = bend_angles(servo[:, 0], servo[:, 1], problem.geometry)
     theta = np.degrees(np.stack(swing_angles(beta1, beta2, problem.geometry), axis=-1))
-    expected = np.degrees(desired_swing_angles(problem, 'axial', times))
+    expected = np.degrees(desired_swing_angles(problem, ThetaBar.AXIAL, times))
     fig, ax = plt.subplots(figsize=(8, 3.5))
     for i, color in enumerate(('C0', 'C1')):
         ax.plot(times, expected[:, i], '--', color=color,
@@ -251,11 +253,14 @@ def report(s: dict) -> str:
              f'{"":44s}{"literal (the paper)":>24s}{"phase_free (other problem)":>28s}']
 
     def row(label: str, key) -> None:
-        lines.append(f'{label:44s}{key(modes["literal"]):>24s}{key(modes["phase_free"]):>28s}')
+        lines.append(f'{label:44s}{key(modes[FitMode.LITERAL]):>24s}'
+                     f'{key(modes[FitMode.PHASE_FREE]):>28s}')
 
     row('iterations (wall s)', lambda m: f'{m["iterations"]} ({m["wall_s"]:.2f})')
-    row('RMSE th1/th2 deg, theta-bar axial', lambda m: _rmse(m['rmse_theta_deg']['axial']))
-    row('RMSE th1/th2 deg, theta-bar chord', lambda m: _rmse(m['rmse_theta_deg']['chord']))
+    row('RMSE th1/th2 deg, theta-bar axial',
+        lambda m: _rmse(m['rmse_theta_deg'][ThetaBar.AXIAL]))
+    row('RMSE th1/th2 deg, theta-bar chord',
+        lambda m: _rmse(m['rmse_theta_deg'][ThetaBar.CHORD]))
     row('paper RMSE first met at iteration',
         lambda m: str(m['iteration_at_paper_rmse']))
     row('loss (m*s), own definition', lambda m: f'{m["loss"]:.5g}')
@@ -267,9 +272,9 @@ def report(s: dict) -> str:
     row('  locked frequency measured (Hz)',
         lambda m: f'{m["integrated_check"]["measured_frequency_hz"]:.4f}')
     lines.append('  params literal:    ' + ', '.join(
-        f'{k} {v:+.3f}' for k, v in modes['literal']['params'].items()))
+        f'{k} {v:+.3f}' for k, v in modes[FitMode.LITERAL]['params'].items()))
     lines.append('  params phase_free: ' + ', '.join(
-        f'{k} {v:+.3f}' for k, v in modes['phase_free']['params'].items()))
+        f'{k} {v:+.3f}' for k, v in modes[FitMode.PHASE_FREE]['params'].items()))
     lines.append('')
     lines.append("Table 1 (the paper's parameters)            loss (m*s)   RMSE axial     "
                  'RMSE chord   (loss: literal over [t_s, t_o], phase_free per period)')
@@ -282,7 +287,7 @@ def report(s: dict) -> str:
     lines.append(f"the loss in the readings tried for the paper's {PAPER_LOSS} "
                  '(Table 1 literal | literal fit):')
     table1_readings = s['table1_literal_loss_readings']
-    fit_readings = modes['literal']['loss_readings']
+    fit_readings = modes[FitMode.LITERAL]['loss_readings']
     for name, value in table1_readings.items():
         lines.append(f'  {name:46s} {value:12.5g} ({value / PAPER_LOSS:7.3f} x) | '
                      f'{fit_readings[name]:10.5g}')
@@ -306,7 +311,7 @@ def main(argv: list[str] | None = None) -> int:
                         help='PSO iterations of each fit (at most)')
     args = parser.parse_args(argv)
     options = PsoOptions(swarm_size=args.swarm, max_iterations=args.iterations)
-    progress = Progress('reproduce_paper', len(FIT_MODES) * (options.max_iterations + 1))
+    progress = Progress('reproduce_paper', len(FitMode) * (options.max_iterations + 1))
     try:
         s = run(args.out, args.seed, options, progress)
     except KeyboardInterrupt:
@@ -315,7 +320,7 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     print(report(s))
     print(f'figures: {args.out}/fig6a.png fig6b.png fig7a.png fig7bc.png summary.json')
-    met = all(all(a <= b for a, b in zip(m['rmse_theta_deg']['axial'], PAPER_RMSE_DEG))
+    met = all(all(a <= b for a, b in zip(m['rmse_theta_deg'][ThetaBar.AXIAL], PAPER_RMSE_DEG))
               for m in s['modes'].values())
     return 0 if met else 1
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from wirefish_cpg.gait_library import Gait, GaitLibrary
+from wirefish_cpg.gait_library import FitMode, Gait, GaitLibrary
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import stable_phase_difference
 from wirefish_kinematics.wave_spec import WaveSpec
@@ -60,7 +60,7 @@ def scale_of(wave: WaveSpec, reference: WaveSpec) -> float | None:
 
 
 def family_members(library: GaitLibrary, reference: WaveSpec, geometry: dict[str, float],
-                   mode: str = 'phase_free') -> list[FamilyMember]:
+                   mode: str = FitMode.PHASE_FREE) -> list[FamilyMember]:
     """Return the library's gaits of the reference's family on ``geometry``, by (f, s)."""
     members = []
     for gait in library.for_geometry(geometry):

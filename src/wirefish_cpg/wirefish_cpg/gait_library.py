@@ -29,6 +29,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
+import enum
 import math
 import os
 from pathlib import Path
@@ -45,6 +46,19 @@ PARAMETER_FIELDS = ('frequency_hz', 'amplitude_1', 'amplitude_2', 'w12', 'w21', 
 LIBRARY_FILE = Path('wirefish') / 'gaits.yaml'
 WORKSPACE_LIBRARY = Path('out') / 'gaits.yaml'  # in a colcon workspace
 TEMPORARY_SUFFIX = '.tmp'
+
+
+class FitMode(enum.StrEnum):
+    """
+    The problem a gait was fitted to: RetuneGait's ``mode``, the library file's ``mode``.
+
+    ``wirefish_tuner.wave_loss`` defines both: PHASE_FREE (the default) scores the locked
+    output, the robot's phase free; LITERAL is the paper's own problem. Defined here, beside
+    the gaits that record it, because the fish reads the library without the tuner.
+    """
+
+    PHASE_FREE = 'phase_free'
+    LITERAL = 'literal'
 
 
 def default_library_path(environ: Mapping[str, str] | None = None,
@@ -98,10 +112,10 @@ class Gait:
     loss: float
     rmse_theta_deg: tuple[float, float]
     fitted_at: str = field(default_factory=lambda: datetime.now(timezone.utc).isoformat())
-    mode: str = 'phase_free'  # the fit mode (wave_loss.FIT_MODES)
+    mode: str = FitMode.PHASE_FREE  # the fit mode (FitMode)
 
     def matches(self, wave: WaveSpec, geometry: dict[str, float],
-                mode: str = 'phase_free') -> bool:
+                mode: str = FitMode.PHASE_FREE) -> bool:
         """Return whether this gait was fitted to exactly ``wave`` on ``geometry`` in ``mode``."""
         return (self.wave == wave and dict(self.geometry) == dict(geometry)
                 and self.mode == mode)
@@ -117,7 +131,7 @@ class Gait:
                 'params': {name: float(values[name]) for name in PARAMETER_FIELDS},
                 'loss': float(self.loss),
                 'rmse_theta_deg': [float(v) for v in self.rmse_theta_deg],
-                'fitted_at': self.fitted_at, 'mode': self.mode}
+                'fitted_at': self.fitted_at, 'mode': str(self.mode)}
 
     @classmethod
     def from_record(cls, record: dict) -> Gait:
@@ -134,7 +148,7 @@ class Gait:
             rmse = tuple(float(v) for v in record['rmse_theta_deg'])
             loss = float(record['loss'])
             fitted_at = str(record['fitted_at'])
-            mode = str(record.get('mode', 'phase_free'))
+            mode = str(record.get('mode', FitMode.PHASE_FREE))
         except (KeyError, TypeError, AttributeError) as error:
             raise ValueError(f'a gait record lacks or mistypes {error}') from error
         if len(rmse) != 2 or not math.isfinite(loss):
@@ -154,7 +168,7 @@ class GaitLibrary:
 
     gaits: tuple[Gait, ...] = ()
 
-    def find(self, wave: WaveSpec, geometry: dict[str, float], mode: str = 'phase_free'
+    def find(self, wave: WaveSpec, geometry: dict[str, float], mode: str = FitMode.PHASE_FREE
              ) -> Gait | None:
         """Return the gait fitted to ``wave`` on ``geometry`` in ``mode``, or None."""
         return next((g for g in self.gaits if g.matches(wave, geometry, mode)), None)

@@ -16,6 +16,7 @@ import time
 
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
 from wirefish_common.progress import estimate_text
+from wirefish_cpg.gait_library import FitMode
 from wirefish_operator.goal_sender import GoalSender
 
 BAR_WIDTH = 30
@@ -43,7 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--iterations', type=count, default=0,
                         help='PSO iterations (0: default)')
     parser.add_argument('--swarm', type=count, default=0, help='PSO particles (0: default)')
-    parser.add_argument('--mode', choices=('phase_free', 'literal'), default='phase_free',
+    parser.add_argument('--mode', choices=[mode.value for mode in FitMode],
+                        default=FitMode.PHASE_FREE.value,
                         help="fit mode: the locked output (default) or the paper's literal "
                              'problem')
     parser.add_argument('--no-library', action='store_true',

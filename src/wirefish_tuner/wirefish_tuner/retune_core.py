@@ -23,17 +23,16 @@ import math
 import time
 
 import numpy as np
-from wirefish_cpg.gait_library import Gait, GaitLibrary
+from wirefish_cpg.gait_library import FitMode, Gait, GaitLibrary
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.geometry_parameters import BODY_WAVE_GEOMETRY_FIELDS
 from wirefish_tuner.feasibility import fit_rejection, FitLimits, wave_infeasibility
 from wirefish_tuner.pso import PsoOptions
 from wirefish_tuner.tuning import fit_gait
-from wirefish_tuner.wave_loss import (FIT_MODES, PAPER_UPPER, swarm_swing_rmse_deg,
-                                      WaveFitProblem, WaveSpec)
+from wirefish_tuner.wave_loss import (PAPER_UPPER, swarm_swing_rmse_deg, WaveFitProblem,
+                                      WaveSpec)
 
-DEFAULT_MODE = 'phase_free'
 MAX_SWARM_SIZE = 2000
 MAX_ITERATIONS = 5000
 # (iteration, best loss (m*s), swing-angle RMSE (2,) deg of the best so far); may raise
@@ -57,11 +56,11 @@ class RetuneOrder:
     max_iterations: int = 0
     swarm_size: int = 0
     use_library: bool = True
-    mode: str = ''  # '' = 'phase_free'; FIT_MODES of wave_loss
+    mode: str = ''  # a FitMode's value; '' = phase_free
 
     def fit_mode(self) -> str:
-        """Return the fit mode the order asks for ('phase_free' when not given)."""
-        return self.mode or DEFAULT_MODE
+        """Return the fit mode the order asks for (FitMode.PHASE_FREE when not given)."""
+        return self.mode or FitMode.PHASE_FREE
 
     def wave_values(self) -> dict[str, float]:
         """Return the wave's four numbers by their message field names."""
@@ -143,8 +142,8 @@ def order_problem(order: RetuneOrder) -> str | None:
     if order.swarm_size != 0 and not 2 <= order.swarm_size <= MAX_SWARM_SIZE:
         return (f'swarm_size must be 0 (default) or in [2, {MAX_SWARM_SIZE}], '
                 f'got {order.swarm_size}')
-    if order.mode and order.mode not in FIT_MODES:
-        return f'mode must be empty or one of {", ".join(FIT_MODES)}, got {order.mode!r}'
+    if order.mode and order.mode not in tuple(FitMode):
+        return f'mode must be empty or one of {", ".join(FitMode)}, got {order.mode!r}'
     if order.max_iterations != 0 and not 1 <= order.max_iterations <= MAX_ITERATIONS:
         return (f'max_iterations must be 0 (default) or in [1, {MAX_ITERATIONS}], '
                 f'got {order.max_iterations}')

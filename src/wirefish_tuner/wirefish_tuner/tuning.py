@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import time
 
 import numpy as np
+from wirefish_cpg.gait_library import FitMode
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_tuner.pso import minimise, ProgressCallback, PsoOptions, PsoResult
 from wirefish_tuner.wave_loss import (check_mode, PAPER_LOWER, PAPER_UPPER, parameters_at,
@@ -32,14 +33,14 @@ class FitResult:
 def fit_gait(problem: WaveFitProblem, rng: np.random.Generator,
              options: PsoOptions = PsoOptions(), lower: np.ndarray = PAPER_LOWER,
              upper: np.ndarray = PAPER_UPPER, alpha: float = 20.0,
-             callback: ProgressCallback | None = None, mode: str = 'phase_free'
+             callback: ProgressCallback | None = None, mode: str = FitMode.PHASE_FREE
              ) -> FitResult:
     """
     Return the CPG parameters whose output best follows ``problem``'s wave.
 
     Searches (w12, w21, phi12, phi21, R1, R2) in [lower, upper] (6,) (default: the paper's
-    bounds) with alpha fixed and offsets 0, as in paper section 4.1. ``mode`` (``FIT_MODES``
-    of wave_loss): 'phase_free' scores the locked output with v chosen to lock at the wave's
+    bounds) with alpha fixed and offsets 0, as in paper section 4.1. ``mode`` (a
+    ``FitMode``): 'phase_free' scores the locked output with v chosen to lock at the wave's
     frequency; 'literal' is the paper's problem (v = the wave's frequency, eq 1 from rest,
     eq 24 over [t_s, t_o]). Raises ``ValueError`` for an unknown mode.
     """

@@ -20,7 +20,7 @@ The window is ``window_periods`` whole periods of the desired wave (default 1), 
 ``samples_per_period`` instants; the rectangle rule is the natural quadrature of a periodic
 integrand. The loss is in m*s.
 
-Two fit modes (``FIT_MODES``). ``'phase_free'`` (the default, above) is the engineering problem:
+Two fit modes (``FitMode``). ``'phase_free'`` (the default, above) is the engineering problem:
 the robot's phase is arbitrary and v is whatever locks the network to the wave. ``'literal'`` is
 the paper's own problem (sections 4.1 and 5.2): v = omega / 2 pi (the wave's frequency), eq 1
 started from rest with alpha = 20 (``from_rest``, exact), the same clock t in y_body and in the
@@ -34,10 +34,12 @@ show a 0.01 Hz frequency error as 0.3 rad of drift.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+import enum
 import math
 
 import numpy as np
 from wirefish_cpg.from_rest import outputs_from_rest
+from wirefish_cpg.gait_library import FitMode
 from wirefish_cpg.oscillator import CpgParameters
 from wirefish_cpg.steady_state import intrinsic_frequency_for, stable_phase_difference
 from wirefish_kinematics.body_wave import body_positions, swing_angles
@@ -55,11 +57,18 @@ PAPER_UPPER = -PAPER_LOWER
 # Loss added (m*s) when the locked frequency cannot be reached with an admissible v: far above
 # any real fit (a perfect miss of the section 5.2 wave costs about 0.08 m*s per period).
 FREQUENCY_PENALTY = 10.0
-FIT_MODES = ('phase_free', 'literal')
-# Expected swing angle theta-bar_i of section 5.2 (unstated in the paper): 'axial' puts the wave
-# point at x = q_i (atan2(y_body, q_i), the project's); 'chord' at distance q_i from O0
-# (x = sqrt(q_i^2 - y_body^2), i.e. asin(y_body / q_i)).
-THETA_BAR_DEFINITIONS = ('axial', 'chord')
+
+
+class ThetaBar(enum.StrEnum):
+    """
+    Where the expected swing angle theta-bar_i of section 5.2 puts the wave (unstated there).
+
+    AXIAL: at x = q_i (atan2(y_body, q_i), the project's); CHORD: at distance q_i from O0
+    (x = sqrt(q_i^2 - y_body^2), i.e. asin(y_body / q_i)).
+    """
+
+    AXIAL = 'axial'
+    CHORD = 'chord'
 
 
 @dataclass(frozen=True)
@@ -195,35 +204,36 @@ def admissible_frequency(intrinsic_hz: np.ndarray, problem: WaveFitProblem) -> n
     return (intrinsic_hz > 0.0) & (intrinsic_hz <= problem.max_frequency_hz)
 
 
-def desired_swing_angles(problem: WaveFitProblem, theta_bar: str = 'axial',
+def desired_swing_angles(problem: WaveFitProblem, theta_bar: str = ThetaBar.AXIAL,
                          times: np.ndarray | None = None) -> np.ndarray:
     """
     Return the expected swing angles theta-bar_i (N, 2) rad of section 5.2, from eq 23.
 
     'axial': theta-bar_i = atan2(y_body(q_i, t), q_i) (``wirefish_kinematics.desired_wave``);
-    'chord': asin(y_body / q_i) (``THETA_BAR_DEFINITIONS``). Default times: ``times()``.
+    'chord': asin(y_body / q_i) (``ThetaBar``). Default times: ``times()``.
     """
     w = problem.wave
     times = problem.times() if times is None else times
-    if theta_bar == 'axial':
+    if theta_bar == ThetaBar.AXIAL:
         return np.stack(wave_swing_angles(times, w.c1, w.c2, w.k, w.frequency_hz,
                                           problem.geometry, time_sign=problem.time_sign()),
                         axis=-1)
-    if theta_bar == 'chord':
+    if theta_bar == ThetaBar.CHORD:
         ratio = problem.desired(times) / problem.stations()[None, :]
         return np.arcsin(np.clip(ratio, -1.0, 1.0))
-    raise ValueError(f'theta_bar must be one of {THETA_BAR_DEFINITIONS}, got {theta_bar!r}')
+    raise ValueError(f'theta_bar must be one of {tuple(d.value for d in ThetaBar)}, '
+                     f'got {theta_bar!r}')
 
 
 def swing_angle_rmse_deg(positions: np.ndarray, problem: WaveFitProblem,
-                         theta_bar: str = 'axial') -> np.ndarray:
+                         theta_bar: str = ThetaBar.AXIAL) -> np.ndarray:
     """Return the RMSE of theta_1, theta_2 against theta-bar over one period, (P, 2) degrees."""
     return waveform_swing_rmse_deg(swarm_waveforms(positions, problem).angles, problem,
                                    theta_bar)
 
 
 def waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem,
-                            theta_bar: str = 'axial') -> np.ndarray:
+                            theta_bar: str = ThetaBar.AXIAL) -> np.ndarray:
     """Return the swing-angle RMSE (P, 2) degrees of servo angles (P, N, 2) (section 5.2)."""
     error = _swing_angles_of(angles, problem) - desired_swing_angles(problem, theta_bar)[None]
     return np.degrees(np.sqrt(np.mean(error ** 2, axis=-2)))
@@ -267,14 +277,14 @@ def literal_body_wave_loss(positions: np.ndarray, problem: WaveFitProblem,
 
 
 def literal_swing_rmse_deg(positions: np.ndarray, problem: WaveFitProblem,
-                           theta_bar: str = 'axial', alpha: float = 20.0) -> np.ndarray:
+                           theta_bar: str = ThetaBar.AXIAL, alpha: float = 20.0) -> np.ndarray:
     """Return the theta_1, theta_2 RMSE (P, 2) degrees over [t_s, t_o] in the literal mode."""
     return literal_waveform_swing_rmse_deg(literal_waveforms(positions, problem, alpha),
                                            problem, theta_bar)
 
 
 def literal_waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem,
-                                    theta_bar: str = 'axial') -> np.ndarray:
+                                    theta_bar: str = ThetaBar.AXIAL) -> np.ndarray:
     """Return the swing RMSE (P, 2) degrees of servo angles (P, N, 2) on ``window_times()``."""
     times = problem.window_times()
     expected = desired_swing_angles(problem, theta_bar, times)
@@ -289,26 +299,28 @@ def _trapezoid(values: np.ndarray, times: np.ndarray) -> np.ndarray:
     return np.sum(0.5 * (values[..., 1:] + values[..., :-1]) * step, axis=-1)
 
 
-def check_mode(mode: str) -> str:
-    """Return ``mode`` if it is one of ``FIT_MODES``; else raise ``ValueError``."""
-    if mode not in FIT_MODES:
-        raise ValueError(f'mode must be one of {FIT_MODES}, got {mode!r}')
-    return mode
+def check_mode(mode: str) -> FitMode:
+    """Return ``mode`` as a ``FitMode``; raise ``ValueError`` if it is none."""
+    try:
+        return FitMode(mode)
+    except ValueError:
+        raise ValueError(f'mode must be one of {tuple(m.value for m in FitMode)}, '
+                         f'got {mode!r}') from None
 
 
-def swarm_loss(positions: np.ndarray, problem: WaveFitProblem, mode: str = 'phase_free',
+def swarm_loss(positions: np.ndarray, problem: WaveFitProblem, mode: str = FitMode.PHASE_FREE,
                alpha: float = 20.0) -> np.ndarray:
-    """Return the loss (P,) m*s of every particle (P, 6) in fit ``mode`` (``FIT_MODES``)."""
-    if check_mode(mode) == 'literal':
+    """Return the loss (P,) m*s of every particle (P, 6) in fit ``mode`` (``FitMode``)."""
+    if check_mode(mode) == FitMode.LITERAL:
         return literal_body_wave_loss(positions, problem, alpha)
     return body_wave_loss(positions, problem)
 
 
 def swarm_swing_rmse_deg(positions: np.ndarray, problem: WaveFitProblem,
-                         mode: str = 'phase_free', theta_bar: str = 'axial',
+                         mode: str = FitMode.PHASE_FREE, theta_bar: str = ThetaBar.AXIAL,
                          alpha: float = 20.0) -> np.ndarray:
     """Return the swing-angle RMSE (P, 2) degrees of every particle in fit ``mode``."""
-    if check_mode(mode) == 'literal':
+    if check_mode(mode) == FitMode.LITERAL:
         return literal_swing_rmse_deg(positions, problem, theta_bar, alpha)
     return swing_angle_rmse_deg(positions, problem, theta_bar)
 
@@ -319,14 +331,14 @@ def position_of(params: CpgParameters) -> np.ndarray:
 
 
 def parameters_at(position: np.ndarray, problem: WaveFitProblem, alpha: float = 20.0,
-                  offset: tuple[float, float] = (0.0, 0.0), mode: str = 'phase_free'
-                  ) -> CpgParameters:
+                  offset: tuple[float, float] = (0.0, 0.0),
+                  mode: str = FitMode.PHASE_FREE) -> CpgParameters:
     """
     Return the CPG parameters of a position in fit ``mode``.
 
     'phase_free': v chosen to lock to the wave's frequency; 'literal': v = the wave's frequency.
     """
-    if check_mode(mode) == 'literal':
+    if check_mode(mode) == FitMode.LITERAL:
         frequency = problem.wave.frequency_hz
     else:
         frequency = float(swarm_waveforms(np.asarray(position)[None, :],
