@@ -10,19 +10,14 @@ import numpy as np
 import pytest
 from rclpy.action import ActionClient
 from ros_utils import spin_until
-from wirefish_common.qos import reliable
+from wirefish_common.qos import latched, reliable
 from wirefish_cpg.gait_library import Gait, GaitLibrary, load_library, save_library
 from wirefish_msgs.action import RetuneGait as RetuneGaitAction
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
-from wirefish_operator.goal_sender import GoalSender
+from wirefish_operator.goal_sender import FEEDBACK_DEPTH, GoalSender
 
-# Any test of this module has been seen, once, to lose the first goal's answer after the tuner
-# starts (rmw_fastrtps: the response sent before the client's reader is matched), and to pass
-# when run again. GoalRun now adopts such a goal as `wirefish retune` does (goal_sender); the
-# one rerun each stays until full runs show the losses gone (other requests of these tests,
-# get_result and parameter calls, can meet the same race).
-pytestmark = [pytest.mark.ros, pytest.mark.flaky(reruns=1)]
+pytestmark = pytest.mark.ros
 CPG_NAMES = ['frequency_hz', 'amplitude_1', 'amplitude_2', 'w12', 'w21', 'phi12', 'phi21',
              'alpha']
 
@@ -93,6 +88,26 @@ def test_feedback_every_iteration_and_the_result_equal_the_service_for_the_same_
     assert (response.params, response.loss, response.iterations) == (
         result.params, result.loss, result.iterations)
     np.testing.assert_array_equal(response.rmse_theta_deg, result.rmse_theta_deg)
+
+
+def test_a_feedback_reader_that_joins_after_the_fit_still_gets_every_iteration(
+        tuner, probe, action):
+    # GoalSender's reader is made just before its goal: the tuner's writer may match it only
+    # after a short fit has published its feedback. Here it joins after the result, for sure.
+    tuner()
+    run = GoalRun(probe, action, goal(seed=5, max_iterations=5, swarm_size=20,
+                                      use_library=False))
+    answer = run.result()
+    assert answer.status == GoalStatus.STATUS_SUCCEEDED, answer.result.message
+    goal_id = bytes(run.handle.goal_id.uuid)
+    heard = []
+    probe.node.create_subscription(
+        RetuneGaitAction.Impl.FeedbackMessage, 'retune_gait/_action/feedback',
+        lambda m: heard.append(m.feedback.iteration) if bytes(m.goal_id.uuid) == goal_id
+        else None, latched(FEEDBACK_DEPTH))
+    iterations = list(range(answer.result.iterations + 1))
+    spin_until(probe.executor, lambda: heard == iterations, WAIT_S)
+    assert heard == iterations
 
 
 def test_cancel_stops_the_fit_within_one_iteration_and_leaves_the_cpg_untouched(

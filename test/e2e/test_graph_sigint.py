@@ -11,10 +11,6 @@ import pytest
 pytestmark = pytest.mark.ros
 
 
-# Seen once in a full run with two xdist workers: bridge_node still ran 6 s after the SIGINT
-# and was killed (its log ends at "fish says hello"); 3 runs alone passed. An open defect: one
-# rerun keeps CI from failing on it meanwhile, and a bridge that never stops fails both runs.
-@pytest.mark.flaky(reruns=1)
 def test_sigint_stops_every_process_cleanly_and_leaves_none(e2e_domain_id, tmp_path):
     graph = start_graph(e2e_domain_id, tmp_path, namespace='/e2e_sigint_running')
     children = descendants(graph.launcher.pid)

@@ -10,6 +10,7 @@ The QoS profiles of every wirefish topic and service client, defined once.
   (cpg_command): reliable, volatile, keep last 1, so a late sample is superseded by the next.
 - ``LATCHED``: state a node announces once and a late joiner still needs (cpg_params,
   cpg_status, target_wave): reliable, transient local, depth 1 (the last value).
+  ``latched(depth)`` keeps the last ``depth`` for a late joiner (the tuner's feedback).
 """
 
 from __future__ import annotations
@@ -24,7 +25,12 @@ def reliable(depth: int) -> QoSProfile:
     return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
 
 
+def latched(depth: int) -> QoSProfile:
+    """Return a reliable, transient-local profile keeping ``depth`` samples."""
+    return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
 RELIABLE = reliable(10)
 COMMAND = reliable(1)
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+LATCHED = latched(1)

@@ -15,7 +15,12 @@ resend's answer finds the reader matched by then).
 The sender takes the goal's feedback from the action's feedback topic itself: rclpy forgets a
 goal's feedback callback when its result arrives, and the last feedback (another topic) can
 arrive after the result on a loaded machine (`wirefish retune` lost iterations 3-20 of 20
-once). Keep the sender until the feedback is no longer wanted, then ``destroy()`` it.
+once). Keep the sender until the feedback is no longer wanted, then ``destroy()`` it. Its
+feedback reader is new when the goal goes out, and the server's writer can match it only after
+the first feedback was published: the reader asks for transient local, and the tuner's writer
+offers it (its last 1000), so what was published before the match still arrives. A server
+whose feedback is volatile never matches this reader (incompatible QoS): its goals are still
+adopted from the status, but their feedback is not heard.
 
 ``goal_outcome`` is the decision, pure: what the answers and the active ids say.
 """
@@ -38,6 +43,9 @@ if TYPE_CHECKING:
 
 ANSWER_WAIT_S = 3.0
 MAX_SENDS = 3
+# Every iteration's feedback kept (rclpy's default depth of 10 drops a fast fit's), also what
+# the server published before it matched this reader: wirefish_common.qos.latched(this).
+FEEDBACK_DEPTH = 1000
 
 
 class GoalOutcome(enum.Enum):
@@ -104,7 +112,7 @@ class GoalSender:
         """Subscribe to the action's status (latched: the array comes at once) and feedback."""
         from action_msgs.msg import GoalStatus, GoalStatusArray
         from rclpy.qos import qos_profile_action_status_default
-        from wirefish_common.qos import reliable
+        from wirefish_common.qos import latched
 
         running = (GoalStatus.STATUS_ACCEPTED, GoalStatus.STATUS_EXECUTING,
                    GoalStatus.STATUS_CANCELING, GoalStatus.STATUS_SUCCEEDED,
@@ -126,7 +134,7 @@ class GoalSender:
         # Every iteration's feedback kept (rclpy's default depth of 10 drops a fast fit's).
         self._feedback: Subscription = self.node.create_subscription(
             self.action_type.Impl.FeedbackMessage, f'{self.action_name}/_action/feedback',
-            on_feedback, reliable(1000))
+            on_feedback, latched(FEEDBACK_DEPTH))
 
     def send(self, goal: object, feedback_callback: Callable[[object], None],
              deadline: float) -> ClientGoalHandle | None:

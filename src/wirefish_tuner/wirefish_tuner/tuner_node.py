@@ -44,7 +44,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import LATCHED, reliable
+from wirefish_common.qos import LATCHED, latched, reliable
 from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.gait_library import Gait, GaitLibrary, LibraryFile
 from wirefish_cpg.oscillator import CpgParameters
@@ -65,7 +65,12 @@ from wirefish_tuner.tuner_node_parameters import SPECS, TUNER_PARAMETERS
 SERVICE_QOS = reliable(depth=1000)
 # Feedback of every iteration (hundreds per second) must not overwrite itself in the writer's
 # history before a client takes it; a client keeps what its own depth allows (rclpy: 10).
-FEEDBACK_QOS = reliable(depth=1000)
+# Transient local: a client's feedback reader made just before its goal (wirefish retune's
+# GoalSender) may be matched by this writer only after the first iterations, or the whole of a
+# short fit, were published; a volatile writer never sends those (seen: a 5-iteration goal
+# succeeded and its new reader heard none of its 6 feedbacks). A reader asking for transient
+# local gets the last 1000 when it matches; a volatile one (rclpy's ActionClient) as before.
+FEEDBACK_QOS = latched(depth=1000)
 BUSY = 'busy: a retune is already running; retry when it finishes'
 CANCELED = 'canceled: nothing applied'
 
