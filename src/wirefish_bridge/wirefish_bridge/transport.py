@@ -54,8 +54,8 @@ class PeerNotIdentified(LinkError):
     """The port is open but the device has not identified itself yet: nothing is written."""
 
 
-class LinkState(enum.Enum):
-    """State of the link, as reported to ``on_state``."""
+class LinkState(enum.StrEnum):
+    """State of the link, as reported to ``on_state`` (and /diagnostics' ``link_state``)."""
 
     CONNECTING = 'connecting'
     IDENTIFYING = 'identifying'   # open, waiting for the peer to identify itself

@@ -27,7 +27,7 @@ from wirefish_cpg.cpg_node_parameters import parameters_from
 from wirefish_cpg.oscillator import CpgParameters
 
 
-class TargetSource(enum.Enum):
+class TargetSource(enum.StrEnum):
     """Which input sets the targets (the values of wirefish_msgs/CpgStatus.source)."""
 
     COMMAND = 'command'

@@ -29,7 +29,7 @@ from wirefish_kinematics.body_wave import body_positions, tangent_angles
 from wirefish_kinematics.geometry import FishGeometry
 
 
-class Frame(str, enum.Enum):
+class Frame(enum.StrEnum):
     """The frame ids of one fish (before its ``frame_prefix``)."""
 
     ODOM = 'odom'
@@ -41,7 +41,7 @@ class Frame(str, enum.Enum):
     FIN = 'caudal_fin'
 
 
-class OdomSource(str, enum.Enum):
+class OdomSource(enum.StrEnum):
     """Where ``odom`` -> ``base_link`` comes from (the ``odom_source`` parameter)."""
 
     AUTO = 'auto'  # ground truth once sim/ground_truth is heard, dead reckoning until then
