@@ -90,8 +90,9 @@ def _runs_the_planners_gait(heard) -> bool:
 @pytest.mark.ros
 def test_the_planner_drives_the_cpg_by_topic(graph):
     _, _, _, executor, heard, publisher = graph
-    assert spin_until(executor, _drive(publisher, heard, lambda: _runs_the_planners_gait(heard)),
-                      WAIT_S)
+    # cpg_params and the latched cpg_status are two topics: the gait can be heard first.
+    assert spin_until(executor, _drive(publisher, heard, lambda: _runs_the_planners_gait(heard)
+                                       and bool(heard.statuses)), WAIT_S)
     assert heard.statuses[-1].source == 'command' and heard.statuses[-1].refused == ''
 
 
