@@ -34,10 +34,19 @@ case ":$PATH:" in
   *":$_wf_root/install/wirefish_cli/lib/wirefish_cli:"*) ;;
   *) export PATH="$_wf_root/install/wirefish_cli/lib/wirefish_cli:$PATH" ;;
 esac
+_wf_config="$_wf_root/install/wirefish_bringup/share/wirefish_bringup/config"
+# LOCALHOST brings rmw_fastrtps' shared memory back whatever the transports say: one host is
+# served by the loopback profile instead (UDPv4 on 127.0.0.1 only) under the range rmw leaves
+# alone (wirefish_bringup.dds_profile). A profile already set is kept, and LOCALHOST with it.
+if [ -z "${FASTRTPS_DEFAULT_PROFILES_FILE+x}" ] && [ "${ROS_AUTOMATIC_DISCOVERY_RANGE-}" = LOCALHOST ] \
+    && [ -z "${ROS_STATIC_PEERS-}" ]; then
+  export FASTRTPS_DEFAULT_PROFILES_FILE="$_wf_config/fastdds_loopback.xml"
+  export ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT
+fi
 # The Fast DDS profile of the graph (reply writers wait for a new client's reader; see
 # config/fastdds.xml); a value already set, even empty (no profile), is kept.
-export FASTRTPS_DEFAULT_PROFILES_FILE="${FASTRTPS_DEFAULT_PROFILES_FILE-$_wf_root/install/wirefish_bringup/share/wirefish_bringup/config/fastdds.xml}"
+export FASTRTPS_DEFAULT_PROFILES_FILE="${FASTRTPS_DEFAULT_PROFILES_FILE-$_wf_config/fastdds.xml}"
 # No shared-memory transport: a SIGKILLed subscriber would stall its publishers for up to 1 s
 # (wirefish_bringup.dds_profile); a value already set is kept.
 export FASTDDS_BUILTIN_TRANSPORTS="${FASTDDS_BUILTIN_TRANSPORTS-UDPv4}"
-unset _wf_root _wf_venv _wf_nounset
+unset _wf_root _wf_venv _wf_nounset _wf_config

@@ -7,7 +7,7 @@ import pytest
 from wirefish_bringup.dds_profile import (graph_environment, INSTALLED_NAMESPACES,
                                           profile_path, PROFILES_VARIABLE, render_profile,
                                           reply_writer_names, TRANSPORTS_VARIABLE,
-                                          write_profile)
+                                          with_profile, write_profile)
 
 INSTALLED = Path(__file__).resolve().parents[1] / 'config' / 'fastdds.xml'
 NS = '{http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles}'
@@ -20,6 +20,27 @@ def _writer_names(xml_text: str) -> list[str]:
 
 def test_the_installed_profile_is_the_rendered_one_of_its_namespaces():
     assert INSTALLED.read_text() == render_profile(INSTALLED_NAMESPACES)
+
+
+def test_the_installed_loopback_profile_is_the_rendered_one_of_its_namespaces():
+    loopback = INSTALLED.with_name('fastdds_loopback.xml')
+    assert loopback.read_text() == render_profile(INSTALLED_NAMESPACES, loopback=True)
+
+
+def test_localhost_is_loopback_udp_under_the_range_rmw_leaves_alone():
+    env = with_profile({'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'})
+    assert env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'SYSTEM_DEFAULT'
+    assert env[PROFILES_VARIABLE].endswith('fastdds_loopback.xml')
+    root = ElementTree.fromstring(Path(env[PROFILES_VARIABLE]).read_text())
+    addresses = [e.text for e in root.iter() if e.tag.endswith('address')]
+    assert addresses == ['127.0.0.1']
+
+
+def test_localhost_with_static_peers_keeps_its_range():
+    env = with_profile({'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST',
+                        'ROS_STATIC_PEERS': '10.0.0.2'})
+    assert env['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST'
+    assert env[PROFILES_VARIABLE].endswith('fastdds.xml')
 
 
 @pytest.mark.parametrize('namespace, reply', [

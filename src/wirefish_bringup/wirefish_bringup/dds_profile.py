@@ -30,6 +30,17 @@ long starves the bridge past its 500 ms command timeout and the fish goes neutra
 flight to the recorder were lost with it. Loopback UDP costs a copy per reader, which the
 graph's small messages afford. A value the user already set, for either variable (even empty),
 is kept.
+
+``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` brings shared memory back whatever
+``FASTDDS_BUILTIN_TRANSPORTS`` or a participant profile says: each process of a graph started
+with it mapped 8 of Fast DDS's shared-memory segments (a private /dev/shm, 10 listeners and a
+talker), and one Ctrl-C of such a graph took over 3 s in 8 of 50 rounds, a node's stop waiting
+on a dying peer's shared-memory port (tools/sigint_soak.py). So the workspace honours LOCALHOST
+(without ROS_STATIC_PEERS) as loopback-only UDPv4: a default participant whose UDPv4 transport
+sends and listens on 127.0.0.1 only, and rmw's SYSTEM_DEFAULT range so that rmw leaves it alone
+(config/fastdds_loopback.xml, or a graph's own profile). Nothing leaves the host, as with
+LOCALHOST, and no segment is mapped. A participant that kept LOCALHOST (a `ros2` CLI call, a
+test's own node) still discovers and talks to such a graph, over UDP.
 """
 
 from __future__ import annotations
@@ -41,6 +52,12 @@ from ament_index_python.packages import get_package_share_directory
 
 PROFILES_VARIABLE = 'FASTRTPS_DEFAULT_PROFILES_FILE'
 PROFILE_FILE_NAME = 'fastdds.xml'
+LOOPBACK_PROFILE_FILE_NAME = 'fastdds_loopback.xml'
+RANGE_VARIABLE = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+STATIC_PEERS_VARIABLE = 'ROS_STATIC_PEERS'
+LOCALHOST = 'LOCALHOST'
+SYSTEM_DEFAULT = 'SYSTEM_DEFAULT'
+LOOPBACK_ADDRESS = '127.0.0.1'
 TRANSPORTS_VARIABLE = 'FASTDDS_BUILTIN_TRANSPORTS'
 TRANSPORTS = 'UDPv4'
 INSTALLED_NAMESPACES = ('/wirefish', '/')
@@ -73,7 +90,8 @@ _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
   multi-threaded executor) and the CPG (its oscillator runs on its own loop thread). Not the
   bridge: its executor ticks the servo commands, and the fish goes neutral after 500 ms without.
 
-{radio}  rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
+{radio}{loopback}\
+  rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
   Loaded through FASTRTPS_DEFAULT_PROFILES_FILE (wirefish up, the launch file,
   tools/activate.sh).
 -->
@@ -89,34 +107,55 @@ _RADIO = """  Over a radio (role fish or shore) the default participant: UDPv4 o
   fish's and the shore's participants announcing to each other saturated a 100 kbit/s radio).
 
 """
+_LOOPBACK = """\
+  On one host with ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST: the default participant sends and
+  listens on {address} only, over UDPv4 (rmw's LOCALHOST would bring shared memory back); the
+  processes run with ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT so that rmw keeps it.
+
+"""
 _TRANSPORTS = """    <transport_descriptors>
       <transport_descriptor>
         <transport_id>wirefish_udp</transport_id>
         <type>UDPv4</type>
-      </transport_descriptor>
+{whitelist}      </transport_descriptor>
     </transport_descriptors>
 """
 _PARTICIPANT = """    <participant profile_name="wirefish_participant" is_default_profile="true">
       <rtps>
         <userTransports><transport_id>wirefish_udp</transport_id></userTransports>
         <useBuiltinTransports>false</useBuiltinTransports>
-        <builtin>
+{builtin}      </rtps>
+    </participant>
+"""
+_WHITELIST = """        <interfaceWhiteList><address>{address}</address></interfaceWhiteList>
+"""
+_ANNOUNCEMENTS = """        <builtin>
           <discovery_config>
             <leaseDuration><sec>{lease}</sec></leaseDuration>
             <leaseAnnouncement><sec>{announce}</sec></leaseAnnouncement>
           </discovery_config>
         </builtin>
-      </rtps>
-    </participant>
 """
 _FOOTER = """  </profiles>
 </dds>
 """
 
 
-def profile_path() -> Path:
-    """Return the installed profile file."""
-    return Path(get_package_share_directory('wirefish_bringup'), 'config', PROFILE_FILE_NAME)
+def profile_path(loopback: bool = False) -> Path:
+    """Return the installed profile file (the loopback one for LOCALHOST)."""
+    return Path(get_package_share_directory('wirefish_bringup'), 'config',
+                LOOPBACK_PROFILE_FILE_NAME if loopback else PROFILE_FILE_NAME)
+
+
+def on_loopback(env: Mapping[str, str]) -> bool:
+    """
+    Return whether ``env`` asks for one host only.
+
+    LOCALHOST without static peers, or the installed loopback profile (tools/activate.sh
+    names it for LOCALHOST).
+    """
+    return ((env.get(RANGE_VARIABLE) == LOCALHOST and not env.get(STATIC_PEERS_VARIABLE))
+            or env.get(PROFILES_VARIABLE) == str(profile_path(loopback=True)))
 
 
 def reply_writer_names(namespace: str) -> list[str]:
@@ -128,24 +167,50 @@ def reply_writer_names(namespace: str) -> list[str]:
     return [f'rr{prefix}/{service}Reply' for service in services]
 
 
-def render_profile(namespaces: Iterable[str], radio: bool = False) -> str:
-    """Return the profile XML: reply writers of ``namespaces`` (and the radio's participant)."""
+def render_profile(namespaces: Iterable[str], radio: bool = False,
+                   loopback: bool = False) -> str:
+    """
+    Return the profile XML: reply writers of ``namespaces``, and a participant if needed.
+
+    ``radio``: one side of a radio link (slow announcements); ``loopback``: one host over
+    loopback UDPv4 (``on_loopback``). Either names the participant's UDPv4 transport itself.
+    """
     chosen = list(dict.fromkeys(namespaces))
     writers = ''.join(_WRITER.format(name=name, wait=REPLY_WAIT_S)
                       for namespace in chosen for name in reply_writer_names(namespace))
-    participant = (_TRANSPORTS + _PARTICIPANT.format(lease=LEASE_S, announce=ANNOUNCE_S)
+    participant = ''
+    if radio or loopback:
+        whitelist = _WHITELIST.format(address=LOOPBACK_ADDRESS) if loopback else ''
+        builtin = (_ANNOUNCEMENTS.format(lease=LEASE_S, announce=ANNOUNCE_S)
                    if radio else '')
-    header = _HEADER.format(namespaces=', '.join(chosen), wait=REPLY_WAIT_S,
-                            radio=_RADIO.format(lease=LEASE_S, announce=ANNOUNCE_S)
-                            if radio else '')
+        participant = (_TRANSPORTS.format(whitelist=whitelist)
+                       + _PARTICIPANT.format(builtin=builtin))
+    header = _HEADER.format(
+        namespaces=', '.join(chosen), wait=REPLY_WAIT_S,
+        radio=_RADIO.format(lease=LEASE_S, announce=ANNOUNCE_S) if radio else '',
+        loopback=_LOOPBACK.format(address=LOOPBACK_ADDRESS) if loopback else '')
     return header + participant + writers + _FOOTER
 
 
+def _installed(path: str | None) -> bool:
+    return path in (str(profile_path()), str(profile_path(loopback=True)))
+
+
 def with_profile(env: Mapping[str, str]) -> dict[str, str]:
-    """Return ``env`` with the installed profile and transports, unless it sets them already."""
+    """
+    Return ``env`` with the installed profile and transports, unless it sets them already.
+
+    LOCALHOST (``on_loopback``) with no profile of the user's: the loopback profile and the
+    SYSTEM_DEFAULT range that keeps it.
+    """
     result = dict(env)
-    result.setdefault(PROFILES_VARIABLE, str(profile_path()))
     result.setdefault(TRANSPORTS_VARIABLE, TRANSPORTS)
+    chosen = result.setdefault(PROFILES_VARIABLE, str(profile_path()))
+    if _installed(chosen):
+        loopback = on_loopback(env)
+        result[PROFILES_VARIABLE] = str(profile_path(loopback))
+        if loopback:
+            result[RANGE_VARIABLE] = SYSTEM_DEFAULT
     return result
 
 
@@ -161,12 +226,16 @@ def graph_environment(env: Mapping[str, str], namespaces: Iterable[str], run_dir
     """
     chosen = set(namespaces)
     # tools/activate.sh names the installed profile: that is the workspace's, not the user's.
-    users_own = env.get(PROFILES_VARIABLE, str(profile_path())) != str(profile_path())
-    if users_own or (chosen <= set(INSTALLED_NAMESPACES) and not radio):
+    if not _installed(env.get(PROFILES_VARIABLE, str(profile_path()))) or (
+            chosen <= set(INSTALLED_NAMESPACES) and not radio):
         return with_profile(env), None
+    loopback = on_loopback(env) and not radio
     path = Path(run_dir) / PROFILE_FILE_NAME
-    return (with_profile({**env, PROFILES_VARIABLE: str(path)}),
-            render_profile(sorted(chosen), radio=radio))
+    own = {**env, PROFILES_VARIABLE: str(path)}
+    if loopback:
+        own[RANGE_VARIABLE] = SYSTEM_DEFAULT
+    return (with_profile(own),
+            render_profile(sorted(chosen), radio=radio, loopback=loopback))
 
 
 def write_profile(env: Mapping[str, str], text: str | None) -> None:
