@@ -54,8 +54,11 @@ def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, 
 def test_drive_the_virtual_fish(driver):
     rec = driver.recording
     deadline = time.monotonic() + 30.0
-    while len(rec.truth) < 50 or len(rec.state) < 10:  # discovery on a loaded machine
-        assert time.monotonic() < deadline, 'no ground truth / planner_state from the graph'
+    # Discovery on a loaded machine: each stream its own writer in its own process (a clean-clone
+    # run heard ground truth and planner_state, but not yet one servo_cmd).
+    while len(rec.truth) < 50 or len(rec.state) < 10 or len(rec.servo) < 50:
+        assert time.monotonic() < deadline, \
+            'no ground truth / planner_state / servo_cmd from the graph'
         time.sleep(0.1)
     # No cmd_vel ever received: the planner rests the fish (cpg_node starts with Table 1, and
     # the planner's cpg_command reaches it only once discovery is done).
