@@ -28,7 +28,7 @@ from wirefish_common.qos import RELIABLE, SENSOR_DATA
 from wirefish_kinematics.body_wave import body_positions
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
-from wirefish_tf.tf_node import TF_QOS, TF_STATIC_QOS
+from wirefish_tf.tf_node import TF_QOS, TF_STATIC_LISTENER_QOS
 
 pytestmark = pytest.mark.ros
 
@@ -59,7 +59,8 @@ class TfRecord:
         node.create_subscription(TFMessage, '/tf', lambda m: self.transforms.extend(m.transforms),
                                  TF_QOS)
         node.create_subscription(TFMessage, '/tf_static',
-                                 lambda m: self.static.extend(m.transforms), TF_STATIC_QOS)
+                                 lambda m: self.static.extend(m.transforms),
+                                 TF_STATIC_LISTENER_QOS)
         if namespace is not None:
             node.create_subscription(Odometry, f'{namespace}/sim/ground_truth',
                                      self.ground_truth.append, RELIABLE)

@@ -49,6 +49,11 @@ from wirefish_tf.tf_node_parameters import (consistent_geometry, GEOMETRY_NAMES,
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 TF_STATIC_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# tf2_ros's static listener: deep enough to keep every latched /tf_static message when
+# several broadcasters (a fleet's tf_nodes) answer one late subscriber at once; a depth of 1
+# would keep only the last writer's mounts.
+TF_STATIC_LISTENER_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
+                                    durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def _seconds(stamp: Time) -> float:
