@@ -1,4 +1,4 @@
-"""`make test` deals the longest modules to its two workers first (module_order.py)."""
+"""`make test` deals the longest modules to its workers first (module_order.py)."""
 
 from pathlib import Path
 
