@@ -1,6 +1,7 @@
 """`make test` deals the longest modules to its workers first (module_order.py)."""
 
 from pathlib import Path
+import subprocess
 
 from module_order import LONGEST_MODULES, module_rank
 
@@ -21,7 +22,9 @@ def test_the_longest_modules_rank_first_in_their_order():
 
 def test_make_test_deals_files_in_collection_order():
     # Without --no-loadscope-reorder xdist deals the files with most tests first, and the
-    # one-test long modules come last whatever the collection order.
-    recipe = (WORKSPACE / 'Makefile').read_text().split('\ntest:', 1)[1].split('\n\n', 1)[0]
-    line = next(row for row in recipe.splitlines() if '--dist loadfile' in row)
-    assert '--no-loadscope-reorder' in line
+    # one-test long modules come last whatever the collection order. `make -n` prints the
+    # commands `make test` runs, without running them.
+    commands = subprocess.run(['make', '-n', 'test'], cwd=WORKSPACE, capture_output=True,
+                              text=True, check=True).stdout.replace('\\\n', ' ')
+    run = next(line for line in commands.splitlines() if '--dist loadfile' in line)
+    assert '--no-loadscope-reorder' in run.split() and 'test' in run.split()
