@@ -27,6 +27,11 @@ def verbs() -> dict[str, str]:
             sorted(entry_points(group=VERB_GROUP), key=lambda point: point.name)}
 
 
+def without_ros_args(argv: list[str]) -> list[str]:
+    """Return a command line without ``--ros-args`` and what follows: those belong to ROS."""
+    return argv[:argv.index('--ros-args')] if '--ros-args' in argv else argv
+
+
 def duration_s(text: str) -> float:
     """Return a --duration option as seconds: finite and > 0 (argparse type)."""
     try:
@@ -63,9 +68,7 @@ def verb_main(add_arguments: Callable[[argparse.ArgumentParser], None],
 
     The arguments after ``--ros-args`` belong to ROS and are left out.
     """
-    argv = sys.argv[1:]
-    if '--ros-args' in argv:
-        argv = argv[:argv.index('--ros-args')]
+    argv = without_ros_args(sys.argv[1:])
     parser = argparse.ArgumentParser(prog=prog, description=description)
     add_arguments(parser)
     return run_verb(run, parser.parse_args(argv), prog)

@@ -13,7 +13,7 @@ import importlib.util
 from pathlib import Path
 import sys
 
-from wirefish_cli.api import run_verb, verbs
+from wirefish_cli.api import run_verb, verbs, without_ros_args
 
 
 def _first_line(doc: str | None) -> str:
@@ -51,10 +51,8 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the `wirefish` executable."""
-    argv = sys.argv[1:] if argv is None else argv
-    # Arguments after --ros-args belong to ROS, not to us (ros2 run passes them through).
-    if '--ros-args' in argv:
-        argv = argv[:argv.index('--ros-args')]
+    # ros2 run passes the ROS arguments through: they are not ours.
+    argv = without_ros_args(sys.argv[1:] if argv is None else argv)
     args = build_parser(argv).parse_args(argv)
     return run_verb(args.run, args, f'wirefish {args.command}')
 
