@@ -19,9 +19,11 @@ WAIT_S = 10.0
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of `wirefish hand-back`."""
+    from wirefish_cli.api import duration_s
+
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
                         help='ROS namespace of the graph (default %(default)s)')
-    parser.add_argument('--timeout', type=float, default=WAIT_S,
+    parser.add_argument('--timeout', type=duration_s, default=WAIT_S,
                         help='seconds to wait for the service and its answer (default '
                              '%(default)s)')
 
