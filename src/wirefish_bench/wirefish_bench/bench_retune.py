@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import logging
+from pathlib import Path
 import statistics
 import sys
 import time
@@ -111,6 +112,13 @@ def run(repeats: int = 5, seed: int = 0, baseline: bool = True,
     return result
 
 
+def tuner_executable() -> Path:
+    """Return the installed tuner_node executable (`ros2 run wirefish_tuner tuner_node`)."""
+    from ament_index_python.packages import get_package_prefix
+
+    return Path(get_package_prefix('wirefish_tuner'), 'lib', 'wirefish_tuner', 'tuner_node')
+
+
 def library_answer(repeats: int = 20, domain_id: int = 97) -> dict:
     """
     Return round-trip times (s) of a fitted goal and of ``repeats`` library answers.
@@ -119,19 +127,16 @@ def library_answer(repeats: int = 20, domain_id: int = 97) -> dict:
     library_tuner_s_median (the tuner's elapsed_s: look-up only), all_from_library, how.
     """
     import os
-    from pathlib import Path
     import subprocess
     import tempfile
 
-    from ament_index_python.packages import get_package_prefix
     import rclpy
     from rclpy.action import ActionClient
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
     from wirefish_msgs.action import RetuneGait
 
-    tuner = os.path.join(get_package_prefix('wirefish_cpg'), 'lib', 'wirefish_cpg',
-                         'tuner_node')
+    tuner = str(tuner_executable())
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     with tempfile.TemporaryDirectory() as scratch:
         library = Path(scratch) / 'gaits.yaml'
@@ -145,8 +150,12 @@ def library_answer(repeats: int = 20, domain_id: int = 97) -> dict:
             executor = SingleThreadedExecutor(context=context)
             executor.add_node(node)
             client = ActionClient(node, RetuneGait, 'retune_gait')
-            if not client.wait_for_server(timeout_sec=30.0):
-                raise RuntimeError('no retune_gait action server within 30 s')
+            deadline = time.monotonic() + 30.0
+            while not client.wait_for_server(timeout_sec=1.0):
+                if process.poll() is not None:  # say why, not only that nothing answered
+                    raise RuntimeError(f'{tuner} exited with {process.returncode}')
+                if time.monotonic() > deadline:
+                    raise RuntimeError('no retune_gait action server within 30 s')
 
             def round_trip() -> tuple[float, RetuneGait.Result]:
                 goal = RetuneGait.Goal()
@@ -179,7 +188,6 @@ def library_answer(repeats: int = 20, domain_id: int = 97) -> dict:
 def gaits_build(workers: int | None = None) -> dict:
     """Return the wall time (s) of `wirefish gaits build` on its default grid."""
     import os
-    from pathlib import Path
     import subprocess
     import tempfile
 
