@@ -57,7 +57,7 @@ class CdrReader:
         return self._u32.unpack_from(self.data, self._take(4, 4, what))[0]
 
     def string(self, what: str) -> str:
-        """Read a string (UTF-8, NUL-terminated, at most ``MAX_NAME_BYTES``)."""
+        """Read a UTF-8 string: NUL-terminated, at most ``MAX_NAME_BYTES`` long."""
         size = self.count(what)
         if not 1 <= size <= MAX_NAME_BYTES:
             raise CdrError(f'{what} has an absurd length {size}')
