@@ -1,5 +1,5 @@
 """
-Three levers of the fish's CPU and timing, the old source against today's in one run.
+Four levers of the fish's CPU and timing, the old source against today's in one run.
 
 - The CPG's period error at the source at its default rate (100 Hz, events executor): cpg_node
   of the package before the loop thread's real-time scheduling (``CPG_COMMIT``) and today's,
@@ -10,6 +10,10 @@ Three levers of the fish's CPU and timing, the old source against today's in one
 - kinematics_node's servo intake: a callback per sample beside its 50 Hz tick (before) against
   the tick taking a batch (today), and the bridge's: a servo pair read from each message
   against from the raw bytes; subscriber CPU at 200 Hz (``message_cost``'s probes).
+- planner_node's imu/data intake: a callback per sample (``PLANNER_COMMIT``) against its
+  control tick taking a batch (today), in one fish's whole graph (``bench_graph.fleet``, one
+  process per node, events), alternated ``repeats`` times: the planner's CPU and the onboard
+  graph's; medians.
 
 Old packages come from git (``git archive``), first on their process's PYTHONPATH. Nothing here
 asserts: these are measurements.
@@ -31,6 +35,7 @@ from wirefish_common.executors import ExecutorKind
 
 CPG_COMMIT = '821c50c'  # before FixedRateLoop's SCHED_FIFO and GIL switch interval
 SIM_COMMIT = 'de0bafa'  # before fish_sim simulated N fish in one process
+PLANNER_COMMIT = '254dba5'  # before the planner took imu/data in batches at its control tick
 DEFAULT_RATE_HZ = 100.0  # servo_cmd's default
 FLEET = 8
 WINDOW_S = 10.0
@@ -84,6 +89,37 @@ def cpg_period_error(repeats: int, domain_id: int) -> dict:
             for which, rs in runs.items()}
 
 
+def planner_intake(repeats: int, domain_id: int) -> dict:
+    """Alternate one fish's graph with the old and the new planner_node; return their runs."""
+    from wirefish_bench import bench_graph
+
+    runs: dict[str, list[dict]] = {'old': [], 'new': []}
+    saved = os.environ.get('PYTHONPATH', '')
+    with tempfile.TemporaryDirectory(prefix='wirefish_bench_planner_') as tmp:
+        old = _old_package(PLANNER_COMMIT, 'wirefish_planner', Path(tmp))
+        try:
+            for _ in range(repeats):
+                for which in ('old', 'new'):
+                    # the graph's node processes inherit this environment
+                    os.environ['PYTHONPATH'] = (os.pathsep.join([old, saved])
+                                                if which == 'old' else saved)
+                    runs[which].append(bench_graph.fleet(1, WINDOW_S, domain_id, False,
+                                                         ExecutorKind.EVENTS))
+        finally:
+            os.environ['PYTHONPATH'] = saved
+
+    def planner_cpu(run: dict) -> float:
+        return next(cpu for name, cpu in run['cpu_percent_by_process'].items()
+                    if 'planner' in name)
+    return {which: {'planner_cpu_percent': [planner_cpu(r) for r in rs],
+                    'onboard_cpu_percent': [r['onboard_cpu_percent_per_fish'] for r in rs],
+                    'imu_hz_min': [r['imu_hz_min'] for r in rs],
+                    'median_planner_cpu_percent': float(np.median([planner_cpu(r) for r in rs])),
+                    'median_onboard_cpu_percent': float(np.median(
+                        [r['onboard_cpu_percent_per_fish'] for r in rs]))}
+            for which, rs in runs.items()}
+
+
 def _cpu_s(pids: list[int]) -> float:
     import psutil
 
@@ -133,9 +169,9 @@ def intakes() -> dict:
 
 
 def run(repeats: int = 3, domain_id: int = 92) -> dict:
-    """Run the three comparisons; return their figures (the bench's JSON)."""
+    """Run the four comparisons; return their figures (the bench's JSON)."""
     return {'cpg': cpg_period_error(repeats, domain_id), 'simulators': simulators(),
-            'intakes': intakes()}
+            'intakes': intakes(), 'planner': planner_intake(repeats, domain_id)}
 
 
 def rows(result: dict) -> list[tuple[str, str, str, str, str]]:
@@ -177,6 +213,20 @@ def rows(result: dict) -> list[tuple[str, str, str, str, str]]:
         f'{raw:.2f} %', '—',
         'python -m wirefish_bench.message_cost probes (one process each, events executor, '
         f'{WINDOW_S:g} s after 4 s)'))
+    planner = result.get('planner')
+    if planner is not None:
+        table.append((
+            "planner_node's imu/data intake in one fish's graph, CPU (% of a core): a callback "
+            'per sample vs the control tick taking a batch', '—',
+            f'planner old {planner["old"]["median_planner_cpu_percent"]:.2f} % (runs '
+            f'{runs(planner["old"]["planner_cpu_percent"])}), new '
+            f'{planner["new"]["median_planner_cpu_percent"]:.2f} % (runs '
+            f'{runs(planner["new"]["planner_cpu_percent"])}); onboard old '
+            f'{planner["old"]["median_onboard_cpu_percent"]:.1f} %, new '
+            f'{planner["new"]["median_onboard_cpu_percent"]:.1f} %', '—',
+            f'bench_graph.fleet of 1 fish, one process per node, events, {WINDOW_S:g} s '
+            f'windows, old and new alternated; old = src/wirefish_planner at {PLANNER_COMMIT} '
+            'from git; medians'))
     return table
 
 

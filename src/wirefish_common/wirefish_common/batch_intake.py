@@ -13,7 +13,27 @@ consumer must take them at least every ``depth`` messages.
 
 from __future__ import annotations
 
+import math
 from typing import Any
+
+MAX_INTAKE_DEPTH = 4096
+MIN_INTAKE_DEPTH = 16
+
+
+def intake_qos(fastest_source_hz: float, tick_rate_hz: float) -> Any:
+    """
+    Return a batch intake's QoS: sensor data, its queue two ticks deep at the fastest source.
+
+    Keep-last drops the oldest sample when the queue is full: two ticks' worth at the fastest
+    rate the source may publish means a tick that comes late loses none.
+    """
+    from rclpy.qos import QoSProfile
+    from wirefish_common.qos import SENSOR_DATA
+
+    depth = min(MAX_INTAKE_DEPTH,
+                max(MIN_INTAKE_DEPTH, math.ceil(2.0 * fastest_source_hz / tick_rate_hz)))
+    return QoSProfile(depth=depth, reliability=SENSOR_DATA.reliability,
+                      durability=SENSOR_DATA.durability, history=SENSOR_DATA.history)
 
 
 def _never_called(_msg: Any) -> None:  # no executor spins the reader node

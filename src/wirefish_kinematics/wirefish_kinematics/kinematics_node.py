@@ -32,10 +32,9 @@ import numpy as np
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
-from wirefish_common.batch_intake import BatchIntake
+from wirefish_common.batch_intake import BatchIntake, intake_qos
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.joint_state_cdr import CdrError, read_joint_state
 from wirefish_common.node_main import run_node
@@ -57,17 +56,9 @@ from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate as SpeedEsti
 
 MARKERS = reliable(depth=5)
 # The fastest servo_cmd the CPG publishes (its publish_rate_hz range): the intake's queue holds
-# two ticks' samples at that rate, so a late tick loses none.
+# two ticks' samples at that rate.
 MAX_SERVO_RATE_HZ = 1000.0
-MAX_INTAKE_DEPTH = 4096
 WARN_PERIOD_S = 2.0
-
-
-def intake_qos(publish_rate_hz: float) -> QoSProfile:
-    """Return the servo intake's QoS: sensor data, deep enough for two ticks at the most."""
-    depth = min(MAX_INTAKE_DEPTH, max(16, math.ceil(2.0 * MAX_SERVO_RATE_HZ / publish_rate_hz)))
-    return QoSProfile(depth=depth, reliability=SENSOR_DATA.reliability,
-                      durability=SENSOR_DATA.durability, history=SENSOR_DATA.history)
 
 
 class KinematicsNode(Node):
@@ -141,7 +132,8 @@ class KinematicsNode(Node):
         self._tracker.reset()
         self._latest, self._fresh = None, False
         self._servo_sub = BatchIntake(self, JointState, topic,
-                                      intake_qos(self._values['publish_rate_hz']))
+                                      intake_qos(MAX_SERVO_RATE_HZ,
+                                                 self._values['publish_rate_hz']))
 
     def destroy_node(self) -> None:
         """Destroy the servo intake's reader node too."""

@@ -6,7 +6,10 @@ Subscribes
     refused with a throttled warning), angular.z yaw rate (rad/s, REP-103: + turns left);
     the other fields are ignored (said once per field).
     ``imu/data`` (sensor_msgs/Imu, sensor-data QoS): angular_velocity.z and the orientation's
-    yaw close the yaw loops, with dt from the message stamps.
+    yaw close the yaw loops, with dt from the message stamps. The samples wait in a batch
+    intake's queue (``wirefish_common.batch_intake``) and each control tick reads all of them,
+    oldest first, from their bytes (``imu_cdr``) before it steps: the loops see every sample,
+    the node is not woken 100 times a second for them.
 Publishes
     ``planner_state`` (wirefish_msgs/PlannerState, reliable, depth 10) at ``control_rate_hz``;
     ``/diagnostics`` (diagnostic_msgs/DiagnosticArray) at 1 Hz.
@@ -36,9 +39,11 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Imu
+from wirefish_common.batch_intake import BatchIntake, intake_qos
+from wirefish_common.imu_cdr import CdrError, read_imu
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import COMMAND, LATCHED, RELIABLE, SENSOR_DATA
+from wirefish_common.qos import COMMAND, LATCHED, RELIABLE
 from wirefish_cpg.cpg_control import TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values
 from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
@@ -50,6 +55,9 @@ from wirefish_planner.yaw_control import yaw_from_quaternion
 
 DIAGNOSTICS_PERIOD_S = 1.0
 WARN_THROTTLE_S = 2.0
+# The fastest imu/data the intake's queue is sized for (twice the board's 100 Hz telemetry):
+# two control ticks' samples at that rate.
+MAX_IMU_RATE_HZ = 200.0
 
 
 class PlannerNode(Node):
@@ -69,7 +77,8 @@ class PlannerNode(Node):
         self._output: PlannerOutput | None = None
         self._wire_cpg()
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
-        self.create_subscription(Imu, 'imu/data', self._on_imu, SENSOR_DATA)
+        self._imu_intake: BatchIntake | None = None
+        self._subscribe_imu()
         self._state_pub = self.create_publisher(PlannerState, 'planner_state', RELIABLE)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self.add_on_set_parameters_callback(self._validate)
@@ -95,6 +104,7 @@ class PlannerNode(Node):
             self._control_timer.cancel()
             self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                     self._on_control)
+            self._subscribe_imu()  # its queue holds the samples of two ticks
         if 'cpg_node_name' in names:
             self.destroy_publisher(self._command_pub)
             for subscription in self._cpg_subscriptions:
@@ -135,17 +145,40 @@ class PlannerNode(Node):
             return
         self._last_cmd_s = now
 
-    def _on_imu(self, msg: Imu) -> None:
-        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-        q = msg.orientation
-        yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
-        if msg.orientation_covariance[0] == -1.0:  # REP-145: no orientation
-            yaw = math.nan
-        self._planner.imu(self._now_s(), stamp, yaw, msg.angular_velocity.z)
+    def _subscribe_imu(self) -> None:
+        if self._imu_intake is not None:
+            self._imu_intake.destroy()
+        self._imu_intake = BatchIntake(self, Imu, 'imu/data',
+                                       intake_qos(MAX_IMU_RATE_HZ,
+                                                  self._values['control_rate_hz']))
+
+    def _take_imu(self, now: float) -> None:
+        """Feed the yaw loops every imu/data sample since the last tick, oldest first."""
+        assert self._imu_intake is not None
+        for data in self._imu_intake.take():
+            try:
+                view = read_imu(data)
+            except CdrError as error:  # DDS delivered it whole: a foreign writer's bytes
+                self.get_logger().warn(f'imu/data sample not read: {error}',
+                                       throttle_duration_sec=WARN_THROTTLE_S)
+                continue
+            stamp = view.sec + view.nanosec * 1e-9
+            # REP-145: a covariance of -1 says there is no orientation (yaw NaN: not used)
+            yaw = yaw_from_quaternion(*view.orientation) \
+                if view.orientation_covariance_0 != -1.0 else math.nan
+            self._planner.imu(now, stamp, yaw, view.angular_velocity[2])
+
+    def destroy_node(self) -> None:
+        """Destroy the imu intake's reader node too."""
+        if self._imu_intake is not None:
+            self._imu_intake.destroy()
+            self._imu_intake = None
+        super().destroy_node()
 
     # --- outputs --------------------------------------------------------------------------
     def _on_control(self) -> None:
         now = self._now_s()
+        self._take_imu(now)
         out = self._planner.step(now)
         self._output = out
         if self._manual():
