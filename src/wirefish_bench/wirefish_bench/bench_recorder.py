@@ -29,6 +29,7 @@ from typing import Any
 
 # The last commit with the hand-written encoder (mcap_records, mcap_writer).
 OLD_COMMIT = '3f49806d7555d7fb28b1c37dc11ec565136f5ede'
+OLD_COMMAND = 'wirefish_bringup.cli'  # the `wirefish` command of that commit
 PACKAGE = 'src/wirefish_bringup/wirefish_bringup'
 NAMESPACE = '/bench_recorder'
 WARM_UP_S = 10.0  # graph started, every topic discovered and subscribed by both recorders
@@ -89,17 +90,21 @@ def recorders(domain_id: int, warm_up_s: float = WARM_UP_S,
             [str(_old_package(tmp_path)), env.get('PYTHONPATH', '')]))
         procs: dict[str, subprocess.Popen] = {}
 
-        def start(name: str, args: list[str], proc_env: dict) -> None:
+        def start(name: str, args: list[str], proc_env: dict,
+                  command: str = 'wirefish_cli.cli') -> None:
             procs[name] = subprocess.Popen(
-                [sys.executable, '-m', 'wirefish_cli.cli', *args], env=proc_env,
+                [sys.executable, '-m', command, *args], env=proc_env,
                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                 start_new_session=True)
         try:
             start('graph', ['up', '--sim', '--no-status', '--namespace', NAMESPACE, '--out',
                             str(tmp_path / 'graph')], env)
-            for name, proc_env in (('old', old_env), ('new', env)):
+            # Today's `wirefish record` verb is wirefish_bag's, whatever the path says: the old
+            # recorder runs from the old package's own command.
+            for name, proc_env, command in (('old', old_env, OLD_COMMAND),
+                                            ('new', env, 'wirefish_cli.cli')):
                 start(name, ['record', '-o', str(tmp_path / f'{name}_bag'), '--namespace',
-                             NAMESPACE], proc_env)
+                             NAMESPACE], proc_env, command)
             time.sleep(warm_up_s)
             start_cpu = {n: _cpu_s(procs[n].pid) for n in ('old', 'new')}
             time.sleep(window_s)
