@@ -40,8 +40,12 @@ DEVICE_TIMEOUT_S = 15.0
 STOP_TIMEOUT_S = 5.0
 STOP_S_PER_PROCESS = 1.0
 STOP_LOG_LINES = 60  # of a process that had to be killed: enough for its threads' stacks
-# Start-up may include restarts with back-off (1 + 2 + 4 s) of a node that fails at once.
-READY_TIMEOUT_S = 60.0
+# Start-up may include restarts with back-off (1 + 2 + 4 s) of a node that fails at once, and
+# 8 graphs started at once on the 2-core reference machine (56 processes importing rclpy and
+# numpy together, load average ~120) had the last graph's nodes discovered 60-80 s on.
+READY_TIMEOUT_S = 120.0
+# While it waits longer than this, `wirefish up` says how far start-up has got, every as long.
+READY_PROGRESS_S = 15.0
 # How long a new `wirefish up` listens for the registry's nodes already in its namespace (it
 # answers at once when one is found). Discovery of a running node on one host took 0 to 2.3 s
 # on the loaded 2-core machine (6 tries): twice that leaves a margin.
@@ -140,9 +144,17 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
     def up() -> bool:  # discovered, and no process down (a node dying at start-up is seen)
         return expected() <= discovered_nodes(node) and not supervisor.down()
 
-    deadline = time.monotonic() + timeout_s
+    started = time.monotonic()
+    deadline = started + timeout_s
+    next_progress = started + READY_PROGRESS_S
     while not up():
         _report(supervisor.supervise())
+        if time.monotonic() > next_progress and not stop.requested:
+            waiting = sorted(expected() - discovered_nodes(node))
+            _report([f'{len(expected()) - len(waiting)} of {len(expected())} nodes up after '
+                     f'{time.monotonic() - started:.0f} s (load average '
+                     f'{os.getloadavg()[0]:.1f}); waiting for {", ".join(waiting)}'])
+            next_progress += READY_PROGRESS_S
         if stop.requested and deadline > time.monotonic() + STOP_GRACE_S:
             # A node interrupted while still importing dies of the SIGINT (exit -2, a
             # KeyboardInterrupt trace): let every node finish starting, then stop them all.
