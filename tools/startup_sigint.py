@@ -29,6 +29,19 @@ NODES = (('wirefish_cpg', 'cpg_node'), ('wirefish_tuner', 'tuner_node'),
 EXIT_TIMEOUT_S = 30.0
 
 
+def _sigint_default() -> None:
+    """
+    Give the node SIGINT's default disposition, as a terminal's or a launcher's child has.
+
+    A disposition of SIG_IGN survives exec: started from a background job of a non-interactive
+    shell (`tool &`), which ignores SIGINT, a node's interpreter keeps ignoring it until the
+    node's package installs its own handler, and a SIGINT sent before that is lost (the node
+    then runs until killed). That is the shell's choice, not the node's start-up: measured here
+    it would count as a hang.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _command(package: str, name: str, namespace: str) -> list[str]:
     params = Path(get_package_share_directory('wirefish_bringup'), 'config', 'wirefish.yaml')
     return [str(Path(get_package_prefix(package), 'lib', package, name)), '--ros-args', '-r',
@@ -55,7 +68,8 @@ def main() -> int:
             delay = float(rng.uniform(0.0, args.within))
             twice = run % 2 == 1
             proc = subprocess.Popen(_command(package, name, f'/startup_{run}'), env=env,
-                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                    preexec_fn=_sigint_default)
             time.sleep(delay)
             proc.send_signal(signal.SIGINT)
             if twice:
