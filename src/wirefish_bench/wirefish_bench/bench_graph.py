@@ -64,11 +64,22 @@ def ros_session(domain_id: int, executor_kind: str | None = None):
 @contextmanager
 def processes(specs: list[NodeSpec], domain_id: int, log_dir: Path | None = None,
               executor: str | None = None):
-    """Start ``specs`` on ``domain_id``; yield the Supervisor; stop them all afterwards."""
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    """
+    Start ``specs`` on ``domain_id``; yield the Supervisor; stop them all afterwards.
+
+    The processes get the environment `wirefish up` gives a graph on this machine (the
+    workspace's Fast DDS profile: UDPv4 on loopback under LOCALHOST), so a figure measures
+    the graph as users run it.
+    """
+    from wirefish_bringup.dds_profile import graph_environment, write_profile
+
+    log_dir = log_dir or Path(tempfile.mkdtemp(prefix='wirefish_bench_'))
+    env, own_profile = graph_environment(
+        dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST'),
+        {s.namespace for s in specs if s.namespace}, log_dir)
+    write_profile(env, own_profile)
     if executor is not None:
         env[EXECUTOR_VARIABLE] = executor
-    log_dir = log_dir or Path(tempfile.mkdtemp(prefix='wirefish_bench_'))
     supervisor = Supervisor(log_dir, env=env)
     try:
         for spec in specs:
