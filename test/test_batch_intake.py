@@ -6,8 +6,8 @@ import pytest
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from wirefish_common.batch_intake import BatchIntake
+from wirefish_common.cdr_views import read_joint_state
 from wirefish_common.executors import make_executor
-from wirefish_common.joint_state_cdr import read_joint_state
 
 pytestmark = pytest.mark.ros
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)

@@ -67,7 +67,7 @@ def _subscriber(kind: str) -> None:
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
     from wirefish_common.batch_intake import BatchIntake
-    from wirefish_common.joint_state_cdr import read_joint_state
+    from wirefish_common.cdr_views import read_joint_state
     from wirefish_common.servo_joints import servo_sample
 
     def read_message(msg) -> None:

@@ -58,8 +58,8 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, servo_state_message)
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
                                        SerialLink)
+from wirefish_common.cdr_views import CdrError, read_joint_state
 from wirefish_common.frames import declare_frame_prefix, prefixed
-from wirefish_common.joint_state_cdr import CdrError, read_joint_state
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
@@ -99,7 +99,7 @@ class BridgeNode(Node):
         self._battery_pub = self.create_publisher(BatteryState, 'battery',
                                                   SENSOR_DATA)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
-        # Raw: the pair is read from the bytes (joint_state_cdr), no Python message is built.
+        # Raw: the pair is read from the bytes (cdr_views), no Python message is built.
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA, raw=True)
         self._bridge_timers: dict[str, Timer] = {}

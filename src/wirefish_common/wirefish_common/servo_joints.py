@@ -17,7 +17,7 @@ joints, so the strict rule costs nothing; a hand-typed ``ros2 topic pub`` must n
 The bridge used to accept unnamed positions and kinematics refused them; this is the one rule.
 
 Message types only (no rclpy node), so it is testable without a ROS graph. The readers take a
-JointState or what a raw intake reads from its bytes (``joint_state_cdr.JointStateView``: the
+JointState or what a raw intake reads from its bytes (``cdr_views.JointStateView``: the
 same ``name``, ``position`` and ``velocity``).
 """
 
@@ -41,7 +41,7 @@ class JointProblem:
     Why a JointState gives no servo pair.
 
     ``kind`` is one of ``'names'``, ``'size'``, ``'angles'``, ``'rates'`` (and ``'bytes'``: a
-    raw intake's bytes were no JointState, ``joint_state_cdr.CdrError``), so that a node can
+    raw intake's bytes were no JointState, ``cdr_views.CdrError``), so that a node can
     throttle each kind of warning separately (one bad source must not hide another).
     """
 

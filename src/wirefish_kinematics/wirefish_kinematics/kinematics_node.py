@@ -6,7 +6,7 @@ Subscribes
     any order, position rad, velocity rad/s optional: ``wirefish_common.servo_joints``), or the
     measured ``servo_state`` when ``use_servo_state`` is true, taken in batches: the samples
     wait in the intake's queue (``wirefish_common.batch_intake``) and each tick reads all of
-    them from their bytes (``joint_state_cdr``). Samples that rule refuses are dropped with a
+    them from their bytes (``cdr_views``). Samples that rule refuses are dropped with a
     warning throttled per kind. Times are the header stamps (node clock if unstamped).
     ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local): the desired wave;
     the latest of it and the ``wave_*`` parameters wins.
@@ -35,8 +35,8 @@ from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 from wirefish_common.batch_intake import BatchIntake, intake_qos
+from wirefish_common.cdr_views import CdrError, read_joint_state
 from wirefish_common.frames import declare_frame_prefix, prefixed
-from wirefish_common.joint_state_cdr import CdrError, read_joint_state
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import validate_update
 from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA

@@ -8,7 +8,7 @@ Subscribes
     ``imu/data`` (sensor_msgs/Imu, sensor-data QoS): angular_velocity.z and the orientation's
     yaw close the yaw loops, with dt from the message stamps. The samples wait in a batch
     intake's queue (``wirefish_common.batch_intake``) and each control tick reads all of them,
-    oldest first, from their bytes (``imu_cdr``) before it steps: the loops see every sample,
+    oldest first, from their bytes (``cdr_views``) before it steps: the loops see every sample,
     the node is not woken 100 times a second for them.
 Publishes
     ``planner_state`` (wirefish_msgs/PlannerState, reliable, depth 10) at ``control_rate_hz``;
@@ -40,7 +40,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Imu
 from wirefish_common.batch_intake import BatchIntake, intake_qos
-from wirefish_common.imu_cdr import CdrError, read_imu
+from wirefish_common.cdr_views import CdrError, read_imu
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
 from wirefish_common.qos import COMMAND, LATCHED, RELIABLE

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import Imu
-from wirefish_common.imu_cdr import CdrError, read_imu
+from wirefish_common.cdr_views import CdrError, read_imu
 
 
 def _random_message(rng: np.random.Generator) -> Imu:

@@ -1,9 +1,12 @@
 """
-Plain CDR read in place: the shared reader of the serialized-message views.
+Serialized messages read in place (plain CDR): the few fields a hot intake needs, no message.
 
-A raw subscription (rclpy ``raw=True``) or a batch intake hands over the bytes DDS carried.
-The hot intakes need a few fields of a message, not a Python message: ``joint_state_cdr`` and
-``imu_cdr`` read theirs with ``CdrReader``.
+A raw subscription (rclpy ``raw=True``) or a batch intake (``batch_intake``) hands over the
+bytes DDS carried. The servo intakes need a JointState's header stamp, joint names and position
+and velocity arrays (``read_joint_state``: a ``JointStateView``, which ``servo_joints`` reads as
+it reads a message; effort is skipped); the planner's yaw loop needs an Imu's stamp,
+orientation, ``orientation_covariance[0]`` (-1: no orientation, REP-145) and angular velocity
+(``read_imu``: an ``ImuView``). Both read with ``CdrReader``.
 
 Layout (plain CDR, XCDR1, what rmw_fastrtps sends for ROS 2 types): a 4-byte encapsulation
 header (``00 01``: little endian, ``00 00``: big endian; two option bytes), then the fields in
@@ -16,6 +19,7 @@ elements; a fixed array is its elements alone. Bytes that do not hold the whole 
 from __future__ import annotations
 
 import struct
+from typing import NamedTuple
 
 HEADER_SIZE = 4
 _BYTE_ORDER = {b'\x00\x01': '<', b'\x00\x00': '>'}
@@ -82,3 +86,53 @@ class CdrReader:
             return ()
         start = self._take(8 * count, 8, what)
         return struct.unpack_from(f'{self._order}{count}d', self.data, start)
+
+
+class JointStateView(NamedTuple):
+    """The fields of a serialized JointState the servo intakes read (stamp, names, arrays)."""
+
+    sec: int
+    nanosec: int
+    frame_id: str
+    name: tuple[str, ...]
+    position: tuple[float, ...]
+    velocity: tuple[float, ...]
+
+
+def read_joint_state(data: bytes) -> JointStateView:
+    """Return the stamp, frame id, names, positions and velocities of serialized ``data``."""
+    reader = CdrReader(data, 'JointState')
+    sec, nanosec = reader.stamp()
+    frame_id = reader.string('header.frame_id')
+    names = reader.count('name')
+    if names * 5 > len(data):  # every name takes at least its length and a NUL
+        raise CdrError(f'name claims {names} joints in {len(data)} bytes')
+    name = tuple(reader.string(f'name[{i}]') for i in range(names))
+    position = reader.doubles('position')
+    velocity = reader.doubles('velocity')
+    return JointStateView(sec, nanosec, frame_id, name, position, velocity)
+
+
+COVARIANCE_SIZE = 9  # float64[9], row major about x, y, z
+
+
+class ImuView(NamedTuple):
+    """The fields of a serialized Imu a yaw loop reads."""
+
+    sec: int
+    nanosec: int
+    frame_id: str
+    orientation: tuple[float, float, float, float]  # x, y, z, w
+    orientation_covariance_0: float
+    angular_velocity: tuple[float, float, float]  # x, y, z (rad/s)
+
+
+def read_imu(data: bytes) -> ImuView:
+    """Return the stamp, frame id, orientation, its first covariance and the angular velocity."""
+    reader = CdrReader(data, 'Imu')
+    sec, nanosec = reader.stamp()
+    frame_id = reader.string('header.frame_id')
+    x, y, z, w = reader.fixed_doubles(4, 'orientation')
+    covariance = reader.fixed_doubles(COVARIANCE_SIZE, 'orientation_covariance')
+    wx, wy, wz = reader.fixed_doubles(3, 'angular_velocity')
+    return ImuView(sec, nanosec, frame_id, (x, y, z, w), covariance[0], (wx, wy, wz))

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import JointState
-from wirefish_common.joint_state_cdr import CdrError, read_joint_state
+from wirefish_common.cdr_views import CdrError, read_joint_state
 from wirefish_common.servo_joints import servo_sample
 
 
