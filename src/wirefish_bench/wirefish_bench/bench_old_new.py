@@ -21,6 +21,7 @@ asserts: these are measurements.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import json
 import os
 from pathlib import Path
@@ -63,24 +64,31 @@ def _with_path(entry: str | None) -> dict[str, str]:
     return env
 
 
+def _alternated(commit: str, package: str, repeats: int,
+                measure: Callable[[], dict]) -> dict[str, list[dict]]:
+    """Run ``measure`` ``repeats`` times with ``package`` at ``commit`` and today's, alternated."""
+    runs: dict[str, list[dict]] = {'old': [], 'new': []}
+    saved = os.environ.get('PYTHONPATH', '')
+    with tempfile.TemporaryDirectory(prefix=f'wirefish_bench_{package}_') as tmp:
+        old = _old_package(commit, package, Path(tmp))
+        try:
+            for _ in range(repeats):
+                for which in ('old', 'new'):
+                    # the measured node processes inherit this environment
+                    os.environ['PYTHONPATH'] = (os.pathsep.join([old, saved])
+                                                if which == 'old' else saved)
+                    runs[which].append(measure())
+        finally:
+            os.environ['PYTHONPATH'] = saved
+    return runs
+
+
 def cpg_period_error(repeats: int, domain_id: int) -> dict:
     """Alternate the old and the new cpg_node at 100 Hz (events); return each one's runs."""
     from wirefish_bench import bench_graph
 
-    runs: dict[str, list[dict]] = {'old': [], 'new': []}
-    saved = os.environ.get('PYTHONPATH', '')
-    with tempfile.TemporaryDirectory(prefix='wirefish_bench_cpg_') as tmp:
-        old = _old_package(CPG_COMMIT, 'wirefish_cpg', Path(tmp))
-        try:
-            for _ in range(repeats):
-                for which in ('old', 'new'):
-                    # cpg_rate's node process inherits this environment
-                    os.environ['PYTHONPATH'] = (os.pathsep.join([old, saved])
-                                                if which == 'old' else saved)
-                    runs[which].append(bench_graph.cpg_rate(DEFAULT_RATE_HZ, WINDOW_S,
-                                                            domain_id, ExecutorKind.EVENTS))
-        finally:
-            os.environ['PYTHONPATH'] = saved
+    runs = _alternated(CPG_COMMIT, 'wirefish_cpg', repeats, lambda: bench_graph.cpg_rate(
+        DEFAULT_RATE_HZ, WINDOW_S, domain_id, ExecutorKind.EVENTS))
     return {which: {'source_p99_ms': [r['source_period_error_p99_ms'] for r in rs],
                     'source_p50_ms': [r['source_period_error_p50_ms'] for r in rs],
                     'median_source_p99_ms': float(np.median(
@@ -93,20 +101,8 @@ def planner_intake(repeats: int, domain_id: int) -> dict:
     """Alternate one fish's graph with the old and the new planner_node; return their runs."""
     from wirefish_bench import bench_graph
 
-    runs: dict[str, list[dict]] = {'old': [], 'new': []}
-    saved = os.environ.get('PYTHONPATH', '')
-    with tempfile.TemporaryDirectory(prefix='wirefish_bench_planner_') as tmp:
-        old = _old_package(PLANNER_COMMIT, 'wirefish_planner', Path(tmp))
-        try:
-            for _ in range(repeats):
-                for which in ('old', 'new'):
-                    # the graph's node processes inherit this environment
-                    os.environ['PYTHONPATH'] = (os.pathsep.join([old, saved])
-                                                if which == 'old' else saved)
-                    runs[which].append(bench_graph.fleet(1, WINDOW_S, domain_id, False,
-                                                         ExecutorKind.EVENTS))
-        finally:
-            os.environ['PYTHONPATH'] = saved
+    runs = _alternated(PLANNER_COMMIT, 'wirefish_planner', repeats, lambda: bench_graph.fleet(
+        1, WINDOW_S, domain_id, False, ExecutorKind.EVENTS))
 
     def planner_cpu(run: dict) -> float:
         return next(cpu for name, cpu in run['cpu_percent_by_process'].items()
