@@ -7,6 +7,7 @@ group and torn down (SIGINT, then SIGKILL) when the test ends, so none is left b
 """
 
 from collections.abc import Callable, Iterator
+import fcntl
 import itertools
 import os
 from pathlib import Path
@@ -21,7 +22,7 @@ WORKSPACE = Path(__file__).resolve().parents[1]
 # Fast DDS maps a domain to UDP ports; 0..101 is the portable range. A test run owns the window
 # [base, base + 20): each test takes the next of the first 19 ids (so a test never shares a
 # domain with the one before it); base + 19 is kept for module-scoped graphs (test/e2e).
-# Under pytest-xdist (`make test` runs test/ on three workers) worker k owns the next window,
+# Under pytest-xdist (`make test` runs test/ on two workers) worker k owns the next window,
 # [base + 20 k, base + 20 k + 20): set here, before any conftest or test module reads it.
 _WORKER = os.environ.get('PYTEST_XDIST_WORKER', '')
 if _WORKER.startswith('gw'):
@@ -102,6 +103,26 @@ def spawn(ros_env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen]]:
         for stream in (proc.stdout, proc.stderr):
             if stream is not None:
                 stream.close()
+
+
+@pytest.fixture(scope='module')
+def machine_to_itself(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """
+    Run a module that loads the machine while no other such module runs, on any worker.
+
+    A few modules load the machine themselves (busy loops beside a recording, an emulated
+    STM32, a browser): two of them at once starved each other's real-time streams (seen with
+    three workers: a failsafe of the QEMU board, a recording 1.8 s behind, a dashboard that
+    never plotted). They take turns through a lock file shared by the run's workers (the
+    parent of each worker's base temp).
+    """
+    lock_path = tmp_path_factory.getbasetemp().parent / 'machine_to_itself.lock'
+    with open(lock_path, 'w') as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 @pytest.fixture
