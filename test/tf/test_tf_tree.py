@@ -24,11 +24,11 @@ from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until, stop_process
 from sensor_msgs.msg import Imu
 from tf2_msgs.msg import TFMessage
-from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA
 from wirefish_kinematics.body_wave import body_positions
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
-from wirefish_tf.tf_node import TF_QOS, TF_STATIC_LISTENER_QOS
+from wirefish_tf.tf_node import TF_STATIC_LISTENER_QOS
 
 pytestmark = pytest.mark.ros
 
@@ -56,8 +56,9 @@ class TfRecord:
         self.ground_truth: list[Odometry] = []
         self.body_wave: list[BodyWave] = []
         self.tf_type_hash = ''
+        # 10 s of /tf: this listener may be starved for a while on a loaded machine too
         node.create_subscription(TFMessage, '/tf', lambda m: self.transforms.extend(m.transforms),
-                                 TF_QOS)
+                                 reliable(depth=1000))
         node.create_subscription(TFMessage, '/tf_static',
                                  lambda m: self.static.extend(m.transforms),
                                  TF_STATIC_LISTENER_QOS)

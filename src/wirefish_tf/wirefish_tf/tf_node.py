@@ -36,7 +36,7 @@ from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA
 from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
 from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, quaternion_yaw,
@@ -54,6 +54,11 @@ TF_STATIC_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 # would keep only the last writer's mounts.
 TF_STATIC_LISTENER_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
                                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+# A second of the virtual fish's 50 Hz ground truth: a tf_node starved for a moment on a
+# loaded machine publishes every pose late rather than drop the oldest (depth 10 kept 0.2 s).
+GROUND_TRUTH_QOS = reliable(depth=50)
 
 
 def _seconds(stamp: Time) -> float:
@@ -81,7 +86,8 @@ class TfNode(Node):
         self._tf_pub = self.create_publisher(TFMessage, '/tf', TF_QOS)
         self._static_pub = self.create_publisher(TFMessage, '/tf_static', TF_STATIC_QOS)
         self.create_subscription(BodyWave, 'body_wave', self._on_body_wave, SENSOR_DATA)
-        self.create_subscription(Odometry, 'sim/ground_truth', self._on_ground_truth, RELIABLE)
+        self.create_subscription(Odometry, 'sim/ground_truth', self._on_ground_truth,
+                                 GROUND_TRUTH_QOS)
         self.create_subscription(Imu, 'imu/data', self._on_imu, SENSOR_DATA)
         self.create_subscription(SpeedEstimate, 'speed_estimate', self._on_speed, RELIABLE)
         self.add_on_set_parameters_callback(self._validate)
