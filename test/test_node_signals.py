@@ -1,12 +1,16 @@
 """SIGINT and SIGTERM stop every node of the registry with exit code 0 and no trace."""
 
+import dataclasses
+import os
+from pathlib import Path
 import signal
 
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
-from wirefish_bringup.graph import composable_entries, fish_graph
+from wirefish_bringup.graph import composable_entries, COMPOSED_NAME, fish_graph, Role
+from wirefish_launcher.supervisor import Supervisor
 
 pytestmark = pytest.mark.ros
 # Every ROS node of the registry (those with a node class), as the launcher starts it: its name,
@@ -39,3 +43,39 @@ def test_a_signal_stops_the_node_cleanly(spawn, ros_context, spec, signum):
     output = proc.stdout.read()
     assert code == 0, output
     assert 'Traceback' not in output
+
+
+def _every_process_wirefish_up_starts(out: Path) -> list:
+    """Each executable of the registry once (the emulated board aside: it needs QEMU)."""
+    namespace = '/h_signals_start'
+    specs = {}
+    for graph in (fish_graph(namespace, sim=True, bag=out / 'bag', view=True),
+                  fish_graph(namespace, sim=True, role=Role.FISH),
+                  fish_graph(namespace + '_one', sim=True, single_process=True)):
+        for spec in graph:
+            specs.setdefault(spec.executable, spec)
+    view = specs['view_node']  # any free port, no dashboard: other modules' views may run
+    specs['view_node'] = dataclasses.replace(
+        view, parameters={**view.parameters, 'port': '0', 'http_port': '-1'})
+    assert {'fish_sim', 'bridge_node', 'cpg_node', 'kinematics_node', 'tf_node',
+            'planner_node', 'tuner_node', 'link_relay', 'recorder', 'view_node',
+            'compose'} <= set(specs), sorted(specs)
+    assert specs['compose'].name == COMPOSED_NAME
+    return list(specs.values())
+
+
+@pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_sent_as_the_launcher_starts_a_process_ends_it_with_0_and_no_trace(
+        ros_env, tmp_path, signum):
+    # Sent the moment the process exists: its interpreter is starting, nothing of ours runs yet.
+    # The launcher started it with the stop signals blocked; its handler, once installed,
+    # receives the one that waited (the launcher's own SIGINT at stop() follows it).
+    supervisor = Supervisor(tmp_path / 'logs', env=ros_env)
+    for spec in _every_process_wirefish_up_starts(tmp_path):
+        os.killpg(supervisor.start(spec).pid, signum)
+    codes = supervisor.stop(timeout_s=30.0)
+    assert not supervisor.overran
+    logs = {key: (tmp_path / 'logs' / f'{key}.log').read_text() for key in codes}
+    assert codes == dict.fromkeys(codes, 0), {k: logs[k][-800:] for k, c in codes.items() if c}
+    for key, log in logs.items():
+        assert 'Traceback' not in log and 'KeyboardInterrupt' not in log, (key, log[-800:])

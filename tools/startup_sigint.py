@@ -2,12 +2,18 @@
 SIGINT (once or twice) each node executable at a random moment of its start-up; count the clean.
 
     tools/wfenv python tools/startup_sigint.py --runs 50 [--within 3.0] [--domain 92]
+        [--started-by wirefish-up|ros2-run]
 
-For every run and node: start it as `ros2 run` would (the installed executable, the default
-params file, a namespace of its own), wait a random time in [0, ``--within``) s, send SIGINT
-(and, every other run, a second one 50 ms later), and wait for its exit. Clean: exit code 0
-and no "Traceback"/"KeyboardInterrupt" in its output. Prints the unclean ones with the delay
-and the end of their output, and a summary per node; exit code 0 only if all were clean.
+For every run and node: start it (the installed executable, the default params file, a
+namespace of its own), wait a random time in [0, ``--within``) s, send SIGINT (and, every other
+run, a second one 50 ms later), and wait for its exit. Clean: exit code 0 and no
+"Traceback"/"KeyboardInterrupt" in its output. Prints the unclean ones with the delay and the
+end of their output, and a summary per node; exit code 0 only if all were clean.
+
+``--started-by wirefish-up`` (the default) starts each node through `wirefish up`'s own
+``Supervisor`` (stop signals blocked until the node's handler is in place); ``ros2-run`` as
+`ros2 run` and `ros2 launch` do, with SIGINT's default disposition (the interpreter's start-up
+and the entry script's imports are then a window nothing of ours can close).
 """
 
 from __future__ import annotations
@@ -15,17 +21,22 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
-from ament_index_python.packages import get_package_prefix, get_package_share_directory
+
+from ament_index_python.packages import get_package_share_directory
 import numpy as np
+from wirefish_bringup.graph import NodeSpec
+from wirefish_launcher.supervisor import Supervisor
 
 NODES = (('wirefish_cpg', 'cpg_node'), ('wirefish_tuner', 'tuner_node'),
          ('wirefish_kinematics', 'kinematics_node'), ('wirefish_planner', 'planner_node'),
-         ('wirefish_bridge', 'bridge_node'))
+         ('wirefish_bridge', 'bridge_node'), ('wirefish_tf', 'tf_node'))
 EXIT_TIMEOUT_S = 30.0
 
 
@@ -42,10 +53,20 @@ def _sigint_default() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
-def _command(package: str, name: str, namespace: str) -> list[str]:
+def _spec(package: str, name: str, namespace: str) -> NodeSpec:
     params = Path(get_package_share_directory('wirefish_bringup'), 'config', 'wirefish.yaml')
-    return [str(Path(get_package_prefix(package), 'lib', package, name)), '--ros-args', '-r',
-            f'__ns:={namespace}', '--params-file', str(params)]
+    return NodeSpec(package, name, name, namespace=namespace, params_file=str(params))
+
+
+def _start(spec: NodeSpec, env: dict[str, str], started_by: str,
+           logs: Path) -> tuple[subprocess.Popen, Path | None]:
+    """Start one node; return it and its log file (None: its output is on its stdout pipe)."""
+    if started_by == 'wirefish-up':
+        supervisor = Supervisor(logs, env=env)
+        return supervisor.start(spec), logs / f'{spec.name}.log'
+    command = [str(spec.executable_path()), *spec.command_arguments()]
+    return subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, preexec_fn=_sigint_default), None
 
 
 def main() -> int:
@@ -57,6 +78,9 @@ def main() -> int:
                              '(default %(default)s)')
     parser.add_argument('--domain', type=int, default=92, help='ROS domain (default %(default)s)')
     parser.add_argument('--seed', type=int, default=0, help='seed of the delays')
+    parser.add_argument('--started-by', choices=('wirefish-up', 'ros2-run'),
+                        default='wirefish-up', help='how each node is started '
+                        '(default %(default)s)')
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     env = dict(os.environ, ROS_DOMAIN_ID=str(args.domain),
@@ -67,9 +91,9 @@ def main() -> int:
         for run in range(args.runs):
             delay = float(rng.uniform(0.0, args.within))
             twice = run % 2 == 1
-            proc = subprocess.Popen(_command(package, name, f'/startup_{run}'), env=env,
-                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                    preexec_fn=_sigint_default)
+            logs = Path(tempfile.mkdtemp(prefix='startup_sigint_'))
+            proc, log = _start(_spec(package, name, f'/startup_{run}'), env, args.started_by,
+                               logs)
             time.sleep(delay)
             proc.send_signal(signal.SIGINT)
             if twice:
@@ -81,6 +105,9 @@ def main() -> int:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 output, _ = proc.communicate()
+            if log is not None:
+                output = log.read_text(errors='replace')
+            shutil.rmtree(logs)
             ok = proc.returncode == 0 and 'Traceback' not in output \
                 and 'KeyboardInterrupt' not in output
             clean += ok
@@ -89,8 +116,9 @@ def main() -> int:
                       f'exit {proc.returncode}\n    ' + '\n    '.join(output.splitlines()[-4:]),
                       flush=True)
         unclean += args.runs - clean
-        print(f'{name}: {clean}/{args.runs} clean (SIGINT within {args.within:g} s of the '
-              f'start, every other run twice; load {os.getloadavg()[0]:.1f})', flush=True)
+        print(f'{name}: {clean}/{args.runs} clean (started by {args.started_by}; SIGINT within '
+              f'{args.within:g} s of the start, every other run twice; load '
+              f'{os.getloadavg()[0]:.1f})', flush=True)
     return 0 if unclean == 0 else 1
 
 

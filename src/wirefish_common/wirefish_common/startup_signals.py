@@ -10,8 +10,14 @@ SIGINT and SIGTERM be recorded in ``received`` instead; ``SignalShutdown`` takes
 stop request, so the node stops at once after start-up with exit code 0. A process that
 imports the package for another reason (a test, a tool) keeps its own handlers.
 
-What is left: the interpreter's own start-up and the entry-point script's imports before the
-package (``importlib.metadata``), tens of milliseconds on a quiet machine.
+That leaves the interpreter's own start-up and the entry-point script's imports before the
+package (``importlib.metadata``): tens of milliseconds in which nothing of ours runs yet. A
+launcher closes them: it starts the process with both signals blocked
+(``block_stop_signals`` between fork and exec; a blocked signal stays pending across exec),
+and the process releases them (``release_stop_signals``) once its own handler is in place,
+from ``hold_stop_signals_for``, ``SignalShutdown`` or a handler of its own; a signal that came
+meanwhile is delivered then, to that handler. `wirefish up` starts every process so; a process
+started with the default disposition (`ros2 run`, `ros2 launch`) keeps the window.
 """
 
 from __future__ import annotations
@@ -20,6 +26,8 @@ import os
 import signal
 import sys
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
 received: list[int] = []  # the signals that arrived before SignalShutdown took over
 
 
@@ -27,8 +35,26 @@ def _keep(signum: int, _frame: object) -> None:
     received.append(signum)
 
 
+def block_stop_signals() -> None:
+    """
+    Block SIGINT and SIGTERM, with their default action (a launcher's child, fork to exec).
+
+    The default action, because an ignored signal is discarded even while blocked, and a
+    launcher started from a background job of a shell inherits SIGINT ignored.
+    """
+    signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, signal.SIG_DFL)
+
+
+def release_stop_signals() -> None:
+    """Unblock SIGINT and SIGTERM: one that is pending is delivered to the handler now."""
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
+
+
 def hold_stop_signals_for(*executables: str) -> None:
     """Record SIGINT/SIGTERM in ``received`` if this process runs one of ``executables``."""
     if os.path.basename(sys.argv[0] if sys.argv else '') in executables:
-        for signum in (signal.SIGINT, signal.SIGTERM):
+        for signum in STOP_SIGNALS:
             signal.signal(signum, _keep)
+        release_stop_signals()
