@@ -32,9 +32,10 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
 # files are dealt in collection order, which puts the longest first (test/module_order.py).
 # Most of test/ waits on real-time graphs (a fish swims in real time): on the 2-core reference
-# machine one worker took 14 min, two 10.4 min, three 7.4 min; but three runs of three workers
-# from a clean clone failed 0, 3 and 2 tests whose real-time streams starved beside two others
-# (the loaded recording, QEMU, the dashboard, the TF match), so test/ runs on two.
+# machine one worker took 14 min, two 10.4 min, three 7.4 min; but three workers starved the
+# real-time streams of the modules that load the machine themselves (the loaded recording, QEMU,
+# the dashboard) beside two others, so those hold two of the machine's three slots and run one
+# at a time (test/machine_share.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
 	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder test \
@@ -49,10 +50,10 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py \
 	test/test_host_closure.py test/test_package_size.py
 
-# pytest-xdist workers: one per core of the 2-core reference machine, for the pure tests and
-# for the graphs of test/ (GRAPH_JOBS=3 is faster and starves the real-time tests).
+# pytest-xdist workers: one per core of the 2-core reference machine for the pure tests, one
+# more for the graphs of test/ (they mostly wait on the clock; see machine_share.py).
 FAST_JOBS ?= 2
-GRAPH_JOBS ?= 2
+GRAPH_JOBS ?= 3
 
 test-fast: setup  ## cores and lint, no node processes (under a minute)
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) -m "not ros" $(FAST_TESTS) $(PYTEST_ARGS)

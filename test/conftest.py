@@ -7,13 +7,13 @@ group and torn down (SIGINT, then SIGKILL) when the test ends, so none is left b
 """
 
 from collections.abc import Callable, Iterator
-import fcntl
 import itertools
 import os
 from pathlib import Path
 import subprocess
 import sys
 
+from machine_share import machine_share, slot_count
 from module_order import module_rank
 import pytest
 from ros_utils import stop_process
@@ -105,24 +105,22 @@ def spawn(ros_env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen]]:
                 stream.close()
 
 
-@pytest.fixture(scope='module')
-def machine_to_itself(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+@pytest.fixture(scope='module', autouse=True)
+def machine_slots(request: pytest.FixtureRequest,
+                  tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """
-    Run a module that loads the machine while no other such module runs, on any worker.
+    Run each module on its share of the machine (machine_share.py): two slots if it loads it.
 
-    A few modules load the machine themselves (busy loops beside a recording, an emulated
-    STM32, a browser): two of them at once starved each other's real-time streams (seen with
-    three workers: a failsafe of the QEMU board, a recording 1.8 s behind, a dashboard that
-    never plotted). They take turns through a lock file shared by the run's workers (the
-    parent of each worker's base temp).
+    The slots are shared by the run's workers (lock files in the run's base temp); mark a
+    module that loads the machine itself ``pytest.mark.loads_machine``.
     """
-    lock_path = tmp_path_factory.getbasetemp().parent / 'machine_to_itself.lock'
-    with open(lock_path, 'w') as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
+    workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
+    weight = 2 if request.node.get_closest_marker('loads_machine') else 1
+    run_directory = tmp_path_factory.getbasetemp()  # a worker's is popen-gwK in the run's
+    if _WORKER:
+        run_directory = run_directory.parent
+    with machine_share(run_directory, slot_count(workers), weight):
+        yield
 
 
 @pytest.fixture

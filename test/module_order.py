@@ -2,7 +2,7 @@
 The order `make test` deals test/'s modules to its workers in: the longest first.
 
 The modules below swim longest (a minute or more each, `--durations` of a full run). `make
-test` runs test/ as `-n 2 --dist loadfile --no-loadscope-reorder`, so xdist deals the files in
+test` runs test/ as `-n 3 --dist loadfile --no-loadscope-reorder`, so xdist deals the files in
 collection order, and conftest.py collects these first. By default xdist deals the files with
 most tests first, so these one-test files came last (the drive, the mission, the two hosts and
 the fleet once ran after everything else and test/ took 9.6 min); dealt first, they

@@ -1,9 +1,13 @@
-"""`make test` deals the longest modules to its workers first (module_order.py)."""
+"""`make test` deals the longest modules first and shares the machine by slots."""
 
 from pathlib import Path
 import subprocess
+import threading
+import time
 
+from machine_share import machine_share, slot_count
 from module_order import LONGEST_MODULES, module_rank
+import pytest
 
 WORKSPACE = Path(__file__).resolve().parents[1]
 
@@ -28,3 +32,57 @@ def test_make_test_deals_files_in_collection_order():
                               text=True, check=True).stdout.replace('\\\n', ' ')
     run = next(line for line in commands.splitlines() if '--dist loadfile' in line)
     assert '--no-loadscope-reorder' in run.split() and 'test' in run.split()
+
+
+def _hold(directory: Path, slots: int, weight: int, events: list, name: str,
+          seconds: float) -> threading.Thread:
+    def run() -> None:
+        with machine_share(directory, slots, weight):
+            events.append((time.monotonic(), name, +weight))
+            time.sleep(seconds)
+            events.append((time.monotonic(), name, -weight))
+    thread = threading.Thread(target=run)
+    thread.start()
+    return thread
+
+
+def _most_slots_held(events: list) -> int:
+    held, most = 0, 0
+    for _, _, change in sorted(events):
+        held += change
+        most = max(most, held)
+    return most
+
+
+@pytest.mark.parametrize('workers', [1, 2, 3])
+def test_modules_never_hold_more_slots_than_the_machine_has(tmp_path, workers):
+    events: list = []
+    weights = [2, 1, 1, 2, 1, 1, 1]
+    threads = [_hold(tmp_path, slot_count(workers), w, events, f'm{i}', 0.05)
+               for i, w in enumerate(weights)]
+    for thread in threads:
+        thread.join(timeout=30.0)
+    assert len(events) == 2 * len(weights)
+    assert _most_slots_held(events) <= slot_count(workers)
+
+
+def test_a_module_that_loads_the_machine_waits_for_two_free_slots(tmp_path):
+    events: list = []
+    first = _hold(tmp_path, 3, 1, events, 'a', 0.6)
+    second = _hold(tmp_path, 3, 1, events, 'b', 0.6)
+    time.sleep(0.2)  # both hold their slot: one of three is free
+    heavy = _hold(tmp_path, 3, 2, events, 'heavy', 0.05)
+    time.sleep(0.2)
+    late = _hold(tmp_path, 3, 1, events, 'late', 0.05)  # queues behind the heavy one
+    for thread in (first, second, heavy, late):
+        thread.join(timeout=30.0)
+    starts = {name: t for t, name, change in events if change > 0}
+    ends = {name: t for t, name, change in events if change < 0}
+    assert starts['heavy'] >= min(ends['a'], ends['b'])
+    assert starts['late'] >= starts['heavy']
+
+
+def test_a_weight_outside_one_or_two_is_refused(tmp_path):
+    with pytest.raises(ValueError, match='1 or 2'):
+        with machine_share(tmp_path, 3, 3):
+            pass

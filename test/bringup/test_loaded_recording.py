@@ -16,7 +16,7 @@ import subprocess
 from bag_utils import assert_bag_readable, publish_lags, sequence_gaps
 import pytest
 
-pytestmark = [pytest.mark.ros, pytest.mark.usefixtures('machine_to_itself')]
+pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
 RECORDED, BESIDE = '/wf_loaded', '/wf_loaded_beside'
 DURATION_S = 60

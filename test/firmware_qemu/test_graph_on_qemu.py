@@ -26,7 +26,7 @@ from sensor_msgs.msg import JointState
 from wirefish_bringup.graph import entry
 from wirefish_launcher.monitor import measure_rates
 
-pytestmark = [pytest.mark.ros, pytest.mark.usefixtures('machine_to_itself')]
+pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
 NAMESPACE = '/qemu_graph'
 BRIDGE = entry('bridge_node')

@@ -24,7 +24,7 @@ from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, Role, S
                                       Status, Telemetry)
 from wirefish_bringup.graph import entry
 
-pytestmark = [pytest.mark.ros, pytest.mark.usefixtures('machine_to_itself')]
+pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
 # The graph's servo_cmd rate (the CPG's stream, as the registry lists it).
 GRAPH_RATE_HZ = entry('cpg_node').rates_hz['servo_cmd']

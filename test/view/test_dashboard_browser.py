@@ -29,7 +29,7 @@ from sensor_msgs.msg import JointState
 from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
 from wirefish_msgs.msg import CpgParams, PlannerState
 
-pytestmark = [pytest.mark.ros, pytest.mark.usefixtures('machine_to_itself')]
+pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
 CHROMIUM, CHROMEDRIVER = shutil.which('chromium'), shutil.which('chromedriver')
 ROOT = Path(__file__).resolve().parents[2]
