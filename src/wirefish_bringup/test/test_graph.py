@@ -213,3 +213,16 @@ def test_the_view_is_a_shore_process_started_only_when_asked():
     assert with_view[-1].name == 'view_node'
     assert 'view_node' in [e.name for e in entries(sim=True, role=Role.SHORE, view=True)]
     assert 'view_node' not in [e.name for e in entries(sim=True, role=Role.FISH, view=True)]
+
+
+@pytest.mark.parametrize('options', [{}, {'single_process': True}, {'role': Role.FISH},
+                                     {'qemu': True, 'sim': False}])
+def test_every_process_of_a_graph_releases_the_stop_signals_it_is_started_with(options):
+    # wirefish up starts these with SIGINT/SIGTERM blocked: one that never released them
+    # could be stopped only by SIGKILL.
+    specs = fish_graph('/g', **options)
+    assert specs and all(spec.releases_stop_signals for spec in specs)
+
+
+def test_a_process_outside_the_registry_is_not_trusted_to_release_them():
+    assert not NodeSpec('wirefish_cpg', 'late_node', 'late_node').releases_stop_signals

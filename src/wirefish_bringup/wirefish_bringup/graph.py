@@ -209,6 +209,8 @@ NODES: tuple[NodeEntry, ...] = (
 
 # The process that hosts every entry with a node_class in single-process mode.
 COMPOSED_NAME = 'fish_nodes'
+_RELEASING_EXECUTABLES = frozenset({(e.package, e.executable) for e in NODES}
+                                   | {('wirefish_launcher', 'compose')})
 
 
 @dataclass(frozen=True)
@@ -236,6 +238,17 @@ class NodeSpec:
     def executable_path(self) -> Path:
         """Return the installed executable, where `ros2 run` finds it (lib/<package>/)."""
         return Path(get_package_prefix(self.package), 'lib', self.package, self.executable)
+
+    @property
+    def releases_stop_signals(self) -> bool:
+        """
+        Whether the process unblocks SIGINT/SIGTERM once its own handler is in place.
+
+        Every executable of the registry does (``wirefish_common.startup_signals``), so a
+        launcher may start it with both blocked and lose no stop during its start-up; any other
+        process would never see them.
+        """
+        return (self.package, self.executable) in _RELEASING_EXECUTABLES
 
     def command_arguments(self) -> tuple[str, ...]:
         """Return the arguments after the executable (what `ros2 run` would pass)."""

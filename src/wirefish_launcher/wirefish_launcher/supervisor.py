@@ -4,8 +4,9 @@ Start the graph's processes, watch them, and stop every one of them cleanly.
 What `ros2 launch` does for a full install, in plain subprocess calls: each node is a child in
 its own session (so a terminal's Ctrl-C reaches only the supervisor, which then sends exactly one
 SIGINT to each child, in reverse start order), with a parent-death signal (so no child outlives
-a supervisor that was killed) and SIGINT/SIGTERM blocked until the child's handler is in place
-(``wirefish_common.startup_signals``: no stop is lost or turned into a trace during start-up),
+a supervisor that was killed) and, for the registry's executables, SIGINT/SIGTERM blocked until
+the child's handler is in place (``wirefish_common.startup_signals``: no stop is lost or turned
+into a trace during start-up),
 its output in a log file of its own, restarted by its restart policy when it exits while the
 graph runs.
 """
@@ -26,11 +27,15 @@ _PR_SET_PDEATHSIG = 1
 TERM_GRACE_S = 2.0  # after the SIGTERM to a process still running at the stop's deadline
 
 
-def _prepare_child() -> None:  # runs in the child between fork and exec
+def _die_with_parent() -> None:  # runs in the child between fork and exec
     libc = ctypes.CDLL(None, use_errno=True)
     libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+
+
+def _die_with_parent_holding_stops() -> None:  # the same, for a process that releases them
+    _die_with_parent()
     # A stop that comes while the child's interpreter starts waits for the child's own handler
-    # (every process of the registry releases it then), instead of a KeyboardInterrupt trace.
+    # instead of ending it with a KeyboardInterrupt trace (NodeSpec.releases_stop_signals).
     block_stop_signals()
 
 
@@ -92,7 +97,9 @@ class Supervisor:
         proc = subprocess.Popen([str(spec.executable_path()), *spec.command_arguments()],
                                 env=self._env, stdin=subprocess.DEVNULL, stdout=log,
                                 stderr=subprocess.STDOUT, start_new_session=True,
-                                preexec_fn=_prepare_child)
+                                preexec_fn=(_die_with_parent_holding_stops
+                                            if spec.releases_stop_signals
+                                            else _die_with_parent))
         self.processes[key] = proc
         return proc
 
