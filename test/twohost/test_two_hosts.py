@@ -44,10 +44,7 @@ REST_WITHIN_S = 3.0  # cmd_vel_timeout_s 0.5 + a control period + the CPG's para
 RATE_WINDOW_S = 10.0
 SERVO_WINDOW_S = 5.0  # of driving before the cut
 RATE_FRACTION = 0.8  # of each relayed topic's configured rate, over RATE_WINDOW_S
-# Packets the fish side's bucket may drop in the shaped window: 0, 5 and 9 (of 359, a loaded
-# clean-clone run) with discovery announcing every 10 s; 26-41 when it announced every 3 s (a
-# saturated bucket). The bound is half the saturated bucket's fewest: it tells the two apart.
-MAX_BUCKET_DROPS = 13
+RADIO_BYTES_PER_S = 100e3 / 8  # the 100 kbit/s of the shaped window, each way
 
 
 def _count(probe, topic: str) -> int:
@@ -212,6 +209,8 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
             slack = 1.0 / RATE_WINDOW_S if row.topic in FISH_SOURCES else 0.0
             assert figures[True][2][row.topic] >= RATE_FRACTION * wanted - slack, row.topic
     assert figures[True][2]['speed_estimate'] > 0.0
-    # The bucket drops next to nothing: discovery announces every 10 s (dds_profile), so the
-    # fish side stays under the 100 kbit/s it is given.
-    assert dropped <= MAX_BUCKET_DROPS, qdisc
+    # What the fish sends unshaped fits the radio (discovery announces every 10 s: dds_profile).
+    # The bucket's drops are printed, not judged: with the demand under the rate they come from
+    # bursts of a relay that a loaded machine held back (0-9 of ~360 packets in clean-clone
+    # runs on two workers, 18 on three), not from the demand.
+    assert figures[False][0] < RADIO_BYTES_PER_S
