@@ -3,13 +3,17 @@
 import dataclasses
 import os
 from pathlib import Path
+import shlex
 import signal
+import subprocess
+import time
 
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
 from wirefish_bringup.graph import composable_entries, COMPOSED_NAME, fish_graph, Role
+from wirefish_common.startup_signals import held_start_prefix
 from wirefish_launcher.supervisor import Supervisor
 
 pytestmark = pytest.mark.ros
@@ -79,3 +83,45 @@ def test_a_stop_sent_as_the_launcher_starts_a_process_ends_it_with_0_and_no_trac
     assert codes == dict.fromkeys(codes, 0), {k: logs[k][-800:] for k, c in codes.items() if c}
     for key, log in logs.items():
         assert 'Traceback' not in log and 'KeyboardInterrupt' not in log, (key, log[-800:])
+
+
+def _wait_until_blocked(pid: int, timeout_s: float = 10.0) -> bool:
+    """Wait until process ``pid`` has SIGINT blocked (env did it and execs the node)."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        status = Path(f'/proc/{pid}/status').read_text()
+        blocked = int(next(line.split()[1] for line in status.splitlines()
+                           if line.startswith('SigBlk:')), 16)
+        if blocked >> (signal.SIGINT - 1) & 1:
+            return True
+        time.sleep(0.0005)
+    return False
+
+
+def test_a_stop_sent_as_ros2_launch_starts_a_process_ends_it_with_0_and_no_trace(
+        ros_env, tmp_path):
+    # The launch file's way: each node through held_start_prefix (env blocking the signals),
+    # in a session of its own; SIGINT as soon as env has blocked them (before that, env's own
+    # first instructions are the one window left, a millisecond or so, against the
+    # interpreter's start and imports without the prefix: tens to hundreds of milliseconds).
+    prefix = shlex.split(held_start_prefix())
+    procs = {}
+    for spec in _every_process_wirefish_up_starts(tmp_path):
+        with open(tmp_path / f'{spec.name}.log', 'w') as log:
+            procs[spec.name] = subprocess.Popen(
+                [*prefix, str(spec.executable_path()), *spec.command_arguments()],
+                env=ros_env, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                start_new_session=True)
+        assert _wait_until_blocked(procs[spec.name].pid), spec.name
+        os.killpg(procs[spec.name].pid, signal.SIGINT)
+    try:
+        codes = {name: proc.wait(timeout=30.0) for name, proc in procs.items()}
+    finally:
+        for proc in procs.values():
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+    logs = {name: (tmp_path / f'{name}.log').read_text() for name in procs}
+    assert codes == dict.fromkeys(codes, 0), {k: logs[k][-800:] for k, c in codes.items() if c}
+    for name, log in logs.items():
+        assert 'Traceback' not in log and 'KeyboardInterrupt' not in log, (name, log[-800:])

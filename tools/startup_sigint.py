@@ -2,7 +2,7 @@
 SIGINT (once or twice) each node executable at a random moment of its start-up; count the clean.
 
     tools/wfenv python tools/startup_sigint.py --runs 50 [--within 3.0] [--domain 92]
-        [--started-by wirefish-up|ros2-run]
+        [--started-by wirefish-up|ros2-launch|ros2-run]
 
 For every run and node: start it (the installed executable, the default params file, a
 namespace of its own), wait a random time in [0, ``--within``) s, send SIGINT (and, every other
@@ -11,9 +11,11 @@ run, a second one 50 ms later), and wait for its exit. Clean: exit code 0 and no
 end of their output, and a summary per node; exit code 0 only if all were clean.
 
 ``--started-by wirefish-up`` (the default) starts each node through `wirefish up`'s own
-``Supervisor`` (stop signals blocked until the node's handler is in place); ``ros2-run`` as
-`ros2 run` and `ros2 launch` do, with SIGINT's default disposition (the interpreter's start-up
-and the entry script's imports are then a window nothing of ours can close).
+``Supervisor`` (stop signals blocked until the node's handler is in place); ``ros2-launch``
+through the launch file's prefix (``held_start_prefix``: env blocks them, then execs the node;
+env's own first milliseconds are the window left); ``ros2-run`` as `ros2 run` does, with
+SIGINT's default disposition (the interpreter's start-up and the entry script's imports are
+then a window nothing of ours can close).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+import shlex
 import shutil
 import signal
 import subprocess
@@ -32,6 +35,7 @@ import time
 from ament_index_python.packages import get_package_share_directory
 import numpy as np
 from wirefish_bringup.graph import NodeSpec
+from wirefish_common.startup_signals import held_start_prefix
 from wirefish_launcher.supervisor import Supervisor
 
 NODES = (('wirefish_cpg', 'cpg_node'), ('wirefish_tuner', 'tuner_node'),
@@ -65,6 +69,8 @@ def _start(spec: NodeSpec, env: dict[str, str], started_by: str,
         supervisor = Supervisor(logs, env=env)
         return supervisor.start(spec), logs / f'{spec.name}.log'
     command = [str(spec.executable_path()), *spec.command_arguments()]
+    if started_by == 'ros2-launch':
+        command = [*shlex.split(held_start_prefix() or ''), *command]
     return subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True, preexec_fn=_sigint_default), None
 
@@ -78,7 +84,7 @@ def main() -> int:
                              '(default %(default)s)')
     parser.add_argument('--domain', type=int, default=92, help='ROS domain (default %(default)s)')
     parser.add_argument('--seed', type=int, default=0, help='seed of the delays')
-    parser.add_argument('--started-by', choices=('wirefish-up', 'ros2-run'),
+    parser.add_argument('--started-by', choices=('wirefish-up', 'ros2-launch', 'ros2-run'),
                         default='wirefish-up', help='how each node is started '
                         '(default %(default)s)')
     args = parser.parse_args()

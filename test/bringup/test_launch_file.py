@@ -19,6 +19,7 @@ import pytest
 from wirefish_bringup.graph import entry
 from wirefish_common.frames import FRAME_PREFIX
 from wirefish_common.parameter_table import ParameterSpec
+from wirefish_common.startup_signals import held_start_prefix
 
 LAUNCH_FILE = (Path(__file__).resolve().parents[2] / 'src' / 'wirefish_bringup' / 'launch'
                / 'wirefish.launch.py')
@@ -184,3 +185,12 @@ def test_the_launch_leaves_shared_memory_out_unless_the_user_set_the_transports(
     value = recorded.environment['FASTDDS_BUILTIN_TRANSPORTS']
     assert value.name == 'FASTDDS_BUILTIN_TRANSPORTS'  # the user's own value wins
     assert value.default_value == 'UDPv4'
+
+
+@pytest.mark.parametrize('overrides', LAUNCHES.values(), ids=LAUNCHES.keys())
+def test_every_node_starts_with_its_stop_signals_held(monkeypatch, overrides):
+    # ros2 launch starts each through env, which blocks SIGINT/SIGTERM until the node's handler
+    # unblocks them: a Ctrl-C during the interpreter's start is not a trace.
+    nodes = launched_nodes(monkeypatch, **overrides)
+    assert nodes and {node['prefix'] for node in nodes} == {held_start_prefix()}
+    assert held_start_prefix() is not None

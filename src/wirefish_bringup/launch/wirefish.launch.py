@@ -20,6 +20,7 @@ from launch_ros.actions import Node
 from wirefish_bringup.dds_profile import (profile_path, PROFILES_VARIABLE, TRANSPORTS,
                                           TRANSPORTS_VARIABLE)
 from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, Role
+from wirefish_common.startup_signals import held_start_prefix
 
 
 def _shutdown_after_last_retry(spec):
@@ -43,6 +44,9 @@ def _nodes(context):
     role = LaunchConfiguration('role').perform(context)
     frame_prefix = LaunchConfiguration('frame_prefix').perform(context)
     actions = []
+    # A Ctrl-C while a node's interpreter starts waits for the node's own handler (every
+    # registry executable unblocks the stop signals once it is in place), not a trace.
+    prefix = held_start_prefix()
     for spec in fish_graph(namespace, sim=sim, port=port, params_file=params_file, role=role,
                            frame_prefix=frame_prefix):
         # The recorder (the only entry that parses its own options) runs with --duration
@@ -54,6 +58,7 @@ def _nodes(context):
             respawn=spec.restart.respawn, respawn_delay=spec.restart.delay_s,
             respawn_max_retries=spec.restart.max_restarts,
             on_exit=_shutdown_after_last_retry(spec) if spec.restart.required else None,
+            prefix=prefix if spec.releases_stop_signals else None,
             output='screen', emulate_tty=True))
     return actions
 

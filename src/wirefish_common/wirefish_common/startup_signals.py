@@ -16,8 +16,10 @@ launcher closes them: it starts the process with both signals blocked
 (``block_stop_signals`` between fork and exec; a blocked signal stays pending across exec),
 and the process releases them (``release_stop_signals``) once its own handler is in place,
 from ``hold_stop_signals_for``, ``SignalShutdown`` or a handler of its own; a signal that came
-meanwhile is delivered then, to that handler. `wirefish up` starts every process so; a process
-started with the default disposition (`ros2 run`, `ros2 launch`) keeps the window.
+meanwhile is delivered then, to that handler. `wirefish up` starts every process of the
+registry so; the launch file starts them through ``held_start_prefix`` (coreutils' ``env``
+blocking both before it execs the node). A process started with the default disposition
+(`ros2 run`) keeps the window.
 """
 
 from __future__ import annotations
@@ -27,6 +29,9 @@ import signal
 import sys
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+# coreutils >= 8.31 (Ubuntu 24.04: 9.4): env resets their action, blocks them, execs the node
+# (in this order: coreutils 9.1 forgets the block when --default-signal follows it).
+_HELD_START = ('--default-signal=INT,TERM', '--block-signal=INT,TERM')
 
 received: list[int] = []  # the signals that arrived before SignalShutdown took over
 
@@ -58,3 +63,30 @@ def hold_stop_signals_for(*executables: str) -> None:
         for signum in STOP_SIGNALS:
             signal.signal(signum, _keep)
         release_stop_signals()
+
+
+def held_start_prefix() -> str | None:
+    """
+    Return a command prefix that starts a process with SIGINT/SIGTERM blocked, for launch_ros.
+
+    None where this machine's ``env`` cannot (no coreutils, one older than 8.31, or one whose
+    block does not reach the command: checked on a process started through it): the process
+    then starts with the default disposition, as without a prefix.
+    """
+    import shlex
+    import shutil
+    import subprocess
+
+    env = shutil.which('env')
+    if env is None:
+        return None
+    try:
+        status = subprocess.run([env, *_HELD_START, 'cat', '/proc/self/status'], check=True,
+                                capture_output=True, text=True, timeout=10.0).stdout
+        blocked = int(next(line.split()[1] for line in status.splitlines()
+                           if line.startswith('SigBlk:')), 16)
+    except (OSError, subprocess.SubprocessError, StopIteration, IndexError, ValueError):
+        return None
+    if not all(blocked >> (signum - 1) & 1 for signum in STOP_SIGNALS):
+        return None
+    return shlex.join([env, *_HELD_START])
