@@ -24,11 +24,10 @@ from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until, stop_process
 from sensor_msgs.msg import Imu
 from tf2_msgs.msg import TFMessage
-from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA
+from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA, TF_STATIC_LISTENER
 from wirefish_kinematics.body_wave import body_positions
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
-from wirefish_tf.tf_node import TF_STATIC_LISTENER_QOS
 
 pytestmark = pytest.mark.ros
 
@@ -61,7 +60,7 @@ class TfRecord:
                                  reliable(depth=1000))
         node.create_subscription(TFMessage, '/tf_static',
                                  lambda m: self.static.extend(m.transforms),
-                                 TF_STATIC_LISTENER_QOS)
+                                 TF_STATIC_LISTENER)
         if namespace is not None:
             node.create_subscription(Odometry, f'{namespace}/sim/ground_truth',
                                      self.ground_truth.append, RELIABLE)

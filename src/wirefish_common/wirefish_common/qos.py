@@ -11,6 +11,8 @@ The QoS profiles of every wirefish topic and service client, defined once.
 - ``LATCHED``: state a node announces once and a late joiner still needs (cpg_params,
   cpg_status, target_wave): reliable, transient local, depth 1 (the last value).
   ``latched(depth)`` keeps the last ``depth`` for a late joiner (the tuner's feedback).
+- ``TF``, ``TF_STATIC``, ``TF_STATIC_LISTENER``: tf2_ros's own profiles for /tf (broadcaster
+  and listener alike), the /tf_static broadcaster and the /tf_static listener.
 """
 
 from __future__ import annotations
@@ -34,3 +36,9 @@ def latched(depth: int) -> QoSProfile:
 RELIABLE = reliable(10)
 COMMAND = reliable(1)
 LATCHED = latched(1)
+
+TF = reliable(100)
+TF_STATIC = latched(1)
+# Deep enough to keep every latched /tf_static message when several broadcasters (a fleet's
+# tf_nodes) answer one late subscriber at once; a depth of 1 would keep only the last writer's.
+TF_STATIC_LISTENER = latched(100)

@@ -30,13 +30,12 @@ from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import Imu
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA
+from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA, TF, TF_STATIC
 from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
 from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, quaternion_yaw,
@@ -44,16 +43,6 @@ from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, qu
 from wirefish_tf.tf_messages import tf_message, transform
 from wirefish_tf.tf_node_parameters import (consistent_geometry, GEOMETRY_NAMES, SPECS,
                                             TF_PARAMETERS)
-
-# tf2_ros's TransformBroadcaster and StaticTransformBroadcaster profiles.
-TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-TF_STATIC_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
-# tf2_ros's static listener: deep enough to keep every latched /tf_static message when
-# several broadcasters (a fleet's tf_nodes) answer one late subscriber at once; a depth of 1
-# would keep only the last writer's mounts.
-TF_STATIC_LISTENER_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
-                                    durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 # A second of the virtual fish's 50 Hz ground truth: a tf_node starved for a moment on a
@@ -83,8 +72,8 @@ class TfNode(Node):
         self._speed = 0.0
         self._last_imu_s: float | None = None
         self._last_odom_s = -math.inf
-        self._tf_pub = self.create_publisher(TFMessage, '/tf', TF_QOS)
-        self._static_pub = self.create_publisher(TFMessage, '/tf_static', TF_STATIC_QOS)
+        self._tf_pub = self.create_publisher(TFMessage, '/tf', TF)
+        self._static_pub = self.create_publisher(TFMessage, '/tf_static', TF_STATIC)
         self.create_subscription(BodyWave, 'body_wave', self._on_body_wave, SENSOR_DATA)
         self.create_subscription(Odometry, 'sim/ground_truth', self._on_ground_truth,
                                  GROUND_TRUTH_QOS)

@@ -55,7 +55,7 @@ from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare
-from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_common.qos import RELIABLE, SENSOR_DATA, TF
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
 from wirefish_view.client_input import check_advertised, cmd_vel_from_client
@@ -66,8 +66,6 @@ from wirefish_view.view_node_parameters import VIEW_PARAMETERS
 from wirefish_view.web import DashboardServer
 
 GLOBAL_TOPICS = ('/tf', '/tf_static', '/diagnostics')
-# tf2_ros's listener profile (matches tf_node's broadcaster).
-TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 SERVICE_WAIT_S = 5.0
 # view/retune: state sent | running (iteration, max_iterations, best_loss) | rejected | done
 # (success, message, applied, loss, iterations, from_library, rmse_theta_deg).
@@ -337,7 +335,7 @@ class ViewNode(Node):
             self._scene_inputs = [
                 self.create_subscription(BodyWave, 'body_wave', self._on_body_wave,
                                          SENSOR_DATA),
-                self.create_subscription(TFMessage, '/tf', self._on_tf, TF_QOS)]
+                self.create_subscription(TFMessage, '/tf', self._on_tf, TF)]
         elif not watched:
             for subscription in self._scene_inputs:
                 self.destroy_subscription(subscription)
