@@ -68,6 +68,8 @@ def _name(proc: psutil.Process) -> str:
         command = proc.cmdline()
     except psutil.Error:
         return '?'
+    if not command:  # a process already exiting has no command line left
+        return '?'
     if len(command) > 2 and command[1] == '-m':
         return command[2]
     return Path(command[1] if len(command) > 1 and 'python' in command[0] else command[0]).name
