@@ -13,7 +13,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
 from wirefish_bringup.graph import composable_entries, COMPOSED_NAME, fish_graph, Role
-from wirefish_common.startup_signals import held_start_prefix
+from wirefish_common.startup_signals import held_start_prefix, stop_signals_blocked
 from wirefish_launcher.supervisor import Supervisor
 
 pytestmark = pytest.mark.ros
@@ -86,13 +86,10 @@ def test_a_stop_sent_as_the_launcher_starts_a_process_ends_it_with_0_and_no_trac
 
 
 def _wait_until_blocked(pid: int, timeout_s: float = 10.0) -> bool:
-    """Wait until process ``pid`` has SIGINT blocked (env did it and execs the node)."""
+    """Wait until process ``pid`` has the stop signals blocked (env did it, execs the node)."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
-        status = Path(f'/proc/{pid}/status').read_text()
-        blocked = int(next(line.split()[1] for line in status.splitlines()
-                           if line.startswith('SigBlk:')), 16)
-        if blocked >> (signal.SIGINT - 1) & 1:
+        if stop_signals_blocked(Path(f'/proc/{pid}/status').read_text()):
             return True
         time.sleep(0.0005)
     return False

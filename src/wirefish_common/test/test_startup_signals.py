@@ -6,7 +6,8 @@ import subprocess
 import sys
 
 from wirefish_common import startup_signals
-from wirefish_common.startup_signals import block_stop_signals, held_start_prefix
+from wirefish_common.startup_signals import (block_stop_signals, held_start_prefix,
+                                             stop_signals_blocked)
 
 REPORT = ('import signal\n'
           'blocked = signal.pthread_sigmask(signal.SIG_BLOCK, [])\n'
@@ -46,3 +47,9 @@ def test_without_either_nothing_is_blocked():
 def test_an_env_that_does_not_block_gives_no_prefix(monkeypatch):
     monkeypatch.setattr(startup_signals, '_HELD_START', ('--default-signal=INT,TERM',))
     assert startup_signals.held_start_prefix() is None
+
+
+def test_a_status_without_both_blocked_is_not_held():
+    assert stop_signals_blocked('SigBlk:\t0000000000004002\n')
+    assert not stop_signals_blocked('SigBlk:\t0000000000000002\n')
+    assert not stop_signals_blocked('Name:\tx\n')

@@ -65,6 +65,13 @@ def hold_stop_signals_for(*executables: str) -> None:
         release_stop_signals()
 
 
+def stop_signals_blocked(proc_status: str) -> bool:
+    """Whether a ``/proc/<pid>/status`` text shows SIGINT and SIGTERM both blocked."""
+    masks = [line.split()[1] for line in proc_status.splitlines() if line.startswith('SigBlk:')]
+    blocked = int(masks[0], 16) if masks else 0
+    return all(blocked >> (signum - 1) & 1 for signum in STOP_SIGNALS)
+
+
 def held_start_prefix() -> str | None:
     """
     Return a command prefix that starts a process with SIGINT/SIGTERM blocked, for launch_ros.
@@ -83,10 +90,8 @@ def held_start_prefix() -> str | None:
     try:
         status = subprocess.run([env, *_HELD_START, 'cat', '/proc/self/status'], check=True,
                                 capture_output=True, text=True, timeout=10.0).stdout
-        blocked = int(next(line.split()[1] for line in status.splitlines()
-                           if line.startswith('SigBlk:')), 16)
-    except (OSError, subprocess.SubprocessError, StopIteration, IndexError, ValueError):
+    except (OSError, subprocess.SubprocessError):
         return None
-    if not all(blocked >> (signum - 1) & 1 for signum in STOP_SIGNALS):
+    if not stop_signals_blocked(status):
         return None
     return shlex.join([env, *_HELD_START])

@@ -6,9 +6,8 @@ its own session (so a terminal's Ctrl-C reaches only the supervisor, which then 
 SIGINT to each child, in reverse start order), with a parent-death signal (so no child outlives
 a supervisor that was killed) and, for the registry's executables, SIGINT/SIGTERM blocked until
 the child's handler is in place (``wirefish_common.startup_signals``: no stop is lost or turned
-into a trace during start-up),
-its output in a log file of its own, restarted by its restart policy when it exits while the
-graph runs.
+into a trace during start-up), its output in a log file of its own, restarted by its restart
+policy when it exits while the graph runs.
 """
 
 from collections.abc import Sequence
