@@ -16,6 +16,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "wf/health.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -44,13 +46,27 @@ bool wf_hal_pwm_init(uint32_t frame_hz);
 void wf_hal_pwm_set_compare(unsigned servo, uint32_t compare_ticks);
 
 /* One I2C transaction with the 7-bit address: writes tx_len bytes, then (repeated start) reads
- * rx_len bytes. Returns false on NACK, bus error or timeout; rx is then unspecified. */
+ * rx_len bytes. Returns false on NACK, bus error or timeout; rx is then unspecified. Bounded: a
+ * stuck or absent device costs at most a few ms. After a failure, and when it finds the bus
+ * busy, the port runs the bus recovery (wf/i2c_bus.h) itself, so the next call starts from an
+ * idle bus: the core only retries. */
 bool wf_hal_i2c_transfer(uint8_t address7, const uint8_t *tx, size_t tx_len, uint8_t *rx,
                          size_t rx_len);
 
 /* The battery voltage divider's ADC reading, 12-bit (0..4095), or a negative value when no
  * conversion is available. */
 int32_t wf_hal_adc_battery_raw(void);
+
+/* Fills the fields of *health that only the port knows and leaves every other one as it is:
+ * reset_cause and the fault record (fault_pc, fault_lr, fault_cfsr, fault_hfsr and
+ * WF_HEALTH_FAULT_RECORD: read once at boot, then the same every call), clock_source, the
+ * flags WF_HEALTH_BOR_LEVEL3, WF_HEALTH_CSS_ON and WF_HEALTH_STACK_GUARD, stack_free_min and
+ * stack_size (bytes; 0, 0 when the port cannot tell), uart_rx_overruns, i2c_bus_recoveries.
+ * The core calls it before it packs each HEALTH message, and at wf_app_init: the clock source
+ * does not change without a reset, so WF_STATUS_CLOCK_FALLBACK (clock_source HSI_PLL or HSI)
+ * can be taken from that first call. Cheap enough for every poll (no bus transfer; the stack
+ * scan reads at most the stack's 2 KB once), never called from an interrupt. */
+void wf_hal_health_port(wf_health_t *health);
 
 #ifdef __cplusplus
 }

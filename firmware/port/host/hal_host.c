@@ -1,8 +1,12 @@
 /* The POSIX port of wf/hal.h: a settable clock, byte queues for the UART, recorded PWM
- * compares, I2C routed to a pluggable device model, a settable ADC reading. */
+ * compares, I2C routed to a pluggable device model, a settable ADC reading, and a model of the
+ * stm32f4 port's reset path (reset flags, the fault record that survives a reset, the fault
+ * handler's neutral compares) and of its I2C bus recovery. */
 #include <string.h>
 
+#include "wf/fault_record.h"
 #include "wf/hal.h"
+#include "wf/i2c_bus.h"
 #include "wf_host.h"
 
 static struct {
@@ -18,11 +22,134 @@ static struct {
     int32_t adc_raw;
 } board;
 
+/* What survives a reset that is not a power cycle: the stm32f4 port's .noinit record and the
+ * reset flags its RCC_CSR holds for the next boot; and what the port decided at boot. */
+static struct {
+    wf_fault_record_t record;
+    uint32_t reset_flags;
+    uint32_t failsafe[WF_SERVO_COUNT];
+    wf_health_t health; /* the port's fields only */
+    wf_host_i2c_lines_fn lines;
+    void *lines_context;
+} port;
+
 void wf_host_reset(void)
 {
     memset(&board, 0, sizeof board);
     board.tx_capacity = WF_HOST_TX_CAPACITY;
     board.adc_raw = 3392;
+    memset(&port, 0, sizeof port);
+    /* A power cycle: RAM holds nothing valid; power-on sets POR, BOR and PIN (RM0090 7.3.21). */
+    port.reset_flags = WF_RESET_FLAG_POR | WF_RESET_FLAG_BOR | WF_RESET_FLAG_PIN;
+}
+
+/* --- the reset path ------------------------------------------------------------------- */
+static void recover_bus(void);
+
+void wf_host_boot(void)
+{
+    const uint16_t recoveries = port.health.i2c_bus_recoveries;
+    memset(&port.health, 0, sizeof port.health);
+    port.health.i2c_bus_recoveries = recoveries;
+    wf_reset_cause_decide(port.reset_flags, &port.record, &port.health);
+    port.reset_flags = 0u; /* RMVF */
+    port.health.clock_source = WF_CLOCK_EMULATED;
+    recover_bus(); /* the stm32f4 port's I2C init runs the recovery too */
+}
+
+void wf_host_set_failsafe_compares(const uint32_t compare[WF_SERVO_COUNT])
+{
+    memcpy(port.failsafe, compare, sizeof port.failsafe);
+}
+
+void wf_host_fault(uint32_t pc, uint32_t lr, uint32_t cfsr, uint32_t hfsr)
+{
+    for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
+        board.compare[i] = port.failsafe[i];
+    }
+    wf_fault_record_save(&port.record, WF_RESET_FAULT, pc, lr, cfsr, hfsr);
+    port.reset_flags |= WF_RESET_FLAG_SOFTWARE | WF_RESET_FLAG_PIN;
+}
+
+void wf_host_watchdog_reset(void)
+{
+    port.reset_flags |= WF_RESET_FLAG_IWDG | WF_RESET_FLAG_PIN;
+}
+
+void wf_host_set_reset_flags(uint32_t flags) { port.reset_flags = flags; }
+
+void wf_host_set_uart_overruns(uint32_t count) { port.health.uart_rx_overruns = count; }
+
+void wf_hal_health_port(wf_health_t *health)
+{
+    const wf_health_t *p = &port.health;
+    health->reset_cause = p->reset_cause;
+    health->clock_source = p->clock_source;
+    health->flags = (uint8_t)((health->flags & ~(WF_HEALTH_FAULT_RECORD | WF_HEALTH_BOR_LEVEL3 |
+                                                 WF_HEALTH_CSS_ON | WF_HEALTH_STACK_GUARD)) |
+                              p->flags);
+    health->fault_pc = p->fault_pc;
+    health->fault_lr = p->fault_lr;
+    health->fault_cfsr = p->fault_cfsr;
+    health->fault_hfsr = p->fault_hfsr;
+    health->stack_free_min = 0;
+    health->stack_size = 0;
+    health->uart_rx_overruns = p->uart_rx_overruns;
+    health->i2c_bus_recoveries = p->i2c_bus_recoveries;
+}
+
+/* --- the I2C lines, for the bus recovery ------------------------------------------------ */
+void wf_host_set_i2c_lines(wf_host_i2c_lines_fn lines, void *context)
+{
+    port.lines = lines;
+    port.lines_context = context;
+}
+
+static int line(int op) { return port.lines(port.lines_context, op); }
+static void host_scl(void *context, bool high)
+{
+    (void)context;
+    (void)line(high ? WF_HOST_SCL_RELEASE : WF_HOST_SCL_LOW);
+}
+static void host_sda(void *context, bool high)
+{
+    (void)context;
+    (void)line(high ? WF_HOST_SDA_RELEASE : WF_HOST_SDA_LOW);
+}
+static bool host_scl_high(void *context)
+{
+    (void)context;
+    return line(WF_HOST_READ_SCL) != 0;
+}
+static bool host_sda_high(void *context)
+{
+    (void)context;
+    return line(WF_HOST_READ_SDA) != 0;
+}
+static void host_half_bit(void *context)
+{
+    (void)context;
+    (void)line(WF_HOST_HALF_BIT);
+}
+
+static bool bus_idle(void)
+{
+    return port.lines == NULL || (host_scl_high(NULL) && host_sda_high(NULL));
+}
+
+/* The stm32f4 port's rule: a recovery counts when it found the bus held. */
+static void recover_bus(void)
+{
+    if (port.lines == NULL) {
+        return;
+    }
+    const bool held = !bus_idle();
+    static const wf_i2c_lines_t lines = {NULL, host_scl, host_sda, host_scl_high, host_sda_high,
+                                         host_half_bit};
+    (void)wf_i2c_bus_recover(&lines);
+    if (held) {
+        port.health.i2c_bus_recoveries++;
+    }
 }
 
 void wf_host_set_millis(uint32_t now_ms) { board.now_ms = now_ms; }
@@ -107,10 +234,20 @@ void wf_hal_pwm_set_compare(unsigned servo, uint32_t compare_ticks)
 bool wf_hal_i2c_transfer(uint8_t address7, const uint8_t *tx, size_t tx_len, uint8_t *rx,
                          size_t rx_len)
 {
+    if (!bus_idle()) {
+        recover_bus(); /* the stm32f4 port's BUSY check */
+        if (!bus_idle()) {
+            return false;
+        }
+    }
     if (board.i2c == NULL) {
         return false; /* no device on the bus: NACK */
     }
-    return board.i2c(board.i2c_context, address7, tx, tx_len, rx, rx_len);
+    const bool ok = board.i2c(board.i2c_context, address7, tx, tx_len, rx, rx_len);
+    if (!ok) {
+        recover_bus();
+    }
+    return ok;
 }
 
 int32_t wf_hal_adc_battery_raw(void) { return board.adc_raw; }

@@ -12,7 +12,9 @@ void wf_host_board_init(const wf_config_t *config)
         wf_config_defaults(&defaults);
         config = &defaults;
     }
+    wf_host_boot();
     wf_app_init(&the_app, config);
+    wf_host_set_failsafe_compares(the_app.compare); /* what a fault handler writes */
 }
 
 size_t wf_host_board_step(uint32_t t, const uint8_t *in, size_t len, uint8_t *out, size_t cap)

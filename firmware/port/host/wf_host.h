@@ -40,6 +40,35 @@ size_t wf_host_take_output(uint8_t *out, size_t max);
 uint32_t wf_host_compare(unsigned servo);
 uint32_t wf_host_pwm_frame_hz(void);
 
+/* The I2C lines as open-drain GPIO, for the bus recovery (wf/i2c_bus.h): the model answers
+ * one operation at a time; the READ operations return the line's level (0 low, 1 high). With
+ * no lines set the bus always reads idle. */
+enum {
+    WF_HOST_SCL_LOW = 0,
+    WF_HOST_SCL_RELEASE = 1,
+    WF_HOST_SDA_LOW = 2,
+    WF_HOST_SDA_RELEASE = 3,
+    WF_HOST_READ_SCL = 4,
+    WF_HOST_READ_SDA = 5,
+    WF_HOST_HALF_BIT = 6,
+};
+typedef int (*wf_host_i2c_lines_fn)(void *context, int op);
+void wf_host_set_i2c_lines(wf_host_i2c_lines_fn lines, void *context);
+
+/* The stm32f4 port's reset path, modelled. wf_host_reset is a power cycle (reset flags POR,
+ * BOR, PIN; no record). wf_host_fault does what the port's fault handler does (both compares
+ * to the failsafe values, the record saved, a software reset requested); wf_host_watchdog_reset
+ * what the IWDG does; wf_host_set_reset_flags sets RCC_CSR's flags (wf/fault_record.h) for the
+ * next boot. wf_host_boot is the port's start-up (reset cause from the flags and the record,
+ * flags cleared, I2C bus recovery): wf_host_board_init calls it before wf_app_init, and then
+ * gives the neutral compares to wf_host_set_failsafe_compares as the port's main does. */
+void wf_host_boot(void);
+void wf_host_fault(uint32_t pc, uint32_t lr, uint32_t cfsr, uint32_t hfsr);
+void wf_host_watchdog_reset(void);
+void wf_host_set_reset_flags(uint32_t flags);
+void wf_host_set_failsafe_compares(const uint32_t compare[WF_SERVO_COUNT]);
+void wf_host_set_uart_overruns(uint32_t count);
+
 /* A flat view of a board for tests. */
 typedef struct {
     uint32_t now_ms;
