@@ -20,7 +20,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'recorder = wirefish_bag.record:main',
+            'recorder = wirefish_bag.executables:recorder',
         ],
         'wirefish.commands': [
             'record = wirefish_bag.record',

@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'bridge_node = wirefish_bridge.bridge_node:main',
+            'bridge_node = wirefish_bridge.executables:bridge_node',
         ],
     },
 )

@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'cpg_node = wirefish_cpg.cpg_node:main',
+            'cpg_node = wirefish_cpg.executables:cpg_node',
         ],
     },
 )

@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'kinematics_node = wirefish_kinematics.kinematics_node:main',
+            'kinematics_node = wirefish_kinematics.executables:kinematics_node',
         ],
     },
 )

@@ -20,8 +20,8 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'qemu_board = wirefish_launcher.qemu_board:main',
-            'compose = wirefish_launcher.compose:main',
+            'qemu_board = wirefish_launcher.executables:qemu_board',
+            'compose = wirefish_launcher.executables:compose',
         ],
         'wirefish.commands': [
             'up = wirefish_launcher.launcher',

@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'planner_node = wirefish_planner.planner_node:main',
+            'planner_node = wirefish_planner.executables:planner_node',
         ],
     },
 )

@@ -20,7 +20,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'link_relay = wirefish_relay.link_relay:main',
+            'link_relay = wirefish_relay.executables:link_relay',
         ],
     },
 )

@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'fish_sim = wirefish_sim.fish_sim:main',
+            'fish_sim = wirefish_sim.executables:fish_sim',
         ],
     },
 )

@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'tf_node = wirefish_tf.tf_node:main',
+            'tf_node = wirefish_tf.executables:tf_node',
         ],
     },
 )

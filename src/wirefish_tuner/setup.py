@@ -19,7 +19,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'tuner_node = wirefish_tuner.tuner_node:main',
+            'tuner_node = wirefish_tuner.executables:tuner_node',
         ],
     },
 )

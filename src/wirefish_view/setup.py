@@ -25,7 +25,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'view_node = wirefish_view.view_node:main',
+            'view_node = wirefish_view.executables:view_node',
         ],
         'wirefish.commands': [
             'view = wirefish_view.view_command',

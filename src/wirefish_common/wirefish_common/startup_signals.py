@@ -2,20 +2,20 @@
 A Ctrl-C while a node's process is still importing is kept, not a KeyboardInterrupt trace.
 
 A node's process spends its first second or more importing (rclpy, numpy, the messages)
-before ``SignalShutdown`` is installed; Python's default SIGINT handler then raised
-KeyboardInterrupt in the middle of an import: a traceback and exit -2. The package of each
-node executable calls ``hold_stop_signals_for`` from its ``__init__`` (the first of its modules
-any entry point imports), which, only in a process started as one of those executables, makes
-SIGINT and SIGTERM be recorded in ``received`` instead; ``SignalShutdown`` takes them over as a
-stop request, so the node stops at once after start-up with exit code 0. A process that
-imports the package for another reason (a test, a tool) keeps its own handlers.
+before ``SignalShutdown`` is installed; Python's default SIGINT handler would raise
+KeyboardInterrupt in the middle of an import: a traceback and exit -2. Each executable's entry
+point (the function ``console_scripts`` names, in its package's ``executables`` module) calls
+``hold_stop_signals`` before it imports its node's module: from then on SIGINT and SIGTERM are
+recorded in ``received``, and ``SignalShutdown`` takes them over as a stop request, so the node
+stops at once after start-up with exit code 0. Importing a package changes no handler: only a
+process started as one of the executables holds its stops.
 
 That leaves the interpreter's own start-up and the entry-point script's imports before the
-package (``importlib.metadata``): tens of milliseconds in which nothing of ours runs yet. A
-launcher closes them: it starts the process with both signals blocked
+entry point runs (``importlib.metadata``): tens of milliseconds in which nothing of ours runs
+yet. A launcher closes them: it starts the process with both signals blocked
 (``block_stop_signals`` between fork and exec; a blocked signal stays pending across exec),
 and the process releases them (``release_stop_signals``) once its own handler is in place,
-from ``hold_stop_signals_for``, ``SignalShutdown`` or a handler of its own; a signal that came
+from ``hold_stop_signals``, ``SignalShutdown`` or a handler of its own; a signal that came
 meanwhile is delivered then, to that handler. `wirefish up` starts every process of the
 registry so; the launch file starts them through ``held_start_prefix`` (coreutils' ``env``
 blocking both before it execs the node). A process started with the default disposition
@@ -24,9 +24,7 @@ blocking both before it execs the node). A process started with the default disp
 
 from __future__ import annotations
 
-import os
 import signal
-import sys
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # coreutils >= 8.31 (Ubuntu 24.04: 9.4): env resets their action, blocks them, execs the node
@@ -57,12 +55,16 @@ def release_stop_signals() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
 
 
-def hold_stop_signals_for(*executables: str) -> None:
-    """Record SIGINT/SIGTERM in ``received`` if this process runs one of ``executables``."""
-    if os.path.basename(sys.argv[0] if sys.argv else '') in executables:
-        for signum in STOP_SIGNALS:
-            signal.signal(signum, _keep)
-        release_stop_signals()
+def hold_stop_signals() -> None:
+    """
+    Record SIGINT/SIGTERM in ``received`` from now on, and release them if a launcher held them.
+
+    For an executable's entry point, before it imports its node: ``SignalShutdown`` (or the
+    process's own handler, which then reads ``received``) acts on them once it is in place.
+    """
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, _keep)
+    release_stop_signals()
 
 
 def stop_signals_blocked(proc_status: str) -> bool:
