@@ -22,6 +22,7 @@ CONTRACTS = ROOT / 'docs' / 'CONTRACTS.md'
 REFERENCE = ROOT / 'docs' / 'REFERENCE.md'
 FAULTS = ROOT / 'docs' / 'FAULTS.md'
 SIM_README = SRC / 'wirefish_sim' / 'README.md'
+BOOTSTRAP = ROOT / 'tools' / 'bootstrap.sh'
 DOCS = (ARCHITECTURE, CONTRACTS)
 # Every document a user reads: its cited files and its relative links must exist.
 USER_DOCS = (README, ARCHITECTURE, CONTRACTS, REFERENCE, FAULTS,
@@ -120,6 +121,68 @@ def _dotted_problem(dotted: str) -> str | None:
 @pytest.mark.parametrize('package', _packages())
 def test_every_package_has_its_row_in_the_architecture(package):
     assert f'| `{package}` |' in _text(ARCHITECTURE)
+
+
+def readme_packages(text: str) -> list[str]:
+    """Return the packages the first column of README.md's package table names, in order."""
+    rows = [line.split('|')[1] for line in text.splitlines()
+            if line.startswith('| ') and 'wirefish_' in line.split('|')[1]]
+    return [name for row in rows for name in re.findall(r'`(wirefish_\w+)`', row)]
+
+
+def reference_packages(text: str) -> list[str]:
+    """Return the packages REFERENCE.md's source layout names (lines ``src/wirefish_x ...``)."""
+    return [name for line in text.splitlines() if line.startswith('src/wirefish_')
+            for name in re.findall(r'src/(wirefish_\w+)', line.split('  ')[0])]
+
+
+PACKAGE_LISTS = ((README, readme_packages), (REFERENCE, reference_packages))
+
+
+@pytest.mark.parametrize('doc, listed', PACKAGE_LISTS, ids=[d.name for d, _ in PACKAGE_LISTS])
+def test_the_package_list_names_every_package_once(doc, listed):
+    names = listed(_text(doc))
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    missing, unknown = set(_packages()) - set(names), set(names) - set(_packages())
+    assert names and not (missing or unknown or repeated), (
+        f'{doc.name}: the package list misses {sorted(missing)}, '
+        f'no such package {sorted(unknown)}, named twice {repeated}')
+
+
+def test_a_package_list_is_read_from_its_table_and_its_layout():
+    table = ('| package | what |\n|---|---|\n| [`wirefish_cpg`](x) | the CPG |\n'
+             '| `wirefish_bag`, `wirefish_operator` | verbs |\n| `other` | `wirefish_tf` |\n')
+    layout = ('src/wirefish_msgs         msgs\nsrc/wirefish_fish, src/wirefish_shore   hosts\n'
+              'test/                     not src/wirefish_x\n')
+    assert readme_packages(table) == ['wirefish_cpg', 'wirefish_bag', 'wirefish_operator']
+    assert reference_packages(layout) == ['wirefish_msgs', 'wirefish_fish', 'wirefish_shore']
+
+
+def setup_needs(bootstrap: str) -> list[str]:
+    """Return the commands ``tools/bootstrap.sh`` stops without (its ``need CMD PKG`` lines)."""
+    return re.findall(r'(?m)^need (\S+) \S+$', bootstrap)
+
+
+def readme_setup_needs(readme: str) -> str:
+    """Return README.md's paragraph that begins "Setup needs"."""
+    match = re.search(r'(?ms)^Setup needs.*?(?:\n\n|\Z)', readme)
+    assert match, 'README.md has no "Setup needs" paragraph'
+    return match.group(0)
+
+
+def test_the_readme_names_every_tool_the_setup_stops_without():
+    bootstrap = _text(BOOTSTRAP)
+    needs, paragraph = setup_needs(bootstrap), readme_setup_needs(_text(README))
+    python = re.search(r'WIREFISH_PYTHON:-python(3\.\d+)', bootstrap)
+    missing = [cmd for cmd in needs if f'`{cmd}`' not in paragraph]
+    assert needs and python, 'tools/bootstrap.sh: no need lines or no default Python'
+    assert not missing and f'CPython {python.group(1)}' in paragraph, (
+        f'README.md "Setup needs" leaves out {missing} (or CPython {python.group(1)})')
+
+
+def test_a_setup_need_is_read_from_the_bootstrap():
+    assert setup_needs('need cmake cmake\nneed c++ g++\n  need x y\nneeded z\n') == [
+        'cmake', 'c++']
 
 
 @pytest.mark.parametrize('doc', DOCS, ids=[d.name for d in DOCS])
