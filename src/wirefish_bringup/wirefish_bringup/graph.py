@@ -20,7 +20,7 @@ retries are spent.
 """
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import enum
 import math
 from pathlib import Path
@@ -187,11 +187,10 @@ NODES: tuple[NodeEntry, ...] = (
     # The TF tree (/tf, /tf_static): odom -> base_link, the mounts and the tail's frames.
     NodeEntry('wirefish_tf', 'tf_node', 'tf_node', start_order=32,
               node_class='wirefish_tf.tf_node:TfNode', frames=True),
-    # rest_at_start false: cpg_node keeps the default gait until the first cmd_vel (the graph's
-    # other users expect it); the cmd_vel timeout still rests the fish when commands stop.
+    # The fish starts still: cpg_node's autostart is false (config/wirefish.yaml) and the planner
+    # holds the targets at rest (rest_at_start) until the first command, when it starts the CPG.
     NodeEntry('wirefish_planner', 'planner_node', 'planner_node', start_order=35,
-              node_class='wirefish_planner.planner_node:PlannerNode',
-              parameters={'rest_at_start': 'false'}, fed_by=('bridge_node',)),
+              node_class='wirefish_planner.planner_node:PlannerNode', fed_by=('bridge_node',)),
     NodeEntry('wirefish_tuner', 'tuner_node', 'tuner_node', start_order=40,
               node_class='wirefish_tuner.tuner_node:TunerNode', own_executor=True,
               role=Role.SHORE),
@@ -444,6 +443,44 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
             ros_nodes=tuple(e.name for e in composed)))
         specs.sort(key=lambda s: _start_order(s, composed))
     return specs
+
+
+# On the simulated-time road a step of fish_sim's clock waits for the bridge's SERVO_CMD, so
+# the bridge's rate limit (100 Hz of wall time) would cap `--speed max` near real time: there
+# it is set to the parameter's most (at most 10 times real time), and the lockstep paces it.
+SIM_TIME_COMMAND_RATE_HZ = '1000.0'
+
+
+def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
+    """
+    Return a virtual-fish graph's processes with fish_sim owning the clock at ``speed``.
+
+    fish_sim gets ``--speed`` (it publishes /clock and steps in lockstep with the host's
+    SERVO_CMD, ``wirefish_sim.lockstep``); every other ROS node of the graph gets
+    ``use_sim_time`` (the single-process host: ``--sim-time``), so its timers, stamps and
+    timeouts run on simulated time; the bridge's command rate limit is lifted to its most
+    above real time (``SIM_TIME_COMMAND_RATE_HZ``). ``speed`` is ``--speed``'s text (``1``,
+    ``4``, ``max``). A process that parses its own options (the recorder) keeps the wall clock
+    for its receive times; the messages it records carry simulated stamps.
+    """
+    simulator = entry('fish_sim')
+    if not any(s.executable == simulator.executable and s.package == simulator.package
+               for s in specs):
+        raise ValueError("simulated time is the virtual fish's clock: this graph has none")
+    faster = speed.strip().lower() == 'max' or float(speed) > 1.0
+    timed = []
+    for spec in specs:
+        if (spec.package, spec.executable) == (simulator.package, simulator.executable):
+            spec = replace(spec, arguments=(*spec.arguments, '--speed', speed))
+        elif spec.name == COMPOSED_NAME:
+            spec = replace(spec, arguments=(*spec.arguments, '--sim-time'))
+        elif spec.namespace is not None:
+            extra = {'use_sim_time': 'true'}
+            if spec.executable == 'bridge_node' and faster:
+                extra['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
+            spec = replace(spec, parameters={**spec.parameters, **extra})
+        timed.append(spec)
+    return timed
 
 
 def _start_order(spec: NodeSpec, composed: list[NodeEntry]) -> int:

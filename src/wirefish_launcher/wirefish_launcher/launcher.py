@@ -18,6 +18,7 @@ import os
 from pathlib import Path
 import sys
 import time
+from typing import Any
 
 from wirefish_bringup.dds_profile import graph_environment, write_profile
 from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, Role,
@@ -95,9 +96,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--view', action='store_true',
                         help='also the live view: Foxglove WebSocket server and dashboard '
                         '(wirefish view; view_node parameters port, http_port)')
+    parser.add_argument('--start-swimming', action='store_true',
+                        help="swim the parameter file's gait from start-up (default: the fish "
+                        'starts still, the servos at neutral until the first cmd_vel, retune '
+                        'applied or start service)')
+    parser.add_argument('--view-port', type=port_number, default=None, metavar='PORT',
+                        help="with --view: the Foxglove WebSocket port (view_node's port, "
+                        'default 8765)')
+    parser.add_argument('--view-http-port', type=port_number, default=None, metavar='PORT',
+                        help="with --view: the dashboard's HTTP port (view_node's http_port, "
+                        'default 8080)')
+    parser.add_argument('--baud', type=int, default=None,
+                        help="the serial link's baud rate (bridge_node's baudrate, default "
+                        '115200)')
     parser.add_argument('--allow-duplicate', action='store_true',
                         help='start even if nodes of the graph already run in this namespace '
                         '(e.g. a graph that just died is still discovered)')
+
+
+def port_number(text: str) -> int:
+    """Return a TCP port option: a whole number in 1..65535 (argparse type)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a port number: {text!r}') from None
+    if not 1 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f'a port is 1..65535, got {value}')
+    return value
 
 
 def fleet_size(text: str) -> int:
@@ -183,6 +208,68 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
     return '\n'.join([f'nodes: {", ".join(sorted(expected()))}', *live.lines()]), live
 
 
+def _effective_params(args: argparse.Namespace, run_dir: Path
+                      ) -> tuple[Path, dict, dict]:
+    """
+    Write the run's parameter file: the defaults, the user's file and the options on top.
+
+    Returns (its path, the user's file as read, the merged content). The user's file overrides
+    only what it names (``params_overlay``); the options --start-swimming, --view-port,
+    --view-http-port and --baud are values on top of both.
+    """
+    import yaml
+    from wirefish_bringup.graph import default_params_file
+    from wirefish_launcher.params_overlay import overlaid
+
+    defaults = yaml.safe_load(default_params_file().read_text(encoding='utf-8'))
+    user = (yaml.safe_load(args.params_file.read_text(encoding='utf-8'))
+            if args.params_file is not None else {})
+    options: dict[str, dict] = {}
+
+    def put(key: str, name: str, value: object) -> None:
+        options.setdefault(key, {'ros__parameters': {}})['ros__parameters'][name] = value
+
+    if args.start_swimming:
+        put('/**/cpg_node', 'autostart', True)
+        put('/**/planner_node', 'rest_at_start', False)
+    if args.view_port is not None:
+        put('/**/view_node', 'port', args.view_port)
+    if args.view_http_port is not None:
+        put('/**/view_node', 'http_port', args.view_http_port)
+    if args.baud is not None:
+        put('/**/bridge_node', 'baudrate', args.baud)
+    merged = overlaid(overlaid(defaults, user), options)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    path = run_dir / 'params.yaml'
+    path.write_text('# wirefish up: the installed defaults, --params-file and the options on '
+                    'top\n' + yaml.safe_dump(merged, sort_keys=False), encoding='utf-8')
+    return path, user, merged
+
+
+def _view_ports_problem(params: dict, namespace: str) -> str | None:
+    """Return why the live view's ports cannot be bound on this machine (in use), or None."""
+    import socket
+    from wirefish_launcher.params_overlay import matched_nodes
+
+    values: dict[str, Any] = {'port': 8765, 'http_port': 8080, 'address': '127.0.0.1'}
+    view_node = f'{namespace.rstrip("/")}/view_node'
+    for key, block in params.items():  # later keys of the file win, as rcl reads them
+        if matched_nodes(key, [view_node]):
+            values.update((k, v) for k, v in block['ros__parameters'].items() if k in values)
+    for name, flag in (('port', '--view-port'), ('http_port', '--view-http-port')):
+        if int(values[name]) <= 0:  # 0: any free port; -1: no dashboard
+            continue
+        with socket.socket() as probe:
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                probe.bind((str(values['address']), int(values[name])))
+            except OSError as error:
+                return (f'the live view cannot bind {values["address"]}:{values[name]} '
+                        f'({error.strerror}; another `wirefish view` or `wirefish up --view`?): '
+                        f'give {flag} another port')
+    return None
+
+
 def _report(lines: list[str]) -> None:
     for line in lines:
         print(f'wirefish up: {line}', file=sys.stderr, flush=True)
@@ -229,6 +316,12 @@ def _run(args: argparse.Namespace) -> int:
     stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
     run_dir = (args.out / f'run_{stamp}').resolve()
     bag_path = run_dir / 'bag' if args.duration else None
+    if args.params_file is not None:
+        problem = params_file_problem(args.params_file)
+        if problem is not None:
+            print(f'wirefish up: {problem}', file=sys.stderr)
+            return 2
+    params_file, user_params, merged_params = _effective_params(args, run_dir)
     try:
         if bag_path is not None and importlib.util.find_spec('wirefish_bag') is None:
             # A fish install has no bag library (the fish records nothing: the shore does).
@@ -243,11 +336,11 @@ def _run(args: argparse.Namespace) -> int:
                                  'with frames fish_<i>/...: no --port, --single-process or '
                                  '--frame-prefix with it')
             from wirefish_bringup.fleet import fleet_graph
-            specs = fleet_graph(namespace, args.fleet, params_file=args.params_file,
+            specs = fleet_graph(namespace, args.fleet, params_file=params_file,
                                 bag=bag_path, role=args.role)
         else:
             specs = fish_graph(namespace, sim=sim, port=args.port,
-                               params_file=args.params_file, single_process=args.single_process,
+                               params_file=params_file, single_process=args.single_process,
                                bag=bag_path, role=args.role, frame_prefix=args.frame_prefix,
                                qemu=qemu, view=args.view)
             if qemu:
@@ -260,10 +353,15 @@ def _run(args: argparse.Namespace) -> int:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 1
     problem = ((serial_port_problem(args.port) if args.port is not None else None)
-               or (params_file_problem(args.params_file) if args.params_file else None))
+               or (_view_ports_problem(merged_params, namespace) if args.view else None))
     if problem is not None:
         print(f'wirefish up: {problem}', file=sys.stderr)
         return 2
+    from wirefish_launcher.params_overlay import unused_entries
+    for warning in unused_entries(user_params, [name for spec in specs
+                                                for name in _node_names(spec, namespace)]):
+        print(f'wirefish up: warning: --params-file {args.params_file}: {warning}',
+              file=sys.stderr)
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
@@ -304,9 +402,8 @@ def _run(args: argparse.Namespace) -> int:
             print(f'started {len(supervisor.processes)} processes in {namespace}; '
                   f'logs in {run_dir / "logs"}', flush=True)
             if any('tuner_node' in spec.ros_nodes for spec in specs):
-                from wirefish_bringup.graph import default_params_file
                 from wirefish_cpg.gait_library import tuner_library_path
-                library = tuner_library_path(args.params_file or default_params_file())
+                library = tuner_library_path(params_file)
                 print(f'gait library: {library}', flush=True)
             status, measured = _wait_ready(node, executor, namespace, specs, supervisor,
                                            not args.no_status, stop, role=args.role)
@@ -325,6 +422,10 @@ def _run(args: argparse.Namespace) -> int:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
         else:
             print('running: Ctrl-C stops everything', flush=True)
+            if not args.start_swimming and args.role != Role.SHORE:
+                print('the fish starts still (servos at neutral): `wirefish drive`, a '
+                      '`wirefish retune --apply` or the dashboard set it swimming '
+                      '(--start-swimming: at once)', flush=True)
         started = drawn = time.monotonic()
         # A timed run off a terminal says how far it is (a line per 5 %, with the time left);
         # on a terminal the live status's first line says it.

@@ -80,6 +80,20 @@ def battery_text(message) -> str:
     return ', '.join(parts) or 'unknown'
 
 
+# What the tail does in the planner's modes that do not say it by their name alone.
+MODE_MEANINGS = {
+    'still': 'still: servos at neutral until the first command',
+    'own_gait': 'own_gait: the CPG swims its start-up gait',
+    'rest': 'rest: no swimming command, the tail at rest',
+    'manual': 'manual: the CPG swims a set gait, cmd_vel not followed',
+}
+
+
+def planner_text(state) -> str:
+    """Return the planner's mode as the status shows it: what the tail is doing."""
+    return MODE_MEANINGS.get(state.mode, state.mode)
+
+
 @dataclass
 class _Watched:
     subscription: Any  # an rclpy Subscription (rclpy is imported only when watching)
@@ -164,7 +178,7 @@ class LiveStatus:
                 if name.startswith(f'{self._namespace}/')]
         return (f'link: {link_text(ours)}'
                 f' | battery: {battery_text(battery) if battery else "no battery yet"}'
-                f' | planner: {planner.mode if planner else "no planner_state yet"}')
+                f' | planner: {planner_text(planner) if planner else "no planner_state yet"}')
 
     def lines(self) -> list[str]:
         """Return the header and one line per topic (name, type, rate)."""

@@ -13,6 +13,12 @@ Modes (``PlannerMode``, PlannerState.mode)
     ``open_loop`` ``yaw_control`` off, or no IMU sample for ``imu_timeout_s``: the feed-forward
                   offset of angular.z alone.
     ``manual``    set by planner_node, not by these rules: the CPG is under a manual override.
+    ``still``     set by planner_node: no command since start-up (``rest_at_start``): the CPG
+                  has not been started and the planner holds its targets at rest, so the
+                  servos stay at neutral until the first cmd_vel that asks to move, a manual
+                  override (a retune applied) or the CPG's ``start``.
+    ``own_gait``  set by planner_node: no cmd_vel since start-up with ``rest_at_start`` false:
+                  the CPG swims its start-up parameters (`wirefish up --start-swimming`).
 Speed: ``GaitPlanner.choose`` (eq 18 inverted, ``gait_choice``); turning: ``yaw_control``.
 """
 
@@ -43,6 +49,8 @@ class PlannerMode(enum.StrEnum):
     STRAIGHT = 'straight'
     OPEN_LOOP = 'open_loop'
     MANUAL = 'manual'
+    STILL = 'still'
+    OWN_GAIT = 'own_gait'
 
 
 @dataclass(frozen=True)

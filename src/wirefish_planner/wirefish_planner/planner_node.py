@@ -22,6 +22,11 @@ Drives
     step. At rest (no cmd_vel yet, or none for ``cmd_vel_timeout_s``) the amplitudes and offsets
     are 0, the frequency and couplings those the CPG runs (``rest_at_start`` false: nothing is
     sent until the first cmd_vel).
+Starts
+    the CPG (its ``start`` service, std_srvs/Trigger) once, at the first command since start-up:
+    the first cmd_vel that asks to move, or the first manual override it hears (a retune
+    applied). Until then planner_state says ``still`` (the graph's cpg_node starts with
+    ``autostart`` false: the servos at neutral), or ``own_gait`` with ``rest_at_start`` false.
     Hears ``cpg_params`` (what the CPG runs: planner_state's cpg_* fields) and ``cpg_status``.
     One owner of the gait: while the CPG is under a manual override (its parameters were set,
     e.g. a retune applied) the planner sends nothing and says so (mode ``manual``); a refused
@@ -39,6 +44,7 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Imu
+from std_srvs.srv import Trigger
 from wirefish_common.batch_intake import BatchIntake, intake_qos
 from wirefish_common.cdr_views import CdrError, read_imu
 from wirefish_common.node_main import run_node
@@ -75,6 +81,9 @@ class PlannerNode(Node):
         self._cpg_params: CpgParams | None = None  # what the CPG last said it runs
         self._cpg_status: CpgStatus | None = None
         self._output: PlannerOutput | None = None
+        # No command since start-up: the tail is still (or swims the CPG's own start-up gait).
+        self._commanded = False
+        self._start_pending = False  # the CPG's start is due, its service not yet seen
         self._wire_cpg()
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
         self._imu_intake: BatchIntake | None = None
@@ -109,6 +118,7 @@ class PlannerNode(Node):
             self.destroy_publisher(self._command_pub)
             for subscription in self._cpg_subscriptions:
                 self.destroy_subscription(subscription)
+            self.destroy_client(self._start_client)
             self._sent = self._cpg_params = self._cpg_status = None
             self._wire_cpg()
 
@@ -122,12 +132,28 @@ class PlannerNode(Node):
                                      self._on_cpg_params, LATCHED),
             self.create_subscription(CpgStatus, cpg_topic(name, 'cpg_status'),
                                      self._on_cpg_status, LATCHED)]
+        self._start_client = self.create_client(Trigger, cpg_topic(name, 'start'))
 
     def _on_cpg_params(self, msg: CpgParams) -> None:
         self._cpg_params = msg
 
     def _on_cpg_status(self, msg: CpgStatus) -> None:
         self._cpg_status = msg
+        if self._manual():  # a retune applied is a command: the fish swims the fit
+            self._first_command()
+
+    def _first_command(self) -> None:
+        """Start the CPG at the first command since start-up (it starts with the tail still)."""
+        if not self._commanded:
+            self._commanded = True
+            self._start_pending = True
+            self._start_cpg()
+
+    def _start_cpg(self) -> None:
+        """Call the CPG's start once its service is there (the next tick retries until then)."""
+        if self._start_pending and self._start_client.service_is_ready():
+            self._start_pending = False
+            self._start_client.call_async(Trigger.Request())
 
     # --- inputs ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
@@ -144,6 +170,8 @@ class PlannerNode(Node):
             self.get_logger().warn(problem, throttle_duration_sec=WARN_THROTTLE_S)
             return
         self._last_cmd_s = now
+        if msg.linear.x > 0.0 or msg.angular.z != 0.0:
+            self._first_command()
 
     def _subscribe_imu(self) -> None:
         if self._imu_intake is not None:
@@ -181,6 +209,7 @@ class PlannerNode(Node):
         self._take_imu(now)
         out = self._planner.step(now)
         self._output = out
+        self._start_cpg()
         if self._manual():
             self._planner.pi.reset()  # the planner's offset is not applied: nothing to integrate
         else:
@@ -226,7 +255,7 @@ class PlannerNode(Node):
         point = out.gait.point
         msg = PlannerState()
         msg.header.stamp = self.get_clock().now().to_msg()
-        msg.mode = str(PlannerMode.MANUAL if self._manual() else out.mode)
+        msg.mode = str(self._mode(out))
         msg.target_speed = float(out.gait.target_speed)
         msg.predicted_speed = float(out.gait.predicted_speed)
         msg.clamp_reason = out.gait.clamp_reason
@@ -248,6 +277,14 @@ class PlannerNode(Node):
         msg.cmd_vel_age_s = math.nan if self._last_cmd_s is None else now - self._last_cmd_s
         return msg
 
+    def _mode(self, out: PlannerOutput) -> PlannerMode:
+        """Return what the tail does: the planner's mode, or why the planner does not drive it."""
+        if self._manual():
+            return PlannerMode.MANUAL
+        if not self._commanded:
+            return PlannerMode.STILL if self._values['rest_at_start'] else PlannerMode.OWN_GAIT
+        return out.mode
+
     def _on_diagnostics(self) -> None:
         out = self._output
         level, message = DiagnosticStatus.OK, 'ok'
@@ -263,7 +300,7 @@ class PlannerNode(Node):
         elif self._planner.gaits.family_note:
             level, message = DiagnosticStatus.WARN, self._planner.gaits.family_note
         values = {} if out is None else {
-            'mode': str(out.mode), 'target_speed': f'{out.gait.target_speed:.3f}',
+            'mode': str(self._mode(out)), 'target_speed': f'{out.gait.target_speed:.3f}',
             'predicted_speed': f'{out.gait.predicted_speed:.3f}',
             'yaw_rate_target': f'{out.yaw_rate_target:.3f}',
             'yaw_rate_measured': f'{out.yaw_rate_measured:.3f}',
