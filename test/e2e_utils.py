@@ -25,13 +25,17 @@ class RunningGraph:
 
 
 def start_graph(domain_id: int, out_dir: Path, *options: str,
-                namespace: str = NAMESPACE) -> RunningGraph:
+                namespace: str = NAMESPACE, swimming: bool = True) -> RunningGraph:
     """
     Start `wirefish up --sim [options]` (the launcher behind `make run`) on its own domain.
 
     Give each test that starts a graph a ``namespace`` of its own: a graph that is still
     stopping in the same namespace would make the new `wirefish up` refuse to start.
+    ``swimming``: with --start-swimming (the tests observe a swimming fish; `make run`'s fish
+    starts still until its first command).
     """
+    if swimming:
+        options = ('--start-swimming', *options)
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(

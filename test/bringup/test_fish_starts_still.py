@@ -18,7 +18,7 @@ def test_the_fish_starts_still_and_swims_at_the_first_cmd_vel(ros_domain_id, ros
     from sensor_msgs.msg import JointState
     from wirefish_msgs.msg import PlannerState
 
-    graph = start_graph(ros_domain_id, tmp_path, namespace=NAMESPACE)
+    graph = start_graph(ros_domain_id, tmp_path, namespace=NAMESPACE, swimming=False)
     node = rclpy.create_node('still_probe', namespace=NAMESPACE, context=ros_context)
     executor = SingleThreadedExecutor(context=ros_context)
     executor.add_node(node)
