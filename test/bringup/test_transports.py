@@ -4,8 +4,8 @@ The graph's transports: UDPv4 unless the user chose others.
 Why (wirefish_bringup.dds_profile): over Fast DDS's shared memory a publisher whose subscriber
 was SIGKILLed waited out the dead port's 1 s health check in about one kill in four. How long a
 publish takes is a timing on a shared machine, so it is measured by
-``tools/kill_stall_probe.py``, not asserted here: over UDPv4 it found 0 stalls in 16 kills on a
-quiet machine, and once 1.33 s in 8 kills beside a loaded CI run (not yet explained).
+``tools/probes/kill_stall_probe.py``, not asserted here: over UDPv4 it found 0 stalls in 16 kills
+on a quiet machine, and once 1.33 s in 8 kills beside a loaded CI run (not yet explained).
 """
 
 import os

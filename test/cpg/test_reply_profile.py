@@ -1,8 +1,8 @@
 """
 Fresh clients against restarted servers with the workspace's Fast DDS profile: every call answered.
 
-The reduced form of ``tools/reply_probe.py`` (which also runs a second graph for load and shows
-the loss without the profile): a new participant, node and client per call, wait_for_service,
+The reduced form of ``tools/probes/reply_probe.py`` (which also runs a second graph for load and
+shows the loss without the profile): a new participant, node and client per call, wait_for_service,
 one request, no retry, the server restarted before every tenth call. And every reply writer the
 profile names is one of a service the servers offer (a misspelt name would wait for nothing).
 """
@@ -16,7 +16,7 @@ import pytest
 from ros_utils import spin_until
 from wirefish_bringup.dds_profile import reply_writer_names
 
-PROBE = Path(__file__).resolve().parents[2] / 'tools' / 'reply_probe.py'
+PROBE = Path(__file__).resolve().parents[2] / 'tools' / 'probes' / 'reply_probe.py'
 
 
 def _probe():

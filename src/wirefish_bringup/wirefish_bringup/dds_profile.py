@@ -21,26 +21,25 @@ the builtin transports (shared memory) back. On one host (role all) there is no 
 participant: there a 10 s period slowed discovery (a full run: topics and an action not found
 in their tests' time).
 
-Why no shared memory: with it, a publisher whose subscriber was SIGKILLed and restarted stalls
-in ``publish()``: the writer reopens the dead reader's shared-memory port and waits out the
-port's health check (``healthy_check_timeout_ms``, 1000 ms by default). Measured here
-(tools/kill_stall_probe.py, a 100 Hz publisher, 12 kills of a subscriber): with shared memory
-its longest publish took 1001 ms (twice, and 334 ms twice), over UDP 6 ms. A CPG stalled that
-long starves the bridge past its 500 ms command timeout and the fish goes neutral; messages in
-flight to the recorder were lost with it. Loopback UDP costs a copy per reader, which the
-graph's small messages afford. A value the user already set, for either variable (even empty),
-is kept.
+Why no shared memory: with it, a publisher whose subscriber was SIGKILLed and restarted stalls in
+``publish()``: the writer reopens the dead reader's shared-memory port and waits out the port's
+health check (``healthy_check_timeout_ms``, 1000 ms by default). Measured here
+(tools/probes/kill_stall_probe.py, a 100 Hz publisher, 12 kills of a subscriber): with shared
+memory its longest publish took 1001 ms (twice, and 334 ms twice), over UDP 6 ms. A CPG stalled
+that long starves the bridge past its 500 ms command timeout and the fish goes neutral; messages in
+flight to the recorder were lost with it. Loopback UDP costs a copy per reader, which the graph's
+small messages afford. A value the user already set, for either variable (even empty), is kept.
 
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` brings shared memory back whatever
-``FASTDDS_BUILTIN_TRANSPORTS`` or a participant profile says: each process of a graph started
-with it mapped 8 of Fast DDS's shared-memory segments (a private /dev/shm, 10 listeners and a
-talker), and one Ctrl-C of such a graph took over 3 s in 8 of 50 rounds, a node's stop waiting
-on a dying peer's shared-memory port (tools/sigint_soak.py). So the workspace honours LOCALHOST
+``FASTDDS_BUILTIN_TRANSPORTS`` or a participant profile says: each process of a graph started with
+it mapped 8 of Fast DDS's shared-memory segments (a private /dev/shm, 10 listeners and a talker),
+and one Ctrl-C of such a graph took over 3 s in 8 of 50 rounds, a node's stop waiting on a dying
+peer's shared-memory port (tools/probes/sigint_soak.py). So the workspace honours LOCALHOST
 (without ROS_STATIC_PEERS) as loopback-only UDPv4: a default participant whose UDPv4 transport
 sends and listens on 127.0.0.1 only, and rmw's SYSTEM_DEFAULT range so that rmw leaves it alone
 (config/fastdds_loopback.xml, or a graph's own profile). Nothing leaves the host, as with
-LOCALHOST, and no segment is mapped. A participant that kept LOCALHOST (a `ros2` CLI call, a
-test's own node) still discovers and talks to such a graph, over UDP.
+LOCALHOST, and no segment is mapped. A participant that kept LOCALHOST (a `ros2` CLI call, a test's
+own node) still discovers and talks to such a graph, over UDP.
 """
 
 from __future__ import annotations

@@ -12,8 +12,8 @@ restarted before every ``--restart-every``-th call (a server that has just start
 clients it has not discovered yet: where rmw_fastrtps drops answers). A second graph
 (``wirefish up`` in ``/load_0``) loads the machine (``--load-graphs``: how many).
 
-    tools/wfenv python tools/reply_probe.py --profile off --calls 200 --goals 100
-    tools/wfenv python tools/reply_probe.py --profile on --calls 200 --goals 100
+    tools/wfenv python tools/probes/reply_probe.py --profile off --calls 200 --goals 100
+    tools/wfenv python tools/probes/reply_probe.py --profile on --calls 200 --goals 100
 
 ``--profile on`` gives the servers the workspace's Fast DDS profile (config/fastdds.xml:
 reply writers wait for the client's reader); ``off`` gives them none.
@@ -33,7 +33,7 @@ import time
 
 NAMESPACE = '/wirefish'
 LOAD_NAMESPACE = '/load'
-PROFILE = Path(__file__).resolve().parent.parent / 'src' / 'wirefish_bringup' / 'config' / \
+PROFILE = Path(__file__).resolve().parents[2] / 'src' / 'wirefish_bringup' / 'config' / \
     'fastdds.xml'
 STOP_TIMEOUT_S = 10.0
 

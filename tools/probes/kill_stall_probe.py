@@ -2,8 +2,9 @@
 """
 Does a SIGKILLed subscriber stall its publisher? A 100 Hz publisher, a victim killed N times.
 
-    tools/wfenv python tools/kill_stall_probe.py --kills 12
-    FASTDDS_BUILTIN_TRANSPORTS=DEFAULT tools/wfenv python tools/kill_stall_probe.py  # with SHM
+    tools/wfenv python tools/probes/kill_stall_probe.py --kills 12
+    # with shared memory:
+    FASTDDS_BUILTIN_TRANSPORTS=DEFAULT tools/wfenv python tools/probes/kill_stall_probe.py
 
 The publisher (a process of its own, RELIABLE, depth 10, like servo_cmd) times every
 ``publish()``; a victim subscriber is started, left ALIVE_S, SIGKILLed and started again. The

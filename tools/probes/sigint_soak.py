@@ -1,7 +1,7 @@
 """
 SIGINT a whole `wirefish up` graph many times in a row; say how fast every process stopped.
 
-    tools/wfenv python tools/sigint_soak.py --runs 50 [--graphs 8] [--domain 90]
+    tools/wfenv python tools/probes/sigint_soak.py --runs 50 [--graphs 8] [--domain 90]
         [--discovery-range LOCALHOST]
 
 Each round starts ``--graphs`` virtual-fish graphs at once (each its own namespace on one ROS

@@ -1,7 +1,7 @@
 """
 SIGINT (once or twice) each node executable at a random moment of its start-up; count the clean.
 
-    tools/wfenv python tools/startup_sigint.py --runs 50 [--within 3.0] [--domain 92]
+    tools/wfenv python tools/probes/startup_sigint.py --runs 50 [--within 3.0] [--domain 92]
         [--started-by wirefish-up|ros2-launch|ros2-run]
 
 For every run and node: start it (the installed executable, the default params file, a
