@@ -24,6 +24,8 @@ from wirefish_common.startup_signals import block_stop_signals
 
 _PR_SET_PDEATHSIG = 1
 TERM_GRACE_S = 2.0  # after the SIGTERM to a process still running at the stop's deadline
+# The exit code of a node that refuses its start-up parameters (after one FATAL line).
+CONFIGURATION_EXIT_CODE = 1
 
 
 def _die_with_parent() -> None:  # runs in the child between fork and exec
@@ -127,6 +129,17 @@ class Supervisor:
             spec, budget, code = self.specs[key], self.budgets[key], proc.returncode
             for link in spec.links:  # a killed virtual fish leaves its links behind
                 remove_stale_link(link)
+            refusal = self.refusal(key) if code == CONFIGURATION_EXIT_CODE else None
+            if refusal is not None:
+                # A node that refuses its start-up parameters refuses them again at every
+                # restart: a configuration error, said on the terminal, never restarted.
+                self.given_up[key] = code
+                what = (f'{key} refused its start-up parameters and is not restarted (fix '
+                        f'the parameter file and start again): {refusal}')
+                if spec.restart.required:
+                    raise ProcessExitedError(f'{what}; it is required: stopping the graph')
+                lines.append(f'{what}; the rest keeps running')
+                continue
             delay = budget.on_exit(now)
             if delay is not None:
                 self._pending[key] = now + delay
@@ -160,6 +173,25 @@ class Supervisor:
             parts.append('given up: ' + ', '.join(
                 f'{k} (last exit code {code})' for k, code in self.given_up.items()))
         return '; '.join(parts)
+
+    def refusal(self, key: str) -> str | None:
+        """
+        Return the FATAL reason the last start of ``key`` logged before it exited, or None.
+
+        Every wirefish node logs one FATAL line and exits 1 when it refuses its start-up
+        parameters (``wirefish_common.node_main``); a crash ends with a traceback instead.
+        """
+        path = self._log_dir / f'{key}.log'
+        try:
+            text = path.read_text(errors='replace')
+        except OSError:
+            return None
+        last_start = text.rsplit(f'--- {key} restarted by wirefish up ---', 1)[-1]
+        fatal = [line.split(']: ', 1)[-1] for line in last_start.splitlines()
+                 if line.startswith('[FATAL]')]
+        if not fatal or 'Traceback (most recent call last)' in last_start:
+            return None
+        return '; '.join(fatal)
 
     def log_tail(self, name: str, lines: int = 15) -> str:
         """Return the last lines of one process's log (for error messages)."""
