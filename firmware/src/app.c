@@ -1,12 +1,19 @@
 /*
- * The application: link logic, failsafe, servo output, sensors and the telemetry schedule.
+ * The application: link logic, the two drive modes, failsafe, servo output, sensors and the
+ * telemetry schedule.
+ *
+ * Stream mode (from boot): the host's SERVO_CMD sets the servos; a failsafe moves them to
+ * neutral at a bounded slew. Gait mode (from an accepted GAIT): the board integrates eq 1
+ * itself (wf/cpg.h) one 1 ms step per millisecond of its clock, and through a link gap it
+ * coasts on the last gait, then brings the oscillator to rest through its own convergence.
  *
  * The firmware rules are the virtual fish's (wirefish_sim.virtual_fish), and
  * test/firmware/test_fw_virtual_fish_parity.py holds the two to the same output frames and
- * states. One poll: read every byte the UART holds (one chunk, up to 512), act on each valid
- * frame, send one ERROR per kind of drop not yet reported (at most one per kind per 20 ms);
- * sample the sensors; run the failsafe and set the servos; send the telemetry and the
- * heartbeat that are due, in that order.
+ * states. One poll: step the CPG up to now (gait mode); read every byte the UART holds (one
+ * chunk, up to 512), act on each valid frame, send one ERROR per kind of drop not yet reported
+ * (at most one per kind per 20 ms); send one waiting ACK; sample the sensors; run the gap
+ * rules and the failsafe and set the servos; send the telemetry, the heartbeat and the HEALTH
+ * that are due, in that order: at most one of each per poll.
  */
 #include "wf/app.h"
 
@@ -51,6 +58,15 @@ void wf_config_defaults(wf_config_t *config)
     /* 3.3 V reference over 4095 counts behind a 3:1 divider (2S LiPo, 8.4 V full). */
     config->battery_v_per_count = 3.3f * 3.0f / 4095.0f;
     config->low_battery_v = 6.6f;
+    config->health_period_ms = 2000;
+    config->link_timeout_ms = 1500;
+    /* A few tail beats ride out a burst loss at the surface; at 0.3 m/s, 3 s is <= 1 m of
+     * unguided swimming. */
+    config->coast_ms = 3000;
+    config->telemetry_form = WF_TELEMETRY_FULL;
+    /* Neutral from the far limit (pi/2) in 0.8 s: a slew the reel's wires follow, where a
+     * step at the servo's full speed snaps the tail. */
+    config->failsafe_slew_rad_s = 2.0f;
 }
 
 static bool in_range(float value, float low, float high)
@@ -77,7 +93,15 @@ bool wf_config_valid(const wf_config_t *c)
               (c->imu_mode == WF_IMU_MPU6050 || c->imu_mode == WF_IMU_SYNTHETIC) &&
               in_range(c->attitude_tau_s, 0.0f, 1000.0f) &&
               in_range(c->battery_v_per_count, 0.0f, 1.0f) &&
-              in_range(c->low_battery_v, -1.0f, 100.0f);
+              in_range(c->low_battery_v, -1.0f, 100.0f) &&
+              (c->health_period_ms == 0 || (c->health_period_ms >= WF_LINK_HEALTH_MIN_MS &&
+                                            c->health_period_ms <= WF_LINK_HEALTH_MAX_MS)) &&
+              c->link_timeout_ms >= WF_LINK_TIMEOUT_MIN_MS &&
+              c->link_timeout_ms <= WF_LINK_TIMEOUT_MAX_MS &&
+              c->coast_ms <= WF_LINK_COAST_MAX_MS &&
+              (c->telemetry_form == WF_TELEMETRY_FULL ||
+               c->telemetry_form == WF_TELEMETRY_COMPACT) &&
+              in_range(c->failsafe_slew_rad_s, 0.0f, 1000.0f);
     for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
         const wf_servo_cal_t *cal = &c->servo_cal[i];
         ok = ok && in_range(cal->neutral_us, 0.0f, 20000.0f) &&
@@ -123,7 +147,8 @@ static void send_heartbeat(wf_app_t *app)
 static void send_telemetry(wf_app_t *app)
 {
     wf_msg_t msg = {.type = WF_MSG_TELEMETRY};
-    wf_telemetry_t *t = &msg.u.telemetry;
+    wf_telemetry_t full;
+    wf_telemetry_t *t = &full;
     t->board_time_ms = app->now_ms;
     t->roll = app->attitude.roll;
     t->pitch = app->attitude.pitch;
@@ -137,32 +162,172 @@ static void send_telemetry(wf_app_t *app)
     t->servo[1] = app->target[1];
     t->battery_v = app->have_battery ? app->battery_v : 0.0f;
     t->status = app->status;
+    t->gait_id = app->gait_mode ? app->gait_id : 0;
+    if (app->config.telemetry_form == WF_TELEMETRY_COMPACT) {
+        msg.type = WF_MSG_TELEMETRY_COMPACT;
+        wf_telemetry_compact(t, &msg.u.compact);
+    } else {
+        msg.u.telemetry = full;
+    }
     send(app, &msg);
+}
+
+static void send_health(wf_app_t *app)
+{
+    wf_health_t *h = &app->health;
+    const wf_decoder_stats_t *s = &app->decoder.stats;
+    h->uptime_ms = app->now_ms;
+    h->tx_bytes_dropped = app->tx_bytes_dropped;
+    h->rx_crc = s->crc_errors;
+    h->rx_frame = s->cobs_errors + s->short_frames + s->overflows;
+    h->rx_unknown_type = s->unknown_type;
+    h->rx_length = s->length_errors;
+    h->rx_invalid = s->invalid_payload;
+    wf_msg_t msg = {.type = WF_MSG_HEALTH};
+    msg.u.health = *h;
+    send(app, &msg);
+}
+
+/* The oldest waiting ACK; a refused GAIT's ERROR (its code, the GAIT's seq) goes just before
+ * it. */
+static void send_ack(wf_app_t *app)
+{
+    if (app->ack_count == 0) {
+        return;
+    }
+    wf_msg_t msg = {.type = WF_MSG_ACK};
+    msg.u.ack = app->acks[0];
+    app->ack_count--;
+    memmove(app->acks, app->acks + 1, app->ack_count * sizeof app->acks[0]);
+    if (msg.u.ack.acked_type == WF_MSG_GAIT && msg.u.ack.result != 0) {
+        send_error(app, msg.u.ack.result, msg.u.ack.acked_seq);
+    }
+    send(app, &msg);
+}
+
+static void queue_ack(wf_app_t *app, const wf_msg_t *msg, uint8_t result)
+{
+    if (app->ack_count >= WF_ACK_QUEUE) {
+        app->acks_dropped++;
+        return;
+    }
+    wf_ack_t *ack = &app->acks[app->ack_count++];
+    ack->acked_type = msg->type;
+    ack->acked_seq = msg->seq;
+    ack->result = result;
+}
+
+static uint16_t saturating_increment(uint16_t count)
+{
+    return count == UINT16_MAX ? count : (uint16_t)(count + 1u);
 }
 
 /* --- input ------------------------------------------------------------------------------ */
 static void update_outputs(wf_app_t *app);
 
-static void on_frame(wf_app_t *app, const wf_msg_t *msg)
+static void leave_gait_mode(wf_app_t *app)
+{
+    app->gait_mode = false;
+    app->gait_id = 0;
+    app->gap = WF_GAP_NONE;
+}
+
+/* True for the frames a host sends: they, and only they, show that the link is up. */
+static bool from_host(const wf_msg_t *msg)
 {
     switch (msg->type) {
     case WF_MSG_HEARTBEAT:
-        if (msg->u.heartbeat.role != WF_ROLE_HOST) {
-            return; /* our own heartbeat echoed back, or another fish: not a host */
-        }
+        return msg->u.heartbeat.role == WF_ROLE_HOST; /* not our own echoed, not a fish's */
+    case WF_MSG_LINK_CONFIG:
+    case WF_MSG_SERVO_CMD:
+    case WF_MSG_GAIT:
+        return true;
+    default:
+        return false; /* TELEMETRY, ACK, HEALTH and ERROR are a fish's to send */
+    }
+}
+
+static void on_link_config(wf_app_t *app, const wf_msg_t *msg)
+{
+    const wf_link_config_t *l = &msg->u.link_config;
+    uint8_t result = 0;
+    if (!app->host_version_ok) {
+        result = WF_ERR_VERSION_MISMATCH;
+    } else if (!wf_link_config_valid(l)) {
+        result = WF_ERR_COMMAND_OUT_OF_RANGE;
+    } else {
+        wf_config_t *c = &app->config;
+        c->telemetry_period_ms = l->telemetry_period_ms;
+        c->telemetry_form = l->telemetry_form;
+        c->health_period_ms = l->health_period_ms;
+        c->link_timeout_ms = l->link_timeout_ms;
+        c->coast_ms = l->coast_ms;
+        /* At once: both schedules start again from now. */
+        app->next_telemetry_ms = app->now_ms + c->telemetry_period_ms;
+        app->next_health_ms = app->now_ms + c->health_period_ms;
+    }
+    queue_ack(app, msg, result);
+}
+
+static void on_gait(wf_app_t *app, const wf_msg_t *msg)
+{
+    uint8_t result = 0;
+    if (!app->host_version_ok) {
+        result = WF_ERR_VERSION_MISMATCH;
+    } else if (!wf_gait_valid(&msg->u.gait, app->config.servo_limit_rad)) {
+        result = WF_ERR_COMMAND_OUT_OF_RANGE;
+    }
+    if (result != 0) {
+        app->gaits_refused++;
+        queue_ack(app, msg, result);
+        return;
+    }
+    app->gait = msg->u.gait.params;
+    app->gait_id = msg->u.gait.gait_id;
+    if (app->gait_mode) {
+        wf_cpg_set_params(&app->cpg, &app->gait); /* targets only: no step */
+    } else {
+        app->gait_mode = true;
+        wf_cpg_init(&app->cpg, &app->gait); /* from rest, at this poll's time */
+        app->cpg_time_ms = app->now_ms;
+    }
+    app->gaits_accepted++;
+    queue_ack(app, msg, 0);
+}
+
+static void on_frame(wf_app_t *app, const wf_msg_t *msg)
+{
+    if (!from_host(msg)) {
+        return;
+    }
+    app->last_host_frame_ms = app->now_ms;
+    if (app->gap == WF_GAP_RESTING) {
+        wf_cpg_set_params(&app->cpg, &app->gait); /* the last gait again, converging */
+    }
+    app->gap = WF_GAP_NONE;
+    switch (msg->type) {
+    case WF_MSG_HEARTBEAT:
         app->host_seen = true;
         app->host_version_ok = msg->u.heartbeat.version == WF_PROTOCOL_VERSION;
         if (!app->host_version_ok) {
             send_error(app, WF_ERR_VERSION_MISMATCH, msg->seq);
+            leave_gait_mode(app); /* stream mode's failsafe: to neutral, slewed */
         }
         app->have_heartbeat = true;
         app->last_heartbeat_ms = app->now_ms;
+        return;
+    case WF_MSG_LINK_CONFIG:
+        on_link_config(app, msg);
+        return;
+    case WF_MSG_GAIT:
+        on_gait(app, msg);
         return;
     case WF_MSG_SERVO_CMD:
         if (!app->host_version_ok) {
             app->commands_ignored++;
             return;
         }
+        leave_gait_mode(app);
         app->commanded[0] = msg->u.servo_cmd.servo[0];
         app->commanded[1] = msg->u.servo_cmd.servo[1];
         app->have_command = true;
@@ -172,7 +337,7 @@ static void on_frame(wf_app_t *app, const wf_msg_t *msg)
         update_outputs(app);
         return;
     default:
-        return; /* TELEMETRY and ERROR are the fish's to send */
+        return;
     }
 }
 
@@ -234,7 +399,10 @@ static void sample_imu(wf_app_t *app)
     } else {
         if (!app->imu.present && due(now, app->next_imu_probe_ms)) {
             app->next_imu_probe_ms = now + IMU_PROBE_PERIOD_MS;
-            wf_mpu6050_init(&app->imu);
+            if (wf_mpu6050_init(&app->imu) && app->imu_lost) {
+                app->imu_lost = false;
+                app->health.imu_recoveries = saturating_increment(app->health.imu_recoveries);
+            }
             app->imu_sampled = false; /* the first sample after a probe restarts dt */
         }
         if (!app->imu.present) {
@@ -242,6 +410,8 @@ static void sample_imu(wf_app_t *app)
         }
         if (!wf_mpu6050_read(&app->imu, app->config.imu_axes)) {
             app->next_imu_probe_ms = now; /* lost: probe again at once */
+            app->imu_lost = true;
+            app->health.imu_faults = saturating_increment(app->health.imu_faults);
             return;
         }
     }
@@ -261,20 +431,60 @@ static void sample_battery(wf_app_t *app)
     }
 }
 
-/* --- failsafe and servos ---------------------------------------------------------------- */
-static void update_outputs(wf_app_t *app)
+/* --- gait mode: the CPG and the gap ------------------------------------------------------ */
+/* One RK4 step per millisecond of the board's clock, up to now. */
+static void advance_cpg(wf_app_t *app)
+{
+    if (!app->gait_mode) {
+        return;
+    }
+    if (app->now_ms - app->cpg_time_ms > WF_CPG_MAX_LAG_MS) {
+        app->cpg_time_ms = app->now_ms; /* stalled, or the clock went back: go on from here */
+        return;
+    }
+    for (unsigned n = 0; n < WF_CPG_STEPS_PER_POLL && app->cpg_time_ms != app->now_ms; n++) {
+        wf_cpg_step(&app->cpg);
+        app->cpg_time_ms += WF_CPG_STEP_MS;
+    }
+}
+
+/* No valid host frame for link_timeout_ms: COASTING on the last gait; coast_ms later,
+ * RESTING: amplitude and offset targets 0 (frequency, couplings, alpha kept), reached through
+ * the oscillator's own convergence. RESTING holds until a host frame (on_frame) ends it. */
+static void update_gap(wf_app_t *app)
 {
     const wf_config_t *c = &app->config;
-    const uint32_t now = app->now_ms;
+    if (!app->gait_mode || app->gap == WF_GAP_RESTING) {
+        return;
+    }
+    const uint32_t quiet = app->now_ms - app->last_host_frame_ms;
+    if (app->gap == WF_GAP_NONE && quiet > c->link_timeout_ms) {
+        app->gap = WF_GAP_COASTING;
+    }
+    if (app->gap == WF_GAP_COASTING && quiet > c->link_timeout_ms + c->coast_ms) {
+        app->gap = WF_GAP_RESTING;
+        wf_cpg_params_t rest = app->gait;
+        for (unsigned i = 0; i < WF_CPG_OSCILLATORS; i++) {
+            rest.amplitude[i] = 0.0f;
+            rest.offset[i] = 0.0f;
+        }
+        wf_cpg_set_params(&app->cpg, &rest);
+    }
+}
+
+/* --- failsafe and servos ---------------------------------------------------------------- */
+/* v moved toward 0 by at most step. */
+static float toward_neutral(float v, float step)
+{
+    return v > step ? v - step : (v < -step ? v + step : 0.0f);
+}
+
+/* Stream mode: the command, or (any failsafe) a slew to neutral at failsafe_slew_rad_s;
+ * returns the failsafe bits and sets *clamped when a command was beyond the limit. */
+static uint16_t stream_targets(wf_app_t *app, uint32_t dt_ms, bool *clamped)
+{
+    const wf_config_t *c = &app->config;
     uint16_t status = 0;
-    /* A timeout, once passed, holds until the next frame: forgetting the old time keeps the
-     * modular difference from coming round again after 2^31 ms. */
-    if (app->have_command && now - app->last_command_ms > c->command_timeout_ms) {
-        app->have_command = false;
-    }
-    if (app->have_heartbeat && now - app->last_heartbeat_ms > c->heartbeat_timeout_ms) {
-        app->have_heartbeat = false;
-    }
     if (!app->have_command) {
         status |= WF_STATUS_FAILSAFE_COMMAND;
     }
@@ -284,13 +494,56 @@ static void update_outputs(wf_app_t *app)
     if (!app->host_version_ok) {
         status |= WF_STATUS_VERSION_MISMATCH;
     }
-    const bool neutral = status != 0;
+    /* At most a second per update: a long pause reaches neutral anyway. */
+    const float step =
+        c->failsafe_slew_rad_s * (float)(dt_ms < 1000u ? dt_ms : 1000u) * 1e-3f;
     for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
-        const float wanted = neutral ? 0.0f : app->commanded[i];
-        if (fabsf(wanted) > c->servo_limit_rad) {
-            status |= WF_STATUS_SERVO_CLAMPED;
+        if (status != 0) {
+            app->target[i] = toward_neutral(app->target[i], step);
+        } else {
+            *clamped = *clamped || fabsf(app->commanded[i]) > c->servo_limit_rad;
+            app->target[i] = wf_servo_clamp(app->commanded[i], c->servo_limit_rad);
         }
-        app->target[i] = wf_servo_clamp(wanted, c->servo_limit_rad);
+    }
+    return status;
+}
+
+/* Gait mode: the CPG's output now, clipped to the limit (clamp_to_limit's rule). */
+static uint16_t gait_targets(wf_app_t *app, bool *clamped)
+{
+    float angle[WF_CPG_OSCILLATORS];
+    wf_cpg_output(&app->cpg, angle, NULL);
+    *clamped = wf_cpg_clamp(angle, NULL, app->config.servo_limit_rad);
+    app->target[0] = angle[0];
+    app->target[1] = angle[1];
+    return (uint16_t)(WF_STATUS_GAIT_MODE |
+                      (app->gap == WF_GAP_COASTING ? WF_STATUS_COASTING : 0) |
+                      (app->gap == WF_GAP_RESTING ? WF_STATUS_RESTING : 0));
+}
+
+/* Sets the targets and the compares. Called every poll (at least once a millisecond), so each
+ * PWM frame latches the newest target (the timer's compare is preloaded at the frame's
+ * update event) and each SERVO_CMD (so two commands in one poll both reach the register). */
+static void update_outputs(wf_app_t *app)
+{
+    const wf_config_t *c = &app->config;
+    const uint32_t now = app->now_ms;
+    /* A timeout, once passed, holds until the next frame: forgetting the old time keeps the
+     * modular difference from coming round again after 2^31 ms. */
+    if (app->have_command && now - app->last_command_ms > c->command_timeout_ms) {
+        app->have_command = false;
+    }
+    if (app->have_heartbeat && now - app->last_heartbeat_ms > c->heartbeat_timeout_ms) {
+        app->have_heartbeat = false;
+    }
+    bool clamped = false;
+    uint16_t status = app->gait_mode ? gait_targets(app, &clamped)
+                                     : stream_targets(app, now - app->last_output_ms, &clamped);
+    app->last_output_ms = now;
+    if (clamped) {
+        status |= WF_STATUS_SERVO_CLAMPED;
+    }
+    for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
         const uint32_t compare = wf_servo_compare(&c->servo_cal[i], app->target[i],
                                                   wf_hal_pwm_ticks_per_us(), frame_us(c));
         if (compare != app->compare[i]) {
@@ -303,6 +556,10 @@ static void update_outputs(wf_app_t *app)
     }
     if (c->imu_mode == WF_IMU_SYNTHETIC || !app->imu.present) {
         status |= WF_STATUS_IMU_FAULT;
+    }
+    if (app->health.clock_source == WF_CLOCK_HSI_PLL ||
+        app->health.clock_source == WF_CLOCK_HSI) {
+        status |= WF_STATUS_CLOCK_FALLBACK;
     }
     app->status = status;
 }
@@ -323,6 +580,9 @@ void wf_app_init(wf_app_t *app, const wf_config_t *config)
     app->now_ms = wf_hal_millis();
     app->next_telemetry_ms = app->now_ms + app->config.telemetry_period_ms;
     app->next_heartbeat_ms = app->now_ms; /* identification: from power-up, unprompted */
+    app->next_health_ms = app->now_ms;    /* once right after boot, then every period */
+    app->last_output_ms = app->now_ms;
+    app->last_host_frame_ms = app->now_ms;
     app->next_imu_ms = app->now_ms;
     app->next_imu_probe_ms = app->now_ms;
     for (unsigned i = 0; i < WF_REPORTED_KINDS; i++) {
@@ -340,9 +600,12 @@ void wf_app_init(wf_app_t *app, const wf_config_t *config)
 void wf_app_poll(wf_app_t *app)
 {
     app->now_ms = wf_hal_millis();
+    advance_cpg(app); /* with the parameters in force until now */
     receive(app);
+    send_ack(app);
     sample_imu(app);
     sample_battery(app);
+    update_gap(app);
     update_outputs(app);
     if (due(app->now_ms, app->next_telemetry_ms)) {
         app->next_telemetry_ms += app->config.telemetry_period_ms;
@@ -351,5 +614,12 @@ void wf_app_poll(wf_app_t *app)
     if (due(app->now_ms, app->next_heartbeat_ms)) {
         app->next_heartbeat_ms += app->config.heartbeat_period_ms;
         send_heartbeat(app);
+    }
+    if (!app->health_sent ||
+        (app->config.health_period_ms != 0 && due(app->now_ms, app->next_health_ms))) {
+        app->next_health_ms = app->health_sent ? app->next_health_ms + app->config.health_period_ms
+                                               : app->now_ms + app->config.health_period_ms;
+        app->health_sent = true;
+        send_health(app);
     }
 }

@@ -169,7 +169,7 @@ static void test_fish_heartbeats_from_power_up_at_2_hz(void)
     size_t k = 0;
     for (size_t i = 0; i < n; i++) {
         if (out[i].type == WF_MSG_HEARTBEAT) {
-            CHECK(out[i].role == WF_ROLE_FISH && out[i].version_or_code == 1);
+            CHECK(out[i].role == WF_ROLE_FISH && out[i].version_or_code == WF_PROTOCOL_VERSION);
             beats[k++] = out[i].uptime_or_time_ms;
         }
     }
@@ -196,7 +196,7 @@ static void test_telemetry_every_10_ms_with_consecutive_seq(void)
 static void test_hello_with_our_version_lets_commands_through(void)
 {
     fresh_board();
-    send_heartbeat(1, 1);
+    send_heartbeat(1, WF_PROTOCOL_VERSION);
     send_command(2, 0.25f, -0.5f);
     const wf_host_snapshot_t s = snap();
     CHECK(s.host_seen && s.host_version_ok && s.status == 0);
@@ -209,7 +209,7 @@ static void test_other_version_answers_error_5_and_stays_neutral(void)
     run_until(0, 0);
     wf_host_msg_t out[64];
     board_output(out, 64);
-    send_heartbeat(1, 2);
+    send_heartbeat(1, 1); /* a version-1 host */
     send_command(2, 0.25f, 0.25f);
     const size_t n = board_output(out, 64);
     CHECK(n == 1 && out[0].type == WF_MSG_ERROR && out[0].version_or_code == 5);
@@ -222,7 +222,7 @@ static void test_other_version_answers_error_5_and_stays_neutral(void)
 static void test_bad_crc_answers_one_error_and_applies_nothing(void)
 {
     fresh_board();
-    send_heartbeat(1, 1);
+    send_heartbeat(1, WF_PROTOCOL_VERSION);
     wf_msg_t msg = {.type = WF_MSG_SERVO_CMD, .seq = 9};
     msg.u.servo_cmd.servo[0] = 0.5f;
     uint8_t wire[WF_MAX_WIRE];
@@ -255,7 +255,7 @@ static void test_unknown_type_answers_error_3(void)
 static void test_a_flood_of_garbage_leaves_room_for_the_telemetry(void)
 {
     fresh_board();
-    send_heartbeat(0, 1);
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
     wf_host_msg_t out[512];
     board_output(out, 512);
     const uint8_t garbage[12] = {0x07, 0x01, 0x00, 0x02, 0x05, 0x00, 0x55, 0x00,
@@ -275,30 +275,63 @@ static void test_a_flood_of_garbage_leaves_room_for_the_telemetry(void)
 }
 
 /* --- failsafe --------------------------------------------------------------------------- */
-static void test_command_timeout_goes_neutral_after_500_ms(void)
+static void test_command_timeout_slews_to_neutral_after_500_ms(void)
 {
     fresh_board();
-    send_heartbeat(0, 1);
-    send_command(100, 0.5f, 0.5f);
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_command(100, 0.5f, -0.3f);
     for (uint32_t t = 101; t <= 600; t += 100) {
-        send_heartbeat(t, 1);
+        send_heartbeat(t, WF_PROTOCOL_VERSION);
     }
+    run_until(502, 600);
     CHECK(snap().status == 0 && snap().target[0] == 0.5f); /* 500 ms since: not yet */
     wf_host_board_step(601, NULL, 0, NULL, 0);
-    CHECK(snap().status == WF_STATUS_FAILSAFE_COMMAND && snap().target[0] == 0.0f);
-    CHECK(snap().compare[0] == 1500);
+    /* 1 ms at 2 rad/s since the last update: 2 mrad toward neutral, not a step. */
+    CHECK(snap().status == WF_STATUS_FAILSAFE_COMMAND);
+    CHECK(fabsf(snap().target[0] - 0.498f) < 1e-6f && fabsf(snap().target[1] + 0.298f) < 1e-6f);
+    float last = snap().target[0];
+    for (uint32_t t = 602; t <= 900; t++) {
+        wf_host_board_step(t, NULL, 0, NULL, 0);
+        const float now = snap().target[0];
+        CHECK(now <= last && last - now <= 2.0f * 1e-3f + 1e-6f); /* the slew bound per ms */
+        last = now;
+    }
+    CHECK(snap().target[0] == 0.0f && snap().target[1] == 0.0f); /* 0.25 s at 2 rad/s */
+    CHECK(snap().compare[0] == 1500 && snap().compare[1] == 1500);
 }
 
-static void test_heartbeat_timeout_goes_neutral_after_1500_ms(void)
+static void test_heartbeat_timeout_slews_to_neutral_after_1500_ms(void)
 {
     fresh_board();
-    send_heartbeat(0, 1);
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
     for (uint32_t t = 10; t <= 1500; t += 10) {
         send_command(t, 0.25f, 0.25f);
     }
     CHECK(snap().status == 0);
     send_command(1501, 0.25f, 0.25f);
-    CHECK(snap().status == WF_STATUS_FAILSAFE_HEARTBEAT && snap().target[1] == 0.0f);
+    CHECK(snap().status == WF_STATUS_FAILSAFE_HEARTBEAT && snap().target[1] < 0.25f &&
+          snap().target[1] > 0.24f);
+    run_until(1502, 1630);
+    CHECK(snap().target[0] == 0.0f && snap().target[1] == 0.0f);
+}
+
+static void test_slew_rate_is_configurable(void)
+{
+    wf_config_t c;
+    wf_config_defaults(&c);
+    CHECK(c.failsafe_slew_rad_s == 2.0f);
+    c.failsafe_slew_rad_s = 10.0f;
+    wf_host_reset();
+    wf_host_board_init(&c);
+    host_seq = 0;
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_command(1, 1.0f, -1.0f);
+    wf_host_board_step(502, NULL, 0, NULL, 0); /* 501 ms since: failsafe, 501 ms of slew */
+    CHECK(snap().target[0] == 0.0f && snap().target[1] == 0.0f);
+    c.failsafe_slew_rad_s = 0.0f;
+    CHECK(!wf_config_valid(&c));
+    c.failsafe_slew_rad_s = NAN;
+    CHECK(!wf_config_valid(&c));
 }
 
 static void test_failsafe_holds_across_the_clock_wrap(void)
@@ -306,9 +339,9 @@ static void test_failsafe_holds_across_the_clock_wrap(void)
     fresh_board();
     wf_host_set_millis(0xFFFFFF00u);
     wf_host_board_init(NULL);
-    send_heartbeat(0xFFFFFF00u, 1);
+    send_heartbeat(0xFFFFFF00u, WF_PROTOCOL_VERSION);
     send_command(0xFFFFFF10u, 0.1f, 0.1f);
-    send_heartbeat(0x00000010u, 1); /* 272 ms later, across 2^32 */
+    send_heartbeat(0x00000010u, WF_PROTOCOL_VERSION); /* 272 ms later, across 2^32 */
     CHECK(snap().status == 0 && snap().target[0] == 0.1f);
     wf_host_board_step(0xFFFFFF10u + 501u, NULL, 0, NULL, 0);
     CHECK(snap().status == WF_STATUS_FAILSAFE_COMMAND);
@@ -318,7 +351,7 @@ static void test_failsafe_holds_across_the_clock_wrap(void)
 static void test_beyond_the_limit_is_clamped_and_flagged(void)
 {
     fresh_board();
-    send_heartbeat(0, 1);
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
     send_command(1, 3.0f, -0.1f);
     const wf_host_snapshot_t s = snap();
     CHECK(s.status == WF_STATUS_SERVO_CLAMPED && s.target[0] == 1.57079625f);
@@ -336,7 +369,7 @@ static void test_calibration_neutral_gain_and_direction(void)
     wf_host_board_init(&c);
     host_seq = 0;
     CHECK(wf_host_compare(1) == 1520);
-    send_heartbeat(0, 1);
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
     send_command(1, 0.0f, 0.5f);
     CHECK(wf_host_compare(1) == 1270 && wf_host_compare(0) == 1500);
 }
@@ -368,7 +401,7 @@ static void test_a_pulse_never_outlasts_its_frame(void)
     wf_host_reset();
     wf_host_board_init(&c);
     host_seq = 0;
-    send_heartbeat(0, 1);
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
     send_command(1, 1.5f, -1.5f);
     CHECK(wf_host_compare(0) == 3003 && wf_host_compare(1) == 545);
 }
@@ -445,8 +478,9 @@ int main(void)
     test_bad_crc_answers_one_error_and_applies_nothing();
     test_unknown_type_answers_error_3();
     test_a_flood_of_garbage_leaves_room_for_the_telemetry();
-    test_command_timeout_goes_neutral_after_500_ms();
-    test_heartbeat_timeout_goes_neutral_after_1500_ms();
+    test_command_timeout_slews_to_neutral_after_500_ms();
+    test_heartbeat_timeout_slews_to_neutral_after_1500_ms();
+    test_slew_rate_is_configurable();
     test_failsafe_holds_across_the_clock_wrap();
     test_beyond_the_limit_is_clamped_and_flagged();
     test_calibration_neutral_gain_and_direction();

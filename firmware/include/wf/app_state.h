@@ -9,7 +9,9 @@
 #include <stdint.h>
 
 #include "wf/attitude.h"
+#include "wf/cpg.h"
 #include "wf/hal.h"
+#include "wf/health.h"
 #include "wf/mpu6050.h"
 #include "wf/servo.h"
 #include "wf/wire.h"
@@ -33,6 +35,13 @@ typedef struct {
     float attitude_tau_s;          /* complementary filter's time constant for roll, pitch */
     float battery_v_per_count;     /* ADC count -> battery volts (reference and divider) */
     float low_battery_v;           /* LOW_BATTERY below this */
+    /* The link settings at boot; LINK_CONFIG changes them (and telemetry_period_ms) in the
+     * running copy, app.config, in the same ranges. */
+    uint32_t health_period_ms;     /* 2000; 0: HEALTH only once, after boot */
+    uint32_t link_timeout_ms;      /* 1500: gait mode, no valid host frame this long: COASTING */
+    uint32_t coast_ms;             /* 3000: then RESTING */
+    uint8_t telemetry_form;        /* wf_telemetry_form_t: FULL */
+    float failsafe_slew_rad_s;     /* 2.0: stream mode's failsafe moves to neutral this fast */
 } wf_config_t;
 
 /* The decoder's drop counters that an ERROR reports, one per code (ERROR codes 1-4, 6), and
@@ -40,6 +49,20 @@ typedef struct {
  * at most 2.75 kB/s, so a flood of garbage never crowds the telemetry (6.2 kB/s) off 115200
  * baud. */
 enum { WF_REPORTED_KINDS = 5, WF_ERROR_MIN_INTERVAL_MS = 20 };
+
+/* ACKs wait here and go out one per poll, oldest first (a poll's output stays bounded); a
+ * GAIT or LINK_CONFIG that finds the queue full gets no ACK (the host resends it). */
+enum { WF_ACK_QUEUE = 4 };
+
+/* In gait mode, more than this many steps behind the clock are dropped (the state is kept):
+ * a stalled board resumes from where it stopped instead of racing through the backlog; and at
+ * most WF_CPG_STEPS_PER_POLL steps are taken in one poll (about 60 us of a Cortex-M4's time
+ * each 1 ms poll when catching up). */
+enum { WF_CPG_MAX_LAG_MS = 1000, WF_CPG_STEPS_PER_POLL = 50 };
+
+/* Where gait mode is with the link: swimming, coasting (link lost) or resting (lost past the
+ * coast). */
+typedef enum { WF_GAP_NONE = 0, WF_GAP_COASTING = 1, WF_GAP_RESTING = 2 } wf_gap_t;
 
 typedef struct {
     wf_config_t config;
@@ -54,21 +77,38 @@ typedef struct {
     bool have_heartbeat;           /* a host HEARTBEAT within the heartbeat timeout */
     uint32_t last_command_ms;
     uint32_t last_heartbeat_ms;
+    uint32_t last_host_frame_ms;   /* the last valid frame of any host type */
     float commanded[WF_SERVO_COUNT];
+
+    /* gait mode: the board integrates eq 1 itself */
+    bool gait_mode;
+    uint16_t gait_id;              /* the last accepted GAIT's id (0 in stream mode) */
+    wf_cpg_params_t gait;          /* the last accepted GAIT's parameters */
+    uint8_t gap;                   /* wf_gap_t */
+    uint32_t cpg_time_ms;          /* the board time the CPG's state is at */
+    wf_cpg_t cpg;
+
+    /* acknowledgements waiting to be sent */
+    wf_ack_t acks[WF_ACK_QUEUE];
+    uint8_t ack_count;
 
     /* outputs */
     float target[WF_SERVO_COUNT];  /* after the failsafe and the clamp: what the PWM shows */
     uint32_t compare[WF_SERVO_COUNT];
+    uint32_t last_output_ms;       /* the stream failsafe's slew: time of the last update */
     uint16_t status;
 
     /* schedule (ms of wf_hal_millis; every comparison is modular) */
     uint32_t now_ms;
     uint32_t next_telemetry_ms;
     uint32_t next_heartbeat_ms;
+    uint32_t next_health_ms;
+    bool health_sent;              /* the boot HEALTH is out */
     uint32_t next_imu_ms;
     uint32_t next_imu_probe_ms;
     uint32_t last_imu_ms;
     bool imu_sampled;
+    bool imu_lost;                 /* a read failed since the last successful probe */
 
     /* sensors */
     wf_mpu6050_t imu;
@@ -84,12 +124,23 @@ typedef struct {
     uint32_t frames_sent;
     uint32_t errors_sent;
     uint32_t tx_bytes_dropped;     /* bytes the UART's transmit queue had no room for */
+    uint32_t acks_dropped;         /* ACKs that found the queue full */
+    uint32_t gaits_accepted;
+    uint32_t gaits_refused;
+
+    /* What HEALTH reports. The port writes its own fields (reset cause, clock source, flags,
+     * fault record, stack, UART overruns, I2C bus recoveries) after wf_app_init and whenever
+     * they change; the core writes the rest (uptime, decoder and transmit drops, IMU faults and
+     * recoveries) when it sends the message. */
+    wf_health_t health;
 } wf_app_t;
 
 /* True when every value of config is in range: timeouts and periods 1..2^31-1 ms, frame rate
  * 50..333 Hz, limit (0, pi], neutral (0, 20000] us, gain (0, 1e5] us/rad, direction +-1,
  * axes a rotation, a known IMU mode, tau (0, 1000] s, (0, 1] V per count, low battery
- * (-1, 100] V. */
+ * (-1, 100] V; the link settings in LINK_CONFIG's ranges (health 0 or 200..60000 ms, link
+ * timeout 100..10000 ms, coast 0..60000 ms, form FULL or COMPACT), failsafe slew
+ * (0, 1000] rad/s. */
 bool wf_config_valid(const wf_config_t *config);
 
 #endif /* WF_APP_STATE_H */

@@ -13,13 +13,20 @@
 #include <stdint.h>
 
 #include "wf/cobs.h"
+#include "wf/cpg.h"
+#include "wf/health.h"
 
-#define WF_PROTOCOL_VERSION 1u
+#define WF_PROTOCOL_VERSION 2u
 
 typedef enum {
     WF_MSG_HEARTBEAT = 0x01,
+    WF_MSG_LINK_CONFIG = 0x02,
+    WF_MSG_ACK = 0x03,
     WF_MSG_SERVO_CMD = 0x10,
+    WF_MSG_GAIT = 0x11,
     WF_MSG_TELEMETRY = 0x20,
+    WF_MSG_TELEMETRY_COMPACT = 0x21,
+    WF_MSG_HEALTH = 0x30,
     WF_MSG_ERROR = 0x7F,
 } wf_msg_type_t;
 
@@ -41,21 +48,50 @@ enum {
     WF_STATUS_LOW_BATTERY = 0x0008,
     WF_STATUS_IMU_FAULT = 0x0010,
     WF_STATUS_VERSION_MISMATCH = 0x0020,
+    WF_STATUS_COASTING = 0x0040,       /* gait mode, link lost: still swimming the last gait */
+    WF_STATUS_RESTING = 0x0080,        /* gait mode, link lost past the coast: brought to rest */
+    WF_STATUS_GAIT_MODE = 0x0100,      /* the board integrates eq 1 itself (clear: stream) */
+    WF_STATUS_CLOCK_FALLBACK = 0x0200, /* running on HSI: the crystal failed */
 };
+
+typedef enum { WF_TELEMETRY_FULL = 0, WF_TELEMETRY_COMPACT = 1 } wf_telemetry_form_t;
+
+/* LINK_CONFIG's ranges (ms). A health period of 0 turns the periodic HEALTH off. */
+enum {
+    WF_LINK_TELEMETRY_MIN_MS = 10,
+    WF_LINK_TELEMETRY_MAX_MS = 1000,
+    WF_LINK_HEALTH_MIN_MS = 200,
+    WF_LINK_HEALTH_MAX_MS = 60000,
+    WF_LINK_TIMEOUT_MIN_MS = 100,
+    WF_LINK_TIMEOUT_MAX_MS = 10000,
+    WF_LINK_COAST_MAX_MS = 60000,
+};
+
+/* TELEMETRY_COMPACT's units (one count, SI): a value is v / lsb rounded to the nearest count,
+ * halves away from zero, in binary64, saturated to the field's range. */
+#define WF_COMPACT_ANGLE_LSB_RAD 1e-4  /* roll, pitch, yaw, servo angles: +-3.2767 rad */
+#define WF_COMPACT_RATE_LSB_RAD_S 1e-3 /* gyro: +-32.767 rad/s */
+#define WF_COMPACT_ACCEL_LSB_M_S2 1e-3 /* accel: +-32.767 m/s^2 */
+#define WF_COMPACT_BATTERY_LSB_V 1e-3  /* battery_mv: 0..65.535 V */
 
 /* Wire sizes, each the sum of its fields (checked by static_assert in wire.c). */
 #define WF_HEADER_SIZE 3u
 #define WF_CRC_SIZE 2u
 #define WF_HEARTBEAT_SIZE 6u
+#define WF_LINK_CONFIG_SIZE 9u
+#define WF_ACK_SIZE 4u
 #define WF_SERVO_CMD_SIZE 8u
-#define WF_TELEMETRY_SIZE 54u
+#define WF_GAIT_SIZE 42u
+#define WF_TELEMETRY_SIZE 56u
+#define WF_TELEMETRY_COMPACT_SIZE 32u
+#define WF_HEALTH_SIZE 61u
 #define WF_ERROR_SIZE 3u
-#define WF_MAX_PAYLOAD WF_TELEMETRY_SIZE
+#define WF_MAX_PAYLOAD WF_HEALTH_SIZE
 #define WF_MIN_BODY (WF_HEADER_SIZE + WF_CRC_SIZE)
 #define WF_MAX_BODY (WF_MIN_BODY + WF_MAX_PAYLOAD)
-/* The longest COBS run that can be a frame (60 bytes); a longer run is a lost delimiter. */
+/* The longest COBS run that can be a frame (67 bytes); a longer run is a lost delimiter. */
 #define WF_MAX_ENCODED WF_COBS_MAX_ENCODED(WF_MAX_BODY)
-/* The longest frame on the wire: both delimiters and the stuffed body (62 bytes). */
+/* The longest frame on the wire: both delimiters and the stuffed body (69 bytes). */
 #define WF_MAX_WIRE (WF_MAX_ENCODED + 2u)
 
 typedef struct {
@@ -65,8 +101,27 @@ typedef struct {
 } wf_heartbeat_t;
 
 typedef struct {
+    uint16_t telemetry_period_ms;
+    uint8_t telemetry_form; /* wf_telemetry_form_t */
+    uint16_t health_period_ms;
+    uint16_t link_timeout_ms;
+    uint16_t coast_ms;
+} wf_link_config_t;
+
+typedef struct {
+    uint8_t acked_type;
+    uint16_t acked_seq;
+    uint8_t result; /* 0 accepted, else the wf_error_code_t of the refusal */
+} wf_ack_t;
+
+typedef struct {
     float servo[2];
 } wf_servo_cmd_t;
+
+typedef struct {
+    uint16_t gait_id; /* 1..65535 (0: none) */
+    wf_cpg_params_t params;
+} wf_gait_t;
 
 typedef struct {
     uint32_t board_time_ms;
@@ -76,7 +131,19 @@ typedef struct {
     float servo[2];
     float battery_v;
     uint16_t status;
+    uint16_t gait_id;
 } wf_telemetry_t;
+
+typedef struct {
+    uint32_t board_time_ms;
+    int16_t roll, pitch, yaw; /* 1e-4 rad */
+    int16_t gyro[3];          /* 1e-3 rad/s */
+    int16_t accel[3];         /* 1e-3 m/s^2 */
+    int16_t servo[2];         /* 1e-4 rad */
+    uint16_t battery_mv;
+    uint16_t status;
+    uint16_t gait_id;
+} wf_telemetry_compact_t;
 
 typedef struct {
     uint8_t code;
@@ -88,8 +155,13 @@ typedef struct {
     uint16_t seq;
     union {
         wf_heartbeat_t heartbeat;
+        wf_link_config_t link_config;
+        wf_ack_t ack;
         wf_servo_cmd_t servo_cmd;
+        wf_gait_t gait;
         wf_telemetry_t telemetry;
+        wf_telemetry_compact_t compact;
+        wf_health_t health;
         wf_error_t error;
     } u;
 } wf_msg_t;
@@ -104,6 +176,16 @@ size_t wf_encode_body(const wf_msg_t *msg, uint8_t *out);
 /* Writes 0x00 COBS(body) 0x00 into out (capacity cap, WF_MAX_WIRE always suffices); returns
  * the wire length, 0 if the type is unknown or cap is short. */
 size_t wf_encode_frame(const wf_msg_t *msg, uint8_t *out, size_t cap);
+
+/* The compact form of a full telemetry (each value scaled, rounded and saturated). */
+void wf_telemetry_compact(const wf_telemetry_t *full, wf_telemetry_compact_t *compact);
+
+/* The rules a receiver applies to a well-formed LINK_CONFIG: every field in its range. */
+bool wf_link_config_valid(const wf_link_config_t *config);
+
+/* The rules a receiver applies to a well-formed GAIT: gait_id 1..65535 and the parameters
+ * within wf_cpg_params_valid for the board's servo limit. */
+bool wf_gait_valid(const wf_gait_t *gait, float servo_limit_rad);
 
 /* Why a run was dropped, or that it is a frame; the checks in the order they are made. */
 typedef enum {

@@ -68,9 +68,237 @@ void wf_host_board_snapshot(wf_host_snapshot_t *s)
     s->config_rejected = a->config_rejected;
 }
 
+void wf_host_board_gait(wf_host_gait_snapshot_t *s)
+{
+    const wf_app_t *a = &the_app;
+    memset(s, 0, sizeof *s);
+    s->gait_mode = a->gait_mode;
+    s->gap = a->gap;
+    s->gait_id = a->gait_id;
+    s->cpg_time_ms = a->cpg_time_ms;
+    s->cpg_steps = a->cpg.steps;
+    for (unsigned i = 0; i < 2; i++) {
+        s->phase[i] = wf_cpg_phase(&a->cpg, i);
+        s->r[i] = a->cpg.r[i];
+        s->dr[i] = a->cpg.dr[i];
+        s->b[i] = a->cpg.b[i];
+        s->db[i] = a->cpg.db[i];
+        s->target[i] = a->target[i];
+        s->compare[i] = wf_host_compare(i);
+    }
+    wf_cpg_output(&a->cpg, s->output, s->rate);
+    s->status = a->status;
+    s->ack_count = a->ack_count;
+    s->telemetry_form = a->config.telemetry_form;
+    s->acks_dropped = a->acks_dropped;
+    s->gaits_accepted = a->gaits_accepted;
+    s->gaits_refused = a->gaits_refused;
+    s->telemetry_period_ms = a->config.telemetry_period_ms;
+    s->health_period_ms = a->config.health_period_ms;
+    s->link_timeout_ms = a->config.link_timeout_ms;
+    s->coast_ms = a->config.coast_ms;
+    s->params = a->cpg.params;
+}
+
+size_t wf_host_gait_snapshot_size(void) { return sizeof(wf_host_gait_snapshot_t); }
+
+void wf_host_board_health(wf_health_t *health) { *health = the_app.health; }
+
+void wf_host_board_set_port_health(const wf_health_t *in)
+{
+    wf_health_t *h = &the_app.health;
+    h->reset_cause = in->reset_cause;
+    h->clock_source = in->clock_source;
+    h->flags = in->flags;
+    h->fault_pc = in->fault_pc;
+    h->fault_lr = in->fault_lr;
+    h->fault_cfsr = in->fault_cfsr;
+    h->fault_hfsr = in->fault_hfsr;
+    h->stack_free_min = in->stack_free_min;
+    h->stack_size = in->stack_size;
+    h->uart_rx_overruns = in->uart_rx_overruns;
+    h->i2c_bus_recoveries = in->i2c_bus_recoveries;
+}
+
+size_t wf_host_health_size(void) { return sizeof(wf_health_t); }
+
+/* --- a lone CPG ------------------------------------------------------------------------- */
+static wf_cpg_t lone_cpg;
+
+void wf_host_cpg_init(const wf_cpg_params_t *params) { wf_cpg_init(&lone_cpg, params); }
+
+void wf_host_cpg_set_params(const wf_cpg_params_t *params)
+{
+    wf_cpg_set_params(&lone_cpg, params);
+}
+
+void wf_host_cpg_run(uint32_t steps, float *angles, float *phases)
+{
+    for (uint32_t k = 0; k < steps; k++) {
+        wf_cpg_step(&lone_cpg);
+        if (angles != NULL) {
+            wf_cpg_output(&lone_cpg, angles + 2 * k, NULL);
+        }
+        if (phases != NULL) {
+            phases[2 * k] = wf_cpg_phase(&lone_cpg, 0);
+            phases[2 * k + 1] = wf_cpg_phase(&lone_cpg, 1);
+        }
+    }
+}
+
+void wf_host_cpg_state(float state[10])
+{
+    const wf_cpg_t *c = &lone_cpg;
+    const float values[10] = {wf_cpg_phase(c, 0), wf_cpg_phase(c, 1), c->r[0], c->r[1],
+                              c->dr[0],           c->dr[1],           c->b[0], c->b[1],
+                              c->db[0],           c->db[1]};
+    memcpy(state, values, sizeof values);
+}
+
+void wf_host_cpg_output(float angle[2], float rate[2]) { wf_cpg_output(&lone_cpg, angle, rate); }
+
+size_t wf_host_cpg_params_size(void) { return sizeof(wf_cpg_params_t); }
+
+size_t wf_host_msg_size(void) { return sizeof(wf_host_msg_t); }
+
 size_t wf_host_config_size(void) { return sizeof(wf_config_t); }
 
 size_t wf_host_snapshot_size(void) { return sizeof(wf_host_snapshot_t); }
+
+/* The float fields of a GAIT in wire order. */
+static void gait_floats(const wf_cpg_params_t *p, float out[10])
+{
+    const float v[10] = {p->frequency_hz, p->amplitude[0], p->amplitude[1], p->offset[0],
+                         p->offset[1],    p->w12,          p->w21,          p->phi12,
+                         p->phi21,        p->alpha};
+    memcpy(out, v, sizeof v);
+}
+
+static void gait_from_floats(const float v[10], wf_cpg_params_t *p)
+{
+    p->frequency_hz = v[0];
+    p->amplitude[0] = v[1];
+    p->amplitude[1] = v[2];
+    p->offset[0] = v[3];
+    p->offset[1] = v[4];
+    p->w12 = v[5];
+    p->w21 = v[6];
+    p->phi12 = v[7];
+    p->phi21 = v[8];
+    p->alpha = v[9];
+}
+
+/* The integer fields of a message in n's order (wf_host.h); returns how many. */
+static size_t ints_of(const wf_msg_t *m, int64_t n[WF_HOST_MSG_INTS])
+{
+    switch (m->type) {
+    case WF_MSG_TELEMETRY:
+        n[0] = m->u.telemetry.gait_id;
+        return 1;
+    case WF_MSG_LINK_CONFIG: {
+        const wf_link_config_t *c = &m->u.link_config;
+        const int64_t v[5] = {c->telemetry_period_ms, c->telemetry_form, c->health_period_ms,
+                              c->link_timeout_ms, c->coast_ms};
+        memcpy(n, v, sizeof v);
+        return 5;
+    }
+    case WF_MSG_ACK:
+        n[0] = m->u.ack.acked_type;
+        n[1] = m->u.ack.acked_seq;
+        n[2] = m->u.ack.result;
+        return 3;
+    case WF_MSG_GAIT:
+        n[0] = m->u.gait.gait_id;
+        return 1;
+    case WF_MSG_TELEMETRY_COMPACT: {
+        const wf_telemetry_compact_t *c = &m->u.compact;
+        const int64_t v[15] = {c->board_time_ms, c->roll,     c->pitch,    c->yaw,
+                               c->gyro[0],       c->gyro[1],  c->gyro[2],  c->accel[0],
+                               c->accel[1],      c->accel[2], c->servo[0], c->servo[1],
+                               c->battery_mv,    c->status,   c->gait_id};
+        memcpy(n, v, sizeof v);
+        return 15;
+    }
+    case WF_MSG_HEALTH: {
+        const wf_health_t *h = &m->u.health;
+        const int64_t v[20] = {h->reset_cause,      h->clock_source,     h->flags,
+                               h->fault_pc,         h->fault_lr,         h->fault_cfsr,
+                               h->fault_hfsr,       h->uptime_ms,        h->stack_free_min,
+                               h->stack_size,       h->uart_rx_overruns, h->tx_bytes_dropped,
+                               h->rx_crc,           h->rx_frame,         h->rx_unknown_type,
+                               h->rx_length,        h->rx_invalid,       h->imu_faults,
+                               h->imu_recoveries,   h->i2c_bus_recoveries};
+        memcpy(n, v, sizeof v);
+        return 20;
+    }
+    default:
+        return 0;
+    }
+}
+
+static void ints_to(const int64_t n[WF_HOST_MSG_INTS], wf_msg_t *m)
+{
+    switch (m->type) {
+    case WF_MSG_TELEMETRY:
+        m->u.telemetry.gait_id = (uint16_t)n[0];
+        break;
+    case WF_MSG_LINK_CONFIG: {
+        wf_link_config_t *c = &m->u.link_config;
+        c->telemetry_period_ms = (uint16_t)n[0];
+        c->telemetry_form = (uint8_t)n[1];
+        c->health_period_ms = (uint16_t)n[2];
+        c->link_timeout_ms = (uint16_t)n[3];
+        c->coast_ms = (uint16_t)n[4];
+        break;
+    }
+    case WF_MSG_ACK:
+        m->u.ack.acked_type = (uint8_t)n[0];
+        m->u.ack.acked_seq = (uint16_t)n[1];
+        m->u.ack.result = (uint8_t)n[2];
+        break;
+    case WF_MSG_GAIT:
+        m->u.gait.gait_id = (uint16_t)n[0];
+        break;
+    case WF_MSG_TELEMETRY_COMPACT: {
+        wf_telemetry_compact_t *c = &m->u.compact;
+        int16_t *const fields[11] = {&c->roll,     &c->pitch,    &c->yaw,      &c->gyro[0],
+                                     &c->gyro[1],  &c->gyro[2],  &c->accel[0], &c->accel[1],
+                                     &c->accel[2], &c->servo[0], &c->servo[1]};
+        c->board_time_ms = (uint32_t)n[0];
+        for (int i = 0; i < 11; i++) {
+            *fields[i] = (int16_t)n[1 + i];
+        }
+        c->battery_mv = (uint16_t)n[12];
+        c->status = (uint16_t)n[13];
+        c->gait_id = (uint16_t)n[14];
+        break;
+    }
+    case WF_MSG_HEALTH: {
+        wf_health_t *h = &m->u.health;
+        uint32_t *const words[12] = {&h->fault_pc,         &h->fault_lr,
+                                     &h->fault_cfsr,       &h->fault_hfsr,
+                                     &h->uptime_ms,        &h->uart_rx_overruns,
+                                     &h->tx_bytes_dropped, &h->rx_crc,
+                                     &h->rx_frame,         &h->rx_unknown_type,
+                                     &h->rx_length,        &h->rx_invalid};
+        static const int word_index[12] = {3, 4, 5, 6, 7, 10, 11, 12, 13, 14, 15, 16};
+        h->reset_cause = (uint8_t)n[0];
+        h->clock_source = (uint8_t)n[1];
+        h->flags = (uint8_t)n[2];
+        for (int i = 0; i < 12; i++) {
+            *words[i] = (uint32_t)n[word_index[i]];
+        }
+        h->stack_free_min = (uint16_t)n[8];
+        h->stack_size = (uint16_t)n[9];
+        h->imu_faults = (uint16_t)n[17];
+        h->imu_recoveries = (uint16_t)n[18];
+        h->i2c_bus_recoveries = (uint16_t)n[19];
+        break;
+    }
+    default:
+        break;
+    }
+}
 
 static void flatten(const wf_msg_t *m, wf_host_msg_t *f)
 {
@@ -101,9 +329,13 @@ static void flatten(const wf_msg_t *m, wf_host_msg_t *f)
         f->version_or_code = m->u.error.code;
         f->ref_seq_or_status = m->u.error.ref_seq;
         break;
+    case WF_MSG_GAIT:
+        gait_floats(&m->u.gait.params, f->f);
+        break;
     default:
         break;
     }
+    (void)ints_of(m, f->n);
 }
 
 static void unflatten(const wf_host_msg_t *f, wf_msg_t *m)
@@ -137,9 +369,13 @@ static void unflatten(const wf_host_msg_t *f, wf_msg_t *m)
         m->u.error.code = f->version_or_code;
         m->u.error.ref_seq = f->ref_seq_or_status;
         break;
+    case WF_MSG_GAIT:
+        gait_from_floats(f->f, &m->u.gait.params);
+        break;
     default:
         break;
     }
+    ints_to(f->n, m);
 }
 
 size_t wf_host_decode_stream(const uint8_t *in, size_t len, wf_host_msg_t *out, size_t max,

@@ -11,6 +11,8 @@
 #include <stdint.h>
 
 #include "wf/app.h"
+#include "wf/cpg.h"
+#include "wf/health.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -101,7 +103,58 @@ void wf_host_board_snapshot(wf_host_snapshot_t *snapshot);
 size_t wf_host_config_size(void);
 size_t wf_host_snapshot_size(void);
 
-/* Batch codec for tests. A flat message: every field of every type (the type's own are used). */
+/* Gait mode, the CPG and the link settings of the board (a view next to the snapshot). */
+typedef struct {
+    uint8_t gait_mode;
+    uint8_t gap;           /* wf_gap_t: 0 none, 1 coasting, 2 resting */
+    uint16_t gait_id;      /* the last accepted GAIT's (also after leaving gait mode: 0) */
+    uint32_t cpg_time_ms;  /* the board time the CPG's state is at */
+    uint32_t cpg_steps;    /* RK4 steps since gait mode was entered */
+    float phase[2];        /* xi_i wrapped to [-pi, pi) */
+    float r[2], dr[2], b[2], db[2];
+    float output[2];       /* Theta_i of the state, before the clamp */
+    float rate[2];         /* their time derivatives */
+    float target[2];       /* what the PWM shows (after the clamp / the failsafe's slew) */
+    uint32_t compare[2];
+    uint16_t status;
+    uint8_t ack_count;
+    uint8_t telemetry_form;
+    uint32_t acks_dropped;
+    uint32_t gaits_accepted;
+    uint32_t gaits_refused;
+    uint32_t telemetry_period_ms;
+    uint32_t health_period_ms;
+    uint32_t link_timeout_ms;
+    uint32_t coast_ms;
+    wf_cpg_params_t params; /* the targets the CPG runs on now (at rest: R = B = 0) */
+} wf_host_gait_snapshot_t;
+
+void wf_host_board_gait(wf_host_gait_snapshot_t *snapshot);
+size_t wf_host_gait_snapshot_size(void);
+/* The board's wf_health_t as last sent (the core fills its fields when it sends HEALTH). */
+void wf_host_board_health(wf_health_t *health);
+/* Writes the port's fields of the board's health (reset cause, clock source, flags, fault
+ * record, stack, UART overruns, I2C bus recoveries) from health; the core's are left alone. */
+void wf_host_board_set_port_health(const wf_health_t *health);
+size_t wf_host_health_size(void);
+
+/* A lone CPG (wf/cpg.h) next to the board, for the parity with wirefish_cpg. */
+void wf_host_cpg_init(const wf_cpg_params_t *params);
+void wf_host_cpg_set_params(const wf_cpg_params_t *params);
+/* Takes steps RK4 steps; angles (NULL: none) gets Theta_1, Theta_2 after each step and phases
+ * (NULL: none) xi_1, xi_2 (wrapped) after each. */
+void wf_host_cpg_run(uint32_t steps, float *angles, float *phases);
+/* The state in CpgIntegrator's flat order: xi1, xi2, r1, r2, r1', r2', b1, b2, b1', b2'. */
+void wf_host_cpg_state(float state[10]);
+void wf_host_cpg_output(float angle[2], float rate[2]);
+size_t wf_host_cpg_params_size(void);
+
+/* Batch codec for tests. A flat message: every field of every type (the type's own are used).
+ * n holds the integer fields the first part has no place for, each widened, in wire order:
+ * TELEMETRY gait_id; LINK_CONFIG period, form, health period, link timeout, coast; ACK
+ * acked_type, acked_seq, result; GAIT gait_id (its floats in f[0..9], wire order);
+ * TELEMETRY_COMPACT all 15 fields; HEALTH all 20 fields. */
+enum { WF_HOST_MSG_INTS = 20 };
 typedef struct {
     uint8_t type;
     uint8_t version_or_code;
@@ -111,7 +164,11 @@ typedef struct {
     uint16_t ref_seq_or_status;
     uint32_t uptime_or_time_ms;
     float f[12];  /* SERVO_CMD: f[0], f[1]; TELEMETRY: roll..battery_v in wire order */
+    uint32_t pad2;
+    int64_t n[WF_HOST_MSG_INTS];
 } wf_host_msg_t;
+
+size_t wf_host_msg_size(void);
 
 /* Decodes a stream (any bytes) into at most max messages; returns how many; *stats gets the
  * decoder's counters (wf_decoder_stats_t order) when not NULL. */
