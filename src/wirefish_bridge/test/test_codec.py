@@ -7,12 +7,16 @@ from cobs import cobs
 from hypothesis import given, settings, strategies as st
 import pytest
 from wirefish_bridge.codec import (crc16, DecoderStats, encode_body, encode_frame, FrameEncoder,
-                                   MAX_ENCODED_FRAME, StreamDecoder)
-from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, message_class,
-                                      MsgType, Role, ServoCommand, Status, Telemetry)
+                                   MAX_BODY, MAX_ENCODED_FRAME, StreamDecoder)
+from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
+                                      Heartbeat, LinkConfig, message_class, MsgType,
+                                      ResetCause, Role, ServoCommand, Status, Telemetry,
+                                      TelemetryCompact)
 
 f32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
+u8 = st.integers(0, 0xFF)
 u16 = st.integers(0, 0xFFFF)
+i16 = st.integers(-0x8000, 0x7FFF)
 u32 = st.integers(0, 0xFFFFFFFF)
 # One strategy per registered message class (a test below keeps it complete).
 STRATEGIES = {
@@ -21,17 +25,33 @@ STRATEGIES = {
     ServoCommand: st.builds(ServoCommand, f32, f32),
     Telemetry: st.builds(Telemetry, board_time_ms=u32, roll=f32, pitch=f32, yaw=f32,
                          gyro=st.tuples(f32, f32, f32), accel=st.tuples(f32, f32, f32),
-                         servo_1=f32, servo_2=f32, battery_v=f32, status=u16),
-    ErrorReport: st.builds(ErrorReport, code=st.integers(0, 255), ref_seq=u16),
+                         servo_1=f32, servo_2=f32, battery_v=f32, status=u16, gait_id=u16),
+    ErrorReport: st.builds(ErrorReport, code=u8, ref_seq=u16),
+    # Every value of a field without floats decodes: ranges are the receiver's rules.
+    LinkConfig: st.builds(LinkConfig, u16, u8, u16, u16, u16),
+    Ack: st.builds(Ack, u8, u16, u8),
+    Gait: st.builds(Gait, u16, *[f32] * 10),
+    TelemetryCompact: st.builds(TelemetryCompact, board_time_ms=u32, roll=i16, pitch=i16,
+                                yaw=i16, gyro=st.tuples(i16, i16, i16),
+                                accel=st.tuples(i16, i16, i16), servo_1=i16, servo_2=i16,
+                                battery_mv=u16, status=u16, gait_id=u16),
+    Health: st.builds(Health, u8, u8, u8, u32, u32, u32, u32, u32, u16, u16,
+                      *[u32] * 7, u16, u16, u16),
 }
 messages = st.one_of(*STRATEGIES.values())
 TELEMETRY = Telemetry(board_time_ms=1234, roll=0.1, pitch=-0.2, yaw=3.0, gyro=(0.0, 0.5, -1.0),
                       accel=(0.25, 0.0, 9.75), servo_1=0.375, servo_2=-0.5, battery_v=8.125,
-                      status=int(Status.LOW_BATTERY))
+                      status=int(Status.LOW_BATTERY | Status.GAIT_MODE), gait_id=3)
 
 
 def test_the_round_trips_cover_every_registered_message():
     assert set(STRATEGIES) == {message_class(kind) for kind in MsgType}
+
+
+def test_frame_bounds_follow_the_largest_payload_health():
+    # PROTOCOL.md: longest body 66, longest COBS run 67, longest frame on the wire 69.
+    assert (MAX_BODY, MAX_ENCODED_FRAME) == (66, 67)
+    assert len(encode_frame(Health(), 0)) == MAX_ENCODED_FRAME + 2
 
 
 def test_crc16_is_ccitt_false():
@@ -76,8 +96,8 @@ def test_telemetry_example_encodes_to_the_documented_hex():
     frame = encode_frame(TELEMETRY, 0x0102)
     assert frame.hex(' ') == (
         '00 06 20 02 01 d2 04 01 09 cd cc cc 3d cd cc 4c be 01 03 40 40 01 01 01 01 01 01 02 '
-        '3f 01 03 80 bf 01 03 80 3e 01 01 01 01 01 03 1c 41 01 03 c0 3e 01 01 02 bf 01 04 02 '
-        '41 08 03 5c f1 00')
+        '3f 01 03 80 bf 01 03 80 3e 01 01 01 01 01 03 1c 41 01 03 c0 3e 01 01 02 bf 01 06 02 '
+        '41 08 01 03 03 ea d9 00')
 
 
 def test_servo_command_example_encodes_to_the_documented_hex():
@@ -140,6 +160,26 @@ def test_sequence_numbers_wrap_without_gaps():
     decoder = StreamDecoder()
     decoder.feed(b''.join(encoder.encode(Heartbeat()) for _ in range(4)))
     assert (decoder.stats.frames_ok, decoder.stats.seq_gaps) == (4, 0)
+
+
+def test_a_gait_with_a_non_finite_float_is_dropped_as_invalid():
+    body = encode_body(Gait(1, 1.0, 0.1, 0.1), 5)
+    payload = bytearray(body[3:-2])
+    payload[2 + 4 * 9:2 + 4 * 10] = struct.pack('<f', math.inf)  # alpha
+    stream = _reencoded(body[:3] + payload + struct.pack('<H', crc16(body[:3] + payload)))
+    decoder = StreamDecoder()
+    assert decoder.feed(stream) == [] and decoder.stats.invalid_payload == 1
+
+
+def test_out_of_range_link_config_gait_and_health_values_still_decode():
+    # The fish answers those with ACK 6; the host shows an unknown reset cause as a number.
+    for message in (LinkConfig(5, 7, 1, 0, 65535), Gait(0, 50.0, -1.0, 9.0),
+                    Health(reset_cause=200, clock_source=9), Ack(0x55, 3, 200)):
+        (frame,) = StreamDecoder().feed(encode_frame(message, 1))
+        assert frame.message == message
+    (frame,) = StreamDecoder().feed(encode_frame(Health(ResetCause.IWDG, ClockSource.HSI), 1))
+    assert frame.message.reset_cause is ResetCause.IWDG
+    assert frame.message.clock_source is ClockSource.HSI
 
 
 def test_error_report_carries_its_code():

@@ -4,15 +4,17 @@ from dataclasses import dataclass
 
 import pytest
 from wirefish_bridge.codec import encode_frame
-from wirefish_bridge.protocol import (ErrorReport, Heartbeat, message_class, message_type,
-                                      MsgType, pack_payload, PAYLOAD_SIZES, ProtocolMessage,
-                                      ServoCommand, Telemetry, UnknownMessageError,
-                                      unpack_payload)
+from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat, LinkConfig,
+                                      message_class, message_type, MsgType, pack_payload,
+                                      PAYLOAD_SIZES, ProtocolMessage, ServoCommand, Telemetry,
+                                      TelemetryCompact, UnknownMessageError, unpack_payload)
 
 
 @pytest.mark.parametrize('kind, cls, size', [   # the sizes of PROTOCOL.md's message table
-    (MsgType.HEARTBEAT, Heartbeat, 6), (MsgType.SERVO_CMD, ServoCommand, 8),
-    (MsgType.TELEMETRY, Telemetry, 54), (MsgType.ERROR, ErrorReport, 3),
+    (MsgType.HEARTBEAT, Heartbeat, 6), (MsgType.LINK_CONFIG, LinkConfig, 9),
+    (MsgType.ACK, Ack, 4), (MsgType.SERVO_CMD, ServoCommand, 8), (MsgType.GAIT, Gait, 42),
+    (MsgType.TELEMETRY, Telemetry, 56), (MsgType.TELEMETRY_COMPACT, TelemetryCompact, 32),
+    (MsgType.HEALTH, Health, 61), (MsgType.ERROR, ErrorReport, 3),
 ])
 def test_each_type_byte_has_its_one_class_and_documented_size(kind, cls, size):
     assert message_class(kind) is cls and cls.KIND is kind
@@ -44,7 +46,7 @@ def test_a_message_needs_a_type_byte_and_a_layout():
             pass
 
 
-@pytest.mark.parametrize('kind', [0x00, 0x02, 0x55, 0xFF])
+@pytest.mark.parametrize('kind', [0x00, 0x04, 0x12, 0x55, 0xFF])
 def test_an_unregistered_type_byte_decodes_to_nothing(kind):
     assert message_class(kind) is None
     assert unpack_payload(kind, bytes(PAYLOAD_SIZES[MsgType.ERROR])) is None

@@ -6,6 +6,11 @@ impossible value (a firmware bug, a sensor read gone wrong, a forged frame) woul
 published as a measurement. Every field the firmware reports has a limit here, and why.
 Limits are inclusive. ``ANGLE_SLACK_RAD`` lets an angle wrapped to exactly +-pi (or a pitch
 of exactly +-pi/2) through after the firmware rounds it to float32 (float32(pi) > pi by 9e-8).
+TELEMETRY_COMPACT is judged on its expanded values with half a count more on every limit (the
+fish rounds to the nearest count: pi is 31416 counts of 1e-4 rad, 7e-6 rad beyond pi).
+The status bits must also agree with each other and with the gait id: COASTING and RESTING
+only in gait mode and never both, and a gait id exactly in gait mode (an accepted GAIT's id is
+never 0).
 """
 
 from __future__ import annotations
@@ -14,7 +19,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 import math
 
-from wirefish_bridge.protocol import Status, Telemetry
+from wirefish_bridge.protocol import (ACCEL_LSB_M_S2, ANGLE_LSB_RAD, BATTERY_LSB_V,
+                                      RATE_LSB_RAD_S, Status, Telemetry, TelemetryCompact)
 
 ANGLE_SLACK_RAD = 1e-6
 # MPU6050 (section 2.1 of the paper): its widest full-scale ranges are +-2000 deg/s and +-16 g;
@@ -58,6 +64,14 @@ LIMITS: dict[str, Limit] = {
 }
 
 
+# Half a count of TELEMETRY_COMPACT per limit: what the fish's rounding may add.
+COMPACT_SLACK: dict[str, float] = {
+    'roll': ANGLE_LSB_RAD / 2, 'pitch': ANGLE_LSB_RAD / 2, 'yaw': ANGLE_LSB_RAD / 2,
+    'gyro': RATE_LSB_RAD_S / 2, 'accel': ACCEL_LSB_M_S2 / 2, 'servo': ANGLE_LSB_RAD / 2,
+    'battery_v': BATTERY_LSB_V / 2,
+}
+
+
 def _fields(telemetry: Telemetry) -> Iterator[tuple[str, str, float]]:
     """Yield (field name, limit name, value) of every range-checked float."""
     yield 'roll', 'roll', telemetry.roll
@@ -72,18 +86,37 @@ def _fields(telemetry: Telemetry) -> Iterator[tuple[str, str, float]]:
     yield 'battery_v', 'battery_v', telemetry.battery_v
 
 
-def telemetry_problem(telemetry: Telemetry) -> str | None:
+def telemetry_problem(telemetry: Telemetry | TelemetryCompact) -> str | None:
     """
-    Return why ``telemetry`` cannot be a measurement (the first impossible field), or None.
+    Return why ``telemetry`` (either form) cannot be a measurement (the first reason), or None.
 
-    Board time may be any u32 (it wraps); status may carry only the bits PROTOCOL.md defines.
+    Board time may be any u32 (it wraps); status may carry only the bits PROTOCOL.md defines,
+    in combinations the fish can be in.
     """
+    slack: dict[str, float] = {}
+    if isinstance(telemetry, TelemetryCompact):
+        telemetry, slack = telemetry.expanded(), COMPACT_SLACK
     for name, limit_name, value in _fields(telemetry):
         limit = LIMITS[limit_name]
-        if not limit.low <= value <= limit.high:
+        extra = slack.get(limit_name, 0.0)
+        if not limit.low - extra <= value <= limit.high + extra:
             return (f'{name} = {value:.6g} {limit.unit} outside [{limit.low:.6g}, '
                     f'{limit.high:.6g}] ({limit.why})')
-    unknown = telemetry.status & ~KNOWN_STATUS_BITS
+    return status_problem(telemetry.status, telemetry.gait_id)
+
+
+def status_problem(status: int, gait_id: int) -> str | None:
+    """Return why ``status`` with ``gait_id`` is no state of the fish, or None."""
+    unknown = status & ~KNOWN_STATUS_BITS
     if unknown:
-        return f'status 0x{telemetry.status:04x} has undefined bits 0x{unknown:04x}'
+        return f'status 0x{status:04x} has undefined bits 0x{unknown:04x}'
+    gait_mode = bool(status & Status.GAIT_MODE)
+    gap = status & (Status.COASTING | Status.RESTING)
+    if gap and not gait_mode:
+        return f'status 0x{status:04x}: coasting or resting outside gait mode'
+    if gap == Status.COASTING | Status.RESTING:
+        return f'status 0x{status:04x}: coasting and resting at once'
+    if gait_mode != (gait_id != 0):
+        return (f'gait_id {gait_id} with GAIT_MODE {"set" if gait_mode else "clear"} (a gait '
+                'runs exactly in gait mode)')
     return None
