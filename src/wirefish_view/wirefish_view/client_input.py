@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import json
 import math
 
-from wirefish_view.errors import RefusedInput
+from wirefish_view.errors import Refusal, RefusedInput
 
 TWIST = 'geometry_msgs/msg/Twist'
 ENCODINGS = ('cdr', 'json')
@@ -33,13 +33,13 @@ def check_advertised(topic: str, encoding: str, schema_name: str, cmd_vel_topic:
     """Raise ``RefusedInput`` unless a client channel is ``cmd_vel_topic`` as a Twist."""
     if topic != cmd_vel_topic:
         raise RefusedInput(f'client publish on {topic!r} refused: only {cmd_vel_topic} is '
-                           'accepted')
+                           'accepted', Refusal.CHANNEL)
     if encoding not in ENCODINGS:
         raise RefusedInput(f'client publish on {topic} in {encoding!r} refused: use '
-                           f'{" or ".join(ENCODINGS)}')
+                           f'{" or ".join(ENCODINGS)}', Refusal.CHANNEL)
     if schema_name.replace('/msg/', '/') != TWIST.replace('/msg/', '/'):
         raise RefusedInput(f'client publish on {topic} as {schema_name!r} refused: it is a '
-                           f'{TWIST}')
+                           f'{TWIST}', Refusal.CHANNEL)
 
 
 def _twist_fields(encoding: str, data: bytes) -> tuple[list[float], list[float]]:
@@ -68,11 +68,13 @@ def cmd_vel_from_client(encoding: str, data: bytes, max_speed: float, max_turn: 
     if not all(math.isfinite(v) for v in (*linear, *angular)):
         raise RefusedInput('cmd_vel: every field must be finite')
     if any(linear[1:]) or any(angular[:2]):
-        raise RefusedInput('cmd_vel: only linear.x and angular.z may be non-zero')
+        raise RefusedInput('cmd_vel: only linear.x and angular.z may be non-zero',
+                           Refusal.OUT_OF_LIMITS)
     speed, turn = linear[0], angular[2]
     if not 0.0 <= speed <= max_speed:
-        raise RefusedInput(f'cmd_vel: linear.x must be in [0, {max_speed:g}] m/s, got {speed:g}')
+        raise RefusedInput(f'cmd_vel: linear.x must be in [0, {max_speed:g}] m/s, got {speed:g}',
+                           Refusal.OUT_OF_LIMITS)
     if abs(turn) > max_turn:
         raise RefusedInput(f'cmd_vel: angular.z must be in [-{max_turn:g}, {max_turn:g}] '
-                           f'rad/s, got {turn:g}')
+                           f'rad/s, got {turn:g}', Refusal.OUT_OF_LIMITS)
     return CmdVel(speed, turn)

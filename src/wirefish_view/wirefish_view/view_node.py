@@ -1,7 +1,7 @@
 """
 view_node: a Foxglove WebSocket server over the fish's graph, and the dashboard's web server.
 
-Channels (protocol ``foxglove.sdk.v1``)
+Channels (protocol ``foxglove.sdk.v1``, also offered as ``foxglove.websocket.v1``)
     Every topic of the graph in the node's namespace, and ``/tf``, ``/tf_static`` and
     ``/diagnostics``: one CDR channel each with its ``ros2msg`` schema, found by a discovery
     tick (``discovery_period_s``). A topic is subscribed (raw bytes: nothing is decoded) only
@@ -13,7 +13,8 @@ Channels (protocol ``foxglove.sdk.v1``)
 Client publish
     Accepted on ``cmd_vel`` (geometry_msgs/msg/Twist, CDR or JSON) within ``max_speed`` and
     ``max_turn`` (`wirefish drive`'s limits); any other channel, or a message outside the
-    limits or malformed, is refused: a warning in the log and a status message to the clients.
+    limits or malformed, is refused: a warning in the log and a status message to the client
+    that sent it, rate-limited per client and kind of refusal (``front_door``).
 Services (JSON)
     ``start``, ``stop`` (std_srvs/Trigger of cpg_node; stop also sends cmd_vel zero first, so
     the planner rests the fish), ``follow_commands`` (cpg_node's: hands the gait back to the
@@ -44,8 +45,7 @@ from typing import Any
 
 import foxglove
 from foxglove.channels import SceneUpdateChannel
-from foxglove.websocket import (Capability, ChannelView, Client, ClientChannel, ServerListener,
-                                StatusLevel)
+from foxglove.websocket import Capability, ChannelView, Client, ServerListener
 from geometry_msgs.msg import Twist
 from rclpy.action import ActionClient
 from rclpy.node import Node
@@ -59,7 +59,8 @@ from wirefish_common.qos import RELIABLE, SENSOR_DATA, TF
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
 from wirefish_view.client_input import check_advertised, cmd_vel_from_client
-from wirefish_view.errors import RefusedInput, UnknownType
+from wirefish_view.errors import UnknownType
+from wirefish_view.front_door import FrontDoor
 from wirefish_view.scene import fish_scene, tail_segments
 from wirefish_view.schemas import ros2msg_schema
 from wirefish_view.view_node_parameters import VIEW_PARAMETERS
@@ -78,7 +79,6 @@ RETUNE_PROGRESS_SCHEMA = json.dumps({
         'loss': {'type': 'number'}, 'iterations': {'type': 'integer'},
         'from_library': {'type': 'boolean'},
         'rmse_theta_deg': {'type': 'array', 'items': {'type': 'number'}}}}).encode()
-REFUSAL_LOG_PERIOD_S = 2.0
 
 
 def is_loopback(address: str) -> bool:
@@ -121,8 +121,6 @@ class ViewNode(Node):
         self._subscribers: dict[str, int] = {}  # topic -> clients subscribed
         self._raw_subscriptions: dict[str, Any] = {}
         self._requests: queue.Queue[tuple[str, str]] = queue.Queue()
-        self._allowed: dict[tuple[int, int], str] = {}  # (client, channel) -> encoding
-        self._refused_logged: dict[str, float] = {}
         self._trail: list[tuple[float, float]] = []
         self._segments: list[tuple[list[float], list[float]]] = []
         self._scene_inputs: list[Any] = []  # body_wave and /tf, while the scene is watched
@@ -157,20 +155,24 @@ class ViewNode(Node):
                     self._service('follow_commands', self._follow_client),
                     foxglove.Service(f'{self._namespace}/retune_gait', schema=_json_schema(
                         'wirefish_msgs/action/RetuneGait'), handler=self._on_retune)]
+        # The sdk's server on a loopback port of its own; the view's port is the front door's,
+        # which speaks either subprotocol name and answers client publishing per client.
         self._server = foxglove.start_server(
-            name=f'wirefish {self._namespace or "/"}', host=address, port=self._values['port'],
+            name=f'wirefish {self._namespace or "/"}', host='127.0.0.1', port=0,
             capabilities=[Capability.ClientPublish, Capability.Services],
             supported_encodings=['cdr', 'json'], server_listener=_Listener(self),
             services=services,
             context=self._fox_context)
+        self._front = FrontDoor(address, self._values['port'], self._server.port, self,
+                                self.get_logger().warn)
         self._web = None
         if self._values['http_port'] >= 0:
             self._web = DashboardServer(address, self._values['http_port'], {
-                'websocket_port': self._server.port, 'namespace': self._namespace,
+                'websocket_port': self._front.port, 'namespace': self._namespace,
                 'max_speed': self._values['max_speed'], 'max_turn': self._values['max_turn'],
                 'frames': self._frames})
         self.get_logger().info(
-            f'Foxglove WebSocket ws://{address}:{self._server.port}'
+            f'Foxglove WebSocket ws://{address}:{self._front.port}'
             + (f', dashboard http://{address}:{self._web.port}/' if self._web else ''))
 
     def _service(self, name: str, client: Any) -> foxglove.Service:
@@ -180,6 +182,7 @@ class ViewNode(Node):
 
     def destroy_node(self) -> None:
         """Stop the servers, then the node."""
+        self._front.stop()
         self._server.stop()
         if self._web is not None:
             self._web.stop()
@@ -238,43 +241,18 @@ class ViewNode(Node):
         """Drop the ROS subscription once no client wants it."""
         self._requests.put(('unsubscribe', channel.topic))
 
-    def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
-        """Accept a client's cmd_vel channel; refuse (log, status) any other."""
-        try:
-            check_advertised(channel.topic, channel.encoding, channel.schema_name,
-                             self._cmd_vel_topic)
-        except RefusedInput as error:
-            self._refuse(str(error))
-            return
-        self._allowed[(client.id, channel.id)] = channel.encoding
+    # --- client publishing (the front door's thread) --------------------------------------
+    def check_channel(self, topic: str, encoding: str, schema_name: str) -> None:
+        """Raise ``RefusedInput`` unless the channel is this graph's cmd_vel as a Twist."""
+        check_advertised(topic, encoding, schema_name, self._cmd_vel_topic)
 
-    def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
-        """Forget a client's channel."""
-        self._allowed.pop((client.id, client_channel_id), None)
-
-    def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
-        """Publish a client's cmd_vel once validated; refuse anything else."""
-        encoding = self._allowed.get((client.id, client_channel_id))
-        if encoding is None:
-            self._refuse(f'client {client.id}: message on channel {client_channel_id} refused: '
-                         f'only {self._cmd_vel_topic} is accepted')
-            return
-        try:
-            command = cmd_vel_from_client(encoding, data, self._values['max_speed'],
-                                          self._values['max_turn'])
-        except RefusedInput as error:
-            self._refuse(str(error))
-            return
+    def publish(self, encoding: str, data: bytes) -> None:
+        """Publish a client's cmd_vel once validated; raise ``RefusedInput`` otherwise."""
+        command = cmd_vel_from_client(encoding, data, self._values['max_speed'],
+                                      self._values['max_turn'])
         twist = Twist()
         twist.linear.x, twist.angular.z = command.speed, command.turn
         self._cmd_pub.publish(twist)
-
-    def _refuse(self, reason: str) -> None:
-        now = time.monotonic()
-        if now - self._refused_logged.get(reason, -math.inf) >= REFUSAL_LOG_PERIOD_S:
-            self._refused_logged[reason] = now
-            self.get_logger().warn(reason)
-        self._server.publish_status(reason, StatusLevel.Warning)
 
     # --- services (the server's threads) --------------------------------------------------
     def _on_trigger(self, name: str, client: Any, request: Any) -> bytes:
@@ -373,15 +351,6 @@ class _Listener(ServerListener):
 
     def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
         self._node.on_unsubscribe(client, channel)
-
-    def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
-        self._node.on_client_advertise(client, channel)
-
-    def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
-        self._node.on_client_unadvertise(client, client_channel_id)
-
-    def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
-        self._node.on_message_data(client, client_channel_id, data)
 
 
 def _type_of(channel: foxglove.Channel) -> type:

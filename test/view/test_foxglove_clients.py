@@ -1,0 +1,145 @@
+"""
+`wirefish up --sim --view` seen by the clients a ROS user brings, and clients kept apart.
+
+One graph for the module. The claims: Foxglove's own client library (`@foxglove/ws-protocol`'s
+FoxgloveClient, offering its default subprotocol ``foxglove.websocket.v1``, run by node from the
+dashboard's npm packages) lists every channel and decodes 20 s of each, the periodic ones at
+their nominal rates (+-5 %); a handshake offering neither name is refused with HTTP 400 and the
+offered and supported names in the view's log; 5,000 refused messages from one client leave a
+bystander connected, without a status of the flooder's, with servo_cmd at >= 95 Hz.
+"""
+
+import json
+from pathlib import Path
+import shutil
+import struct
+import subprocess
+import time
+
+from foxglove_client import FoxgloveClient
+import pytest
+from websockets.exceptions import InvalidStatus
+from websockets.sync.client import connect
+from wirefish_bringup.graph import default_params_file
+import yaml
+
+pytestmark = pytest.mark.ros
+
+CLIENT_SCRIPT = Path(__file__).with_name('ws_protocol_client.js')
+NODE = shutil.which('node')
+WARMUP_S, WINDOW_S = 4.0, 20.0
+RATE_TOLERANCE = 0.05
+
+
+def _parameter(node: str, name: str) -> float:
+    """Return a rate from the default params file (the graph the fixture runs)."""
+    values = yaml.safe_load(default_params_file().read_text())
+    return float(values[f'/**/{node}']['ros__parameters'][name])
+
+
+def nominal_rates(namespace: str) -> dict[str, float]:
+    """Return the periodic channels and their rates (Hz), from the parameters that set them."""
+    servo = _parameter('cpg_node', 'publish_rate_hz')
+    wave = _parameter('kinematics_node', 'publish_rate_hz')
+    rates = {
+        'servo_cmd': servo,
+        # The board's telemetry answers each command: one frame per servo command.
+        'servo_state': servo, 'imu/data': servo, 'attitude': servo,
+        'body_wave': wave,
+        'body_wave_markers': 10.0,  # kinematics_node's markers_rate_hz default
+        'planner_state': 20.0, 'cpg_command': 20.0,  # planner_node's control_rate_hz default
+        'battery': _parameter('bridge_node', 'battery_rate_hz'),
+        'sim/ground_truth': 50.0,  # fish_sim's ground truth rate
+    }
+    found = {f'{namespace}/{topic}': rate for topic, rate in rates.items()}
+    # /diagnostics: bridge_node's and planner_node's, at the same rate each.
+    found['/diagnostics'] = 2 * _parameter('bridge_node', 'diagnostics_rate_hz')
+    # /tf: tf_node's odom -> base_link (one per ground truth, 50 Hz) and tail frames (one per
+    # body_wave).
+    found['/tf'] = 50.0 + wave
+    return found
+
+
+def test_foxglove_ws_protocol_client_decodes_every_channel_at_its_rate(view_graph, tmp_path):
+    assert NODE, 'node is needed (the dashboard is built with it)'
+    namespace = view_graph.graph.namespace
+    # Every channel is advertised before the client connects, so it subscribes to all at once.
+    probe = FoxgloveClient(view_graph.ws_url)
+    try:
+        assert probe.wait(lambda: set(nominal_rates(namespace)) <= {
+            c['topic'] for c in probe.channels.values()}, timeout_s=30.0)
+    finally:
+        probe.close()
+    out = tmp_path / 'client.json'
+    run = subprocess.run([NODE, '--experimental-websocket', str(CLIENT_SCRIPT), view_graph.ws_url,
+                          str(WARMUP_S), str(WINDOW_S), str(out)],
+                         capture_output=True, text=True, timeout=WARMUP_S + WINDOW_S + 60)
+    assert run.returncode == 0, run.stdout + run.stderr + (out.read_text() if out.exists()
+                                                           else '')
+    result = json.loads(out.read_text())
+    assert result['subprotocol'] == 'foxglove.websocket.v1'
+    channels = result['channels']
+    for topic, channel in sorted(channels.items()):
+        print(f'{topic}: {channel["count"] / WINDOW_S:6.1f} Hz, {channel["received"]} decoded, '
+              f'{channel["failures"]} failures ({channel["encoding"]} {channel["schemaName"]})')
+    assert {t: c['firstError'] for t, c in channels.items() if c['failures']} == {}
+    assert f'{namespace}/view/scene' in channels and f'{namespace}/view/retune' in channels
+    off = {}
+    for topic, rate in nominal_rates(namespace).items():
+        measured = channels[topic]['count'] / WINDOW_S
+        if abs(measured - rate) > RATE_TOLERANCE * rate:
+            off[topic] = (round(measured, 2), rate)
+    assert off == {}, f'measured, nominal (Hz): {off}'
+    # Every stream that published in the window was decoded (latched and event topics too).
+    assert channels[f'{namespace}/cpg_params']['received'] >= 1
+    assert channels['/tf_static']['received'] >= 1
+
+
+def test_a_handshake_offering_neither_name_is_refused_and_logged(view_graph):
+    with pytest.raises(InvalidStatus) as refused:
+        connect(view_graph.ws_url, subprotocols=['foxglove.websocket.v2'], open_timeout=10)
+    assert refused.value.response.status_code == 400
+    body = refused.value.response.body.decode()
+    assert "offered subprotocols ['foxglove.websocket.v2']" in body
+    assert "'foxglove.sdk.v1', 'foxglove.websocket.v1'" in body
+    logs = list(view_graph.graph.out_dir.rglob('view_node*.log'))
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline and not any(
+            'foxglove.websocket.v2' in p.read_text() for p in logs):
+        time.sleep(0.2)
+    assert any("offered subprotocols ['foxglove.websocket.v2']" in p.read_text()
+               for p in logs), logs
+
+
+def test_a_flood_of_refused_messages_reaches_neither_a_bystander_nor_its_stream(view_graph):
+    namespace = view_graph.graph.namespace
+    servo_cmd = f'{namespace}/servo_cmd'
+    bystander = FoxgloveClient(view_graph.ws_url)
+    flooder = FoxgloveClient(view_graph.ws_url)
+    try:
+        assert bystander.wait(lambda: bystander.channel_of(servo_cmd) is not None, 30.0)
+        subscription = bystander.subscribe(bystander.channel_of(servo_cmd)['id'])
+        assert bystander.wait(lambda: len(bystander.messages.get(subscription, [])) > 100, 20.0)
+        channel = flooder.advertise(servo_cmd, 'json', 'sensor_msgs/msg/JointState')
+        start = time.monotonic()
+        with bystander.lock:
+            before = len(bystander.messages[subscription])
+        for _ in range(5000):
+            flooder.ws.send(struct.pack('<BI', 1, channel) + b'{"position": [1.0, 1.0]}')
+        # Then the bystander's stream over a window that starts with the flood.
+        time.sleep(max(0.0, 5.0 - (time.monotonic() - start)))
+        elapsed = time.monotonic() - start
+        with bystander.lock:
+            rate = (len(bystander.messages[subscription]) - before) / elapsed
+        print(f'flood: 5000 refused in {elapsed:.1f} s; the bystander had servo_cmd at '
+              f'{rate:.1f} Hz, {len(bystander.statuses)} statuses; the flooder '
+              f'{len(flooder.statuses)} statuses')
+        assert not bystander.closed and rate >= 95.0
+        assert flooder.wait(lambda: any('refused' in s['message'] for s in flooder.statuses),
+                            10.0)
+        assert [s for s in bystander.statuses if 'refused' in s['message']] == []
+        # Rate-limited per client and reason: a handful, not thousands.
+        assert len(flooder.statuses) <= 2 + 2 * elapsed
+    finally:
+        flooder.close()
+        bystander.close()
