@@ -1,4 +1,4 @@
-/* The QEMU build's debug console on USART2 (see debug_console.h). */
+/* The QEMU build's debug console on USART2 (see debug_console.h); linked only into that build. */
 #include "debug_console.h"
 
 #if WF_PORT_QEMU
@@ -11,13 +11,15 @@
 RING_DEFINE(debug_ring, 2048);
 static uint32_t last_config_ms;
 static const wf_config_t *config;
+static uint8_t rx_last;            /* the byte USART1 received before (the interrupt's own) */
+static uint32_t compare_seen[2];   /* the compare registers at the last "P" line */
 
 void debug_console_init(const wf_config_t *board_config)
 {
     config = board_config;
     RCC_APB1ENR |= RCC_APB1ENR_USART2;
-    USART_BRR(USART2_BASE) = (BOARD_APB1_HZ + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
-    USART_CR1(USART2_BASE) = USART_CR1_UE | USART_CR1_TE;
+    USART_BRR(USART2_BASE) = (board_clocks.apb1_hz + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
+    USART_CR1(USART2_BASE) = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE;
 }
 
 static void put_number(int32_t value)
@@ -63,7 +65,7 @@ static void flush(void)
  * first (it is the consumer), so none of its lines is lost; an interrupt that finds no room
  * drops its whole line and counts it (the "C" line reports the count): a cut line would be
  * misread. */
-void debug_console_line(char tag, const int32_t *values, unsigned count)
+static void line(char tag, const int32_t *values, unsigned count)
 {
     const uint32_t needed = 2u + 12u * count;
     if (!in_interrupt()) {
@@ -85,8 +87,78 @@ void debug_console_line(char tag, const int32_t *values, unsigned count)
     board_irq_restore(primask);
 }
 
+void trace_rx_byte(uint8_t byte)
+{
+    if (byte == 0u && rx_last != 0u) {   /* a delimiter that ends a frame */
+        const int32_t now = (int32_t)wf_hal_millis();
+        line('Z', &now, 1u);
+    }
+    rx_last = byte;
+}
+
+void trace_compare(unsigned servo)
+{
+    const uint32_t now = servo == 0u ? TIM_CCR1(TIM3_BASE) : TIM_CCR2(TIM3_BASE);
+    if (now != compare_seen[servo]) {   /* what the timer holds: the tests read it back */
+        compare_seen[servo] = now;
+        const int32_t event[3] = {(int32_t)wf_hal_millis(), (int32_t)servo, (int32_t)now};
+        line('P', event, 3u);
+    }
+}
+
+/* The fault path: interrupts are masked and the main loop will not run again; everything
+ * queued goes out first, then the fault's own line, synchronously. */
+void trace_fault(uint8_t cause, uint32_t pc)
+{
+    const int32_t fault[4] = {cause, (int32_t)pc, (int32_t)TIM_CCR1(TIM3_BASE),
+                              (int32_t)TIM_CCR2(TIM3_BASE)};
+    flush();
+    if (debug_ring.mask + 1u - ring_used(&debug_ring) >= 2u + 12u * 4u) {
+        (void)ring_put(&debug_ring, 'F');
+        for (unsigned i = 0u; i < 4u; i++) {
+            (void)ring_put(&debug_ring, ' ');
+            put_number(fault[i]);
+        }
+        (void)ring_put(&debug_ring, '\n');
+    }
+    flush();
+}
+
+/* --- failing on purpose ------------------------------------------------------------------ */
+/* Each level keeps 64 bytes and uses them after the call, so no level is a tail call. */
+__attribute__((noinline)) static uint32_t dive(uint32_t depth)
+{
+    volatile uint8_t pad[64];
+    if (depth > 1000000u) {   /* never reached: 64 MB of stack */
+        return 0u;
+    }
+    pad[depth % sizeof pad] = (uint8_t)depth;
+    return dive(depth + 1u) + pad[(depth + 1u) % sizeof pad];
+}
+
+static void command(uint8_t byte)
+{
+    switch (byte) {
+    case 'H':
+        /* UsageFault is not enabled: the undefined instruction escalates to a HardFault. */
+        __asm volatile("udf #0");
+        break;
+    case 'W':
+        for (;;) {   /* the poll loop never comes back: only the watchdog ends this */
+        }
+    case 'S':
+        (void)dive(0u);
+        break;
+    default:
+        break;
+    }
+}
+
 void debug_console_poll(void)
 {
+    while (USART_SR(USART2_BASE) & USART_SR_RXNE) {
+        command((uint8_t)USART_DR(USART2_BASE));
+    }
     uint32_t now = wf_hal_millis();
     if (now - last_config_ms >= 1000u) {
         last_config_ms = now;
@@ -94,15 +166,21 @@ void debug_console_poll(void)
                                   (int32_t)board_pwm_period(), (int32_t)lines_dropped,
                                   (int32_t)board_uart_rx_overflows(),
                                   (int32_t)board_virtual_ns()};
-        debug_console_line('C', timer, 5u);
+        line('C', timer, 5u);
         for (unsigned i = 0u; i < WF_SERVO_COUNT; i++) {
             const wf_servo_cal_t *cal = &config->servo_cal[i];
             const int32_t servo[5] = {(int32_t)i, (int32_t)(cal->neutral_us * 1000.0f + 0.5f),
                                       (int32_t)(cal->us_per_rad * 1000.0f + 0.5f),
                                       cal->direction,
                                       (int32_t)(config->servo_limit_rad * 1e6f + 0.5f)};
-            debug_console_line('K', servo, 5u);
+            line('K', servo, 5u);
         }
+        wf_health_t h = {0};
+        wf_hal_health_port(&h);
+        const int32_t health[9] = {h.reset_cause, (int32_t)h.fault_pc, (int32_t)h.fault_lr,
+                                   (int32_t)h.fault_cfsr, (int32_t)h.fault_hfsr, h.flags,
+                                   h.stack_free_min, h.stack_size, h.clock_source};
+        line('R', health, 9u);
     }
     flush();
 }

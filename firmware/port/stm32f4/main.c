@@ -1,7 +1,9 @@
 /*
- * The board's main: set up the clocks, the millisecond clock, the link UART, I2C1 and the
- * ADC, then hand over to the portable core (wf/app.h) and poll it for ever. The core starts
- * the servo timer itself (wf_hal_pwm_init with its configured frame rate).
+ * The board's main: the reset cause and the stack guard, the brown-out level, the watchdog,
+ * the clocks, the millisecond clock, the link UART, I2C1 and the ADC; then the portable core
+ * (wf/app.h), polled for ever with the watchdog fed once per complete poll. The core starts
+ * the servo timer itself (wf_hal_pwm_init with its configured frame rate) and writes the
+ * neutral compares, which the fault path then reuses.
  */
 #include "board.h"
 #include "debug_console.h"
@@ -12,6 +14,9 @@ static wf_config_t config;
 
 int main(void)
 {
+    board_boot();
+    board_bor_init();        /* before the watchdog: an option-byte write takes a while, once */
+    board_watchdog_start();  /* from here every wait below is bounded well inside it */
     board_clock_init();
     board_systick_init();
     board_uart_init();
@@ -25,9 +30,11 @@ int main(void)
 #endif
     debug_console_init(&config);
     wf_app_init(&app, &config);
+    board_pwm_set_failsafe(app.compare);   /* the neutral pulses wf_app_init wrote */
     for (;;) {
         wf_app_poll(&app);
         debug_console_poll();
+        board_watchdog_feed();   /* here only: a poll that never ends is never fed */
         /* Sleep until the next interrupt: SysTick (1 ms) or a received byte. A byte that came
          * during the poll was queued by its interrupt and is read at the next tick. The core
          * needs nothing faster (its schedule is in ms); an emulator then idles too. */

@@ -16,12 +16,14 @@ ARM_FLASH_BUDGET := 32768
 ARM_RAM_BUDGET := 8192
 ARM_ARCH := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 CORE_INCLUDES ?= -Iinclude
-WARNINGS ?= -Wall -Wextra -Werror
+WARNINGS ?= -Wall -Wextra -Werror -Wundef
 ARM_CFLAGS := $(ARM_ARCH) -std=c11 -Os -g $(WARNINGS) -ffunction-sections \
 	-fdata-sections $(CORE_INCLUDES) -I$(STM32F4_DIR)
 ARM_LDFLAGS := $(ARM_ARCH) --specs=nano.specs --specs=nosys.specs -nostartfiles \
 	-T$(STM32F4_DIR)/stm32f4.ld -Wl,--gc-sections
 ARM_PORT_SRCS := $(wildcard $(STM32F4_DIR)/*.c)
+# The emulator's test console: only the QEMU image links it (debug_console.h).
+ARM_TEST_SRCS := $(STM32F4_DIR)/debug_console.c
 
 .PHONY: arm qemu arm-toolchain
 arm: $(ARM_BUILD)/arm/wirefish.elf $(ARM_BUILD)/arm/wirefish.bin
@@ -41,9 +43,10 @@ arm-toolchain:
 	  "'make setup' as root (it installs it with apt), or install gcc-arm-none-eabi and" \
 	  "libnewlib-arm-none-eabi" >&2; exit 1; }
 
-# One variant: $(1) its name (the build directory), $(2) its defines.
+# One variant: $(1) its name (the build directory), $(2) its defines (WF_PORT_QEMU always
+# defined: -Wundef), $(3) its port sources.
 define ARM_VARIANT
-$(1)_OBJS := $$(patsubst %.c,$(ARM_BUILD)/$(1)/obj/%.o,$(ARM_PORT_SRCS) $(CORE_SRCS))
+$(1)_OBJS := $$(patsubst %.c,$(ARM_BUILD)/$(1)/obj/%.o,$(3) $(CORE_SRCS))
 $(ARM_BUILD)/$(1)/obj/%.o: %.c | arm-toolchain
 	@mkdir -p $$(@D)
 	$(ARM_CC) $(ARM_CFLAGS) $(2) -MMD -MP -c $$< -o $$@
@@ -52,8 +55,8 @@ $(ARM_BUILD)/$(1)/wirefish.elf: $$($(1)_OBJS) $(STM32F4_DIR)/stm32f4.ld
 -include $$($(1)_OBJS:.o=.d)
 endef
 
-$(eval $(call ARM_VARIANT,arm,))
-$(eval $(call ARM_VARIANT,qemu,-DWF_PORT_QEMU=1))
+$(eval $(call ARM_VARIANT,arm,-DWF_PORT_QEMU=0,$(filter-out $(ARM_TEST_SRCS),$(ARM_PORT_SRCS))))
+$(eval $(call ARM_VARIANT,qemu,-DWF_PORT_QEMU=1,$(ARM_PORT_SRCS)))
 
 $(ARM_BUILD)/arm/wirefish.bin: $(ARM_BUILD)/arm/wirefish.elf
 	$(ARM_OBJCOPY) -O binary $< $@

@@ -1,6 +1,7 @@
 /*
  * Servo PWM on TIM3 (RM0090 18): channel 1 = servo 0 on PC6, channel 2 = servo 1 on PC7
- * (AF2). The timer counts at 1 MHz (PSC 83 from the 84 MHz APB1 timer clock), so a compare
+ * (AF2). The timer counts at 1 MHz (PSC 83 from the 84 MHz APB1 timer clock; 15 from the
+ * 16 MHz of the HSI without PLL), so a compare
  * value is a pulse width in microseconds and the period is 1e6 / frame_hz ticks: 20000 at
  * 50 Hz, 3003 at 333 Hz (a 16-bit ARR holds both). PWM mode 1 with preload: a new compare
  * takes effect at the next period, so a pulse is never cut short.
@@ -15,6 +16,24 @@
 enum { PWM_TICK_HZ = 1000000, PWM_MIN_HZ = 50, PWM_MAX_HZ = 333 };
 
 static uint32_t period_ticks;
+static uint32_t failsafe_compare[2];
+
+void board_pwm_set_failsafe(const uint32_t compare[2])
+{
+    failsafe_compare[0] = compare[0];
+    failsafe_compare[1] = compare[1];
+}
+
+/* The fault path's write: only registers, nothing that could itself fault on a broken state.
+ * Preloaded: the pulse under way finishes, the next one is neutral. */
+void board_pwm_failsafe(void)
+{
+    if (period_ticks == 0u) {
+        return;   /* the timer never started: its pins are still inputs, no pulse goes out */
+    }
+    TIM_CCR1(TIM3_BASE) = failsafe_compare[0];
+    TIM_CCR2(TIM3_BASE) = failsafe_compare[1];
+}
 
 uint32_t board_pwm_period(void)
 {
@@ -36,7 +55,7 @@ bool wf_hal_pwm_init(uint32_t frame_hz)
     gpio_alternate(GPIOC_BASE, 7u, 2u, 0);
     period_ticks = PWM_TICK_HZ / frame_hz;
     TIM_CR1(TIM3_BASE) = 0u;
-    TIM_PSC(TIM3_BASE) = BOARD_APB1_TIMER_HZ / PWM_TICK_HZ - 1u;
+    TIM_PSC(TIM3_BASE) = board_clocks.apb1_timer_hz / PWM_TICK_HZ - 1u;
     TIM_ARR(TIM3_BASE) = period_ticks - 1u;
     TIM_CCMR1(TIM3_BASE) = TIM_CCMR1_OC1M_PWM1 | TIM_CCMR1_OC1PE | TIM_CCMR1_OC2M_PWM1
                            | TIM_CCMR1_OC2PE;
@@ -55,11 +74,6 @@ void wf_hal_pwm_set_compare(unsigned servo, uint32_t compare_ticks)
     if (compare_ticks > period_ticks) {
         compare_ticks = period_ticks;   /* a compare beyond the period is a constant high */
     }
-    uint32_t before = *ccr;
     *ccr = compare_ticks;
-    uint32_t now = *ccr;   /* what the timer holds: the test reads this value back */
-    if (now != before) {
-        const int32_t event[3] = {(int32_t)wf_hal_millis(), (int32_t)servo, (int32_t)now};
-        debug_console_line('P', event, 3u);
-    }
+    trace_compare(servo);   /* the QEMU build: a "P" line when the register changed */
 }

@@ -18,6 +18,22 @@
 #define SYST_CSR_TICKINT (1u << 1)
 #define SYST_CSR_CLKSOURCE (1u << 2)  /* processor clock */
 #define NVIC_ISER(n) WF_REG(0xE000E100u + 4u * (n))
+#define SCB_AIRCR WF_REG(0xE000ED0Cu)
+#define SCB_AIRCR_SYSRESETREQ (0x05FAu << 16 | 1u << 2)   /* VECTKEY and the request */
+#define SCB_SHCSR WF_REG(0xE000ED24u)
+#define SCB_SHCSR_MEMFAULTENA (1u << 16)
+#define SCB_CFSR WF_REG(0xE000ED28u)   /* MMFSR | BFSR << 8 | UFSR << 16 */
+#define SCB_HFSR WF_REG(0xE000ED2Cu)
+#define MPU_TYPE WF_REG(0xE000ED90u)
+#define MPU_CTRL WF_REG(0xE000ED94u)
+#define MPU_RNR WF_REG(0xE000ED98u)
+#define MPU_RBAR WF_REG(0xE000ED9Cu)
+#define MPU_RASR WF_REG(0xE000EDA0u)
+#define MPU_CTRL_ENABLE (1u << 0)
+#define MPU_CTRL_PRIVDEFENA (1u << 2)   /* the default map wherever no region says otherwise */
+#define MPU_RASR_ENABLE (1u << 0)
+#define MPU_RASR_XN (1u << 28)
+#define MPU_RASR_SIZE_32B (4u << 1)     /* 2^(SIZE + 1) bytes */
 
 /* --- RCC (RM0090 7.3) ------------------------------------------------------------------- */
 #define RCC_BASE 0x40023800u
@@ -27,11 +43,23 @@
 #define RCC_AHB1ENR WF_REG(RCC_BASE + 0x30u)
 #define RCC_APB1ENR WF_REG(RCC_BASE + 0x40u)
 #define RCC_APB2ENR WF_REG(RCC_BASE + 0x44u)
+#define RCC_CIR WF_REG(RCC_BASE + 0x0Cu)
+#define RCC_CSR WF_REG(RCC_BASE + 0x74u)
+#define RCC_CR_HSION (1u << 0)
+#define RCC_CR_HSIRDY (1u << 1)
+#define RCC_CR_CSSON (1u << 19)
+#define RCC_CIR_CSSF (1u << 7)
+#define RCC_CIR_CSSC (1u << 23)
+#define RCC_CSR_RMVF (1u << 24)
+#define RCC_CSR_FLAGS (0x7Fu << 25)   /* BORRSTF .. LPWRRSTF: wf/fault_record.h's positions */
+#define RCC_PLLCFGR_SRC_HSE (1u << 22)
 #define RCC_CR_HSEON (1u << 16)
 #define RCC_CR_HSERDY (1u << 17)
 #define RCC_CR_PLLON (1u << 24)
 #define RCC_CR_PLLRDY (1u << 25)
+#define RCC_CFGR_SW_MASK 3u
 #define RCC_CFGR_SW_PLL 2u
+#define RCC_CFGR_SWS_HSI (0u << 2)
 #define RCC_CFGR_SWS_MASK (3u << 2)
 #define RCC_CFGR_SWS_PLL (2u << 2)
 #define RCC_CFGR_HPRE_DIV1 (0u << 4)
@@ -49,6 +77,17 @@
 
 /* --- Flash interface (RM0090 3.9) -------------------------------------------------------- */
 #define FLASH_ACR WF_REG(0x40023C00u)
+#define FLASH_OPTKEYR WF_REG(0x40023C08u)
+#define FLASH_SR WF_REG(0x40023C0Cu)
+#define FLASH_OPTCR WF_REG(0x40023C14u)
+#define FLASH_OPTKEY1 0x08192A3Bu
+#define FLASH_OPTKEY2 0x4C5D6E7Fu
+#define FLASH_SR_BSY (1u << 16)
+#define FLASH_SR_ERRORS 0xF2u          /* OPERR, WRPERR, PGAERR, PGPERR, PGSERR */
+#define FLASH_OPTCR_OPTLOCK (1u << 0)
+#define FLASH_OPTCR_OPTSTRT (1u << 1)
+#define FLASH_OPTCR_BOR_LEV_MASK (3u << 2)
+#define FLASH_OPTCR_BOR_LEV3 (0u << 2)  /* 2.70-3.60 V (RM0090 3.7.1) */
 #define FLASH_ACR_LATENCY_5WS 5u
 #define FLASH_ACR_PRFTEN (1u << 8)
 #define FLASH_ACR_ICEN (1u << 9)
@@ -62,9 +101,12 @@
 #define GPIO_OTYPER(base) WF_REG((base) + 0x04u)
 #define GPIO_OSPEEDR(base) WF_REG((base) + 0x08u)
 #define GPIO_PUPDR(base) WF_REG((base) + 0x0Cu)
+#define GPIO_IDR(base) WF_REG((base) + 0x10u)
+#define GPIO_BSRR(base) WF_REG((base) + 0x18u)   /* bits 0-15 set, 16-31 reset */
 #define GPIO_AFRL(base) WF_REG((base) + 0x20u)
 #define GPIO_AFRH(base) WF_REG((base) + 0x24u)
 #define GPIO_MODE_ANALOG 3u
+#define GPIO_MODE_OUTPUT 1u
 #define GPIO_MODE_AF 2u
 
 /* --- USART (RM0090 30.6) ---------------------------------------------------------------- */
@@ -122,7 +164,9 @@
 #define I2C_CR1_START (1u << 8)
 #define I2C_CR1_STOP (1u << 9)
 #define I2C_CR1_ACK (1u << 10)
+#define I2C_CR1_POS (1u << 11)
 #define I2C_CR1_SWRST (1u << 15)
+#define I2C_CCR_FS (1u << 15)
 #define I2C_SR1_SB (1u << 0)
 #define I2C_SR1_ADDR (1u << 1)
 #define I2C_SR1_BTF (1u << 2)
@@ -143,8 +187,18 @@
 #define ADC_DR(base) WF_REG((base) + 0x4Cu)
 #define ADC_CCR WF_REG(0x40012304u)
 #define ADC_SR_EOC (1u << 1)
+#define ADC_SR_OVR (1u << 5)
 #define ADC_CR2_ADON (1u << 0)
 #define ADC_CR2_SWSTART (1u << 30)
 #define ADC_CCR_ADCPRE_DIV4 (1u << 16)
+
+/* --- Independent watchdog (RM0090 21.4) ------------------------------------------------ */
+#define IWDG_KR WF_REG(0x40003000u)
+#define IWDG_PR WF_REG(0x40003004u)
+#define IWDG_RLR WF_REG(0x40003008u)
+#define IWDG_SR WF_REG(0x4000300Cu)
+#define IWDG_KEY_START 0xCCCCu
+#define IWDG_KEY_UNLOCK 0x5555u
+#define IWDG_KEY_RELOAD 0xAAAAu
 
 #endif /* WF_STM32F4_REGS_H */

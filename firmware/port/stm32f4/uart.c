@@ -15,7 +15,6 @@
 RING_DEFINE(rx_ring, 256);
 RING_DEFINE(tx_ring, 512);
 static volatile uint32_t rx_overflows;   /* overruns: a byte came while DR was still full */
-static uint8_t rx_last;                  /* the byte received before (the handler's own) */
 
 uint32_t board_uart_rx_overflows(void)
 {
@@ -27,7 +26,7 @@ void board_uart_init(void)
     RCC_APB2ENR |= RCC_APB2ENR_USART1;
     gpio_alternate(GPIOA_BASE, 9u, 7u, 0);
     gpio_alternate(GPIOA_BASE, 10u, 7u, 0);
-    USART_BRR(USART1_BASE) = (BOARD_APB2_HZ + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
+    USART_BRR(USART1_BASE) = (board_clocks.apb2_hz + BOARD_UART_BAUD / 2u) / BOARD_UART_BAUD;
     USART_CR2(USART1_BASE) = 0u;
     USART_CR3(USART1_BASE) = 0u;
     USART_CR1(USART1_BASE) = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE;
@@ -51,11 +50,7 @@ void wf_usart1_handler(void)
                 rx_overflows = rx_overflows + 1u;
             }
             (void)ring_put(&rx_ring, byte);
-            if (byte == 0u && rx_last != 0u) {   /* a delimiter that ends a frame */
-                const int32_t now = (int32_t)wf_hal_millis();
-                debug_console_line('Z', &now, 1u);
-            }
-            rx_last = byte;
+            trace_rx_byte(byte);   /* the QEMU build: a "Z" line at each frame's end */
         }
     }
     if ((USART_CR1(USART1_BASE) & USART_CR1_TXEIE) && (status & USART_SR_TXE)) {
