@@ -157,7 +157,7 @@ def run_all(quick: bool = False) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmarks, write the JSON and BENCHMARKS.md."""
-    from wirefish_bench.bench_report import render_markdown
+    from wirefish_bench.bench_report import kept_history, render_markdown
 
     parser = argparse.ArgumentParser(prog='wirefish-bench', description=__doc__.strip())
     parser.add_argument('--quick', action='store_true', help='short windows (harness check)')
@@ -167,7 +167,8 @@ def main(argv: list[str] | None = None) -> int:
     results = run_all(quick=args.quick)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / 'results.json').write_text(json.dumps(results, indent=2, default=str))
-    args.markdown.write_text(render_markdown(results))
+    previous = args.markdown.read_text() if args.markdown.exists() else ''
+    args.markdown.write_text(render_markdown(results, kept_history(previous)))
     print(f'wrote {args.markdown} and {args.out / "results.json"}')
     return 0
 

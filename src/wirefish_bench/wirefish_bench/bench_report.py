@@ -290,8 +290,17 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     return table
 
 
-def render_markdown(results: dict) -> str:
-    """Return the whole BENCHMARKS.md text."""
+HISTORY_HEADING = '## History'
+
+
+def kept_history(previous: str) -> str:
+    """Return the History section of a previous BENCHMARKS.md text (to its end), or ''."""
+    at = previous.find(f'\n{HISTORY_HEADING}\n')
+    return previous[at + 1:] if at >= 0 else ''
+
+
+def render_markdown(results: dict, history: str = '') -> str:
+    """Return the whole BENCHMARKS.md text: this run's table, then ``history`` as it was."""
     m = results['machine']
     lines = ['# Benchmarks', '',
              'Written by `make bench` (`python -m wirefish_bench.bench`); figures from one '
@@ -307,4 +316,4 @@ def render_markdown(results: dict) -> str:
     lines += ['', 'Raw numbers: `out/bench/results.json` of the same run. Why the figures are '
               'what they are (py-spy profiles, what limits each missed goal, what would close '
               'it): [docs/PROFILING.md](docs/PROFILING.md).', '']
-    return '\n'.join(lines)
+    return '\n'.join(lines) + ('\n' + history if history else '')
