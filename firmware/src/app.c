@@ -23,7 +23,10 @@
 enum {
     RX_CHUNK = 64,
     RX_CHUNKS_PER_POLL = 8, /* 512 bytes: bounds one poll's work whatever the UART holds */
-    IMU_PROBE_PERIOD_MS = 1000,
+    /* An absent or failed IMU is probed again this often: a probe of an empty bus costs one
+     * NACKed address (25 us at 400 kHz) and a bus recovery that finds it idle, so a sensor
+     * that comes back (a short gone, a reset part) is trusted again within ~0.1 s. */
+    IMU_PROBE_PERIOD_MS = 100,
 };
 
 static bool due(uint32_t now, uint32_t at)
@@ -176,6 +179,7 @@ static void send_health(wf_app_t *app)
 {
     wf_health_t *h = &app->health;
     const wf_decoder_stats_t *s = &app->decoder.stats;
+    wf_hal_health_port(h);
     h->uptime_ms = app->now_ms;
     h->tx_bytes_dropped = app->tx_bytes_dropped;
     h->rx_crc = s->crc_errors;
@@ -576,6 +580,7 @@ void wf_app_init(wf_app_t *app, const wf_config_t *config)
     }
     wf_decoder_init(&app->decoder);
     wf_attitude_reset(&app->attitude);
+    wf_hal_health_port(&app->health); /* the clock source, for CLOCK_FALLBACK from the start */
     app->host_version_ok = true; /* until a host announces another version */
     app->now_ms = wf_hal_millis();
     app->next_telemetry_ms = app->now_ms + app->config.telemetry_period_ms;

@@ -439,9 +439,13 @@ static bool tiny_mpu(void *context, uint8_t address7, const uint8_t *tx, size_t 
         mpu_regs[reg] = tx[i];
         reg = (uint8_t)((reg + 1) & 0x7F);
     }
+    const bool data_read = reg == 0x3B && rx_len == 14;
     for (size_t i = 0; i < rx_len; i++) {
         rx[i] = mpu_regs[reg];
         reg = (uint8_t)((reg + 1) & 0x7F);
+    }
+    if (data_read) {
+        mpu_regs[0x48] ^= 1u; /* a live sensor's noise: gyro z's lowest bit changes */
     }
     return true;
 }
@@ -462,6 +466,486 @@ static void test_imu_sample_reaches_the_telemetry(void)
     wf_host_set_i2c_device(NULL, NULL); /* the sensor drops off the bus */
     run_until(1001, 1010);
     CHECK(raw_snap().status & WF_STATUS_IMU_FAULT);
+}
+
+/* --- protocol v2: gait mode, LINK_CONFIG, ACK, HEALTH, compact telemetry ----------------- */
+static wf_cpg_params_t table1_gait(void)
+{
+    /* Table 1 of the paper at 2 Hz, alpha 20, a small offset on the second oscillator. */
+    wf_cpg_params_t p = {.frequency_hz = 2.0f, .amplitude = {0.38f, 0.47f},
+                         .offset = {0.0f, 0.1f}, .w12 = -0.41f, .w21 = 0.64f,
+                         .phi12 = 1.76f, .phi21 = 1.06f, .alpha = 20.0f};
+    return p;
+}
+
+static uint16_t send_gait(uint32_t t, uint16_t gait_id, const wf_cpg_params_t *p)
+{
+    wf_msg_t msg = {.type = WF_MSG_GAIT};
+    msg.u.gait.gait_id = gait_id;
+    msg.u.gait.params = *p;
+    send_msg(t, &msg);
+    return msg.seq;
+}
+
+static uint16_t send_link_config(uint32_t t, uint16_t telemetry_ms, uint8_t form,
+                                 uint16_t health_ms, uint16_t timeout_ms, uint16_t coast_ms)
+{
+    wf_msg_t msg = {.type = WF_MSG_LINK_CONFIG};
+    msg.u.link_config.telemetry_period_ms = telemetry_ms;
+    msg.u.link_config.telemetry_form = form;
+    msg.u.link_config.health_period_ms = health_ms;
+    msg.u.link_config.link_timeout_ms = timeout_ms;
+    msg.u.link_config.coast_ms = coast_ms;
+    send_msg(t, &msg);
+    return msg.seq;
+}
+
+static wf_host_gait_snapshot_t gait_snap(void)
+{
+    wf_host_gait_snapshot_t g;
+    wf_host_board_gait(&g);
+    return g;
+}
+
+/* Index of the first message of type in out[0..n), or n. */
+static size_t find(const wf_host_msg_t *out, size_t n, uint8_t type)
+{
+    size_t i = 0;
+    while (i < n && out[i].type != type) {
+        i++;
+    }
+    return i;
+}
+
+static size_t count(const wf_host_msg_t *out, size_t n, uint8_t type)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        k += out[i].type == type;
+    }
+    return k;
+}
+
+static void test_gait_is_acked_and_the_board_runs_eq_1_at_1_khz(void)
+{
+    static wf_host_msg_t out[4096];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    board_output(out, 4096);
+    const wf_cpg_params_t p = table1_gait();
+    const uint16_t seq = send_gait(5, 7, &p);
+    size_t n = board_output(out, 4096);
+    const size_t ack = find(out, n, WF_MSG_ACK);
+    CHECK(ack < n && out[ack].n[0] == WF_MSG_GAIT && out[ack].n[1] == seq && out[ack].n[2] == 0);
+    CHECK(count(out, n, WF_MSG_ERROR) == 0);
+    wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(g.gait_mode && g.gait_id == 7 && g.cpg_steps == 0 && g.cpg_time_ms == 5);
+    CHECK(g.target[0] == 0.0f && g.target[1] == 0.0f); /* from rest */
+    CHECK((snap().status & ~WF_STATUS_FAILSAFE_HEARTBEAT) == WF_STATUS_GAIT_MODE);
+    /* The same steps as a lone CPG from rest with the same parameters: bit for bit. */
+    wf_host_cpg_init(&p);
+    static float angles[2 * 1000];
+    wf_host_cpg_run(1000, angles, NULL);
+    for (uint32_t k = 1; k <= 1000; k++) {
+        wf_host_board_step(5 + k, NULL, 0, NULL, 0);
+        if (k % 97 == 0 || k == 1000) {
+            g = gait_snap();
+            CHECK(g.cpg_steps == k && g.cpg_time_ms == 5 + k);
+            CHECK(g.target[0] == angles[2 * (k - 1)] && g.target[1] == angles[2 * k - 1]);
+            const wf_config_t *c = NULL;
+            (void)c;
+            CHECK(g.compare[0] == (uint32_t)lroundf(1500.0f + 636.619772f * g.target[0]));
+        }
+    }
+    /* The gait id in every telemetry; a heartbeat every 200 ms keeps the link up. */
+    n = board_output(out, 4096);
+    size_t telemetry = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (out[i].type == WF_MSG_TELEMETRY) {
+            telemetry++;
+            CHECK(out[i].n[0] == 7 && (out[i].ref_seq_or_status & WF_STATUS_GAIT_MODE));
+        }
+    }
+    CHECK(telemetry == 100);
+}
+
+static void test_an_invalid_gait_is_refused_with_error_6_and_ack_6(void)
+{
+    static wf_host_msg_t out[256];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t good = table1_gait();
+    send_gait(1, 3, &good);
+    run_until(2, 101); /* the refusals below come at 101 too: no step in between */
+    const wf_host_gait_snapshot_t before = gait_snap();
+    wf_cpg_params_t bad[9];
+    for (int i = 0; i < 9; i++) {
+        bad[i] = good;
+    }
+    bad[0].frequency_hz = 0.0f;
+    bad[1].frequency_hz = 10.5f;
+    bad[2].amplitude[0] = -0.01f;
+    bad[3].amplitude[1] = 1.6f; /* beyond the servo limit */
+    bad[4].offset[0] = -1.6f;
+    bad[5].alpha = 0.0f;
+    bad[6].alpha = 200.5f;
+    bad[7] = good; /* gait_id 0 below */
+    bad[8].frequency_hz = -1.0f;
+    for (int i = 0; i < 9; i++) {
+        board_output(out, 256);
+        const uint16_t seq = send_gait(101, i == 7 ? 0 : 9, &bad[i]);
+        const size_t n = board_output(out, 256);
+        const size_t e = find(out, n, WF_MSG_ERROR);
+        CHECK(e + 1 < n && out[e].version_or_code == WF_ERR_COMMAND_OUT_OF_RANGE &&
+              out[e].ref_seq_or_status == seq);
+        CHECK(out[e + 1].type == WF_MSG_ACK && out[e + 1].n[1] == seq && out[e + 1].n[2] == 6);
+        const wf_host_gait_snapshot_t g = gait_snap();
+        CHECK(g.gait_id == 3 && g.params.frequency_hz == 2.0f && g.gaits_refused == (uint32_t)i + 1);
+        CHECK(g.cpg_steps == before.cpg_steps && g.phase[0] == before.phase[0]);
+    }
+    /* A non-finite parameter is the decoder's drop (ERROR 6, ref_seq 0): no ACK. */
+    wf_cpg_params_t nan = good;
+    nan.w12 = NAN;
+    board_output(out, 256);
+    send_gait(140, 9, &nan);
+    const size_t n = board_output(out, 256);
+    CHECK(count(out, n, WF_MSG_ACK) == 0 && count(out, n, WF_MSG_ERROR) == 1);
+    CHECK(out[find(out, n, WF_MSG_ERROR)].ref_seq_or_status == 0 && gait_snap().gait_id == 3);
+    /* A host of another version: ACK 5, stream mode stays. */
+    fresh_board();
+    send_heartbeat(0, 1);
+    board_output(out, 256);
+    send_gait(1, 4, &good);
+    const size_t m = board_output(out, 256);
+    const size_t a = find(out, m, WF_MSG_ACK);
+    CHECK(a < m && out[a].n[2] == WF_ERR_VERSION_MISMATCH && !gait_snap().gait_mode);
+}
+
+/* Runs the board t0..t1 and returns the largest change of a target over one ms, and in
+ * *worst the largest ratio of that change to what the oscillator's own rate allows over the
+ * ms (h times the larger |dTheta/dt| of its two ends): above 1 would be a step. */
+static float largest_ms_change(uint32_t t0, uint32_t t1, bool with_heartbeats, float *worst)
+{
+    wf_host_gait_snapshot_t last = gait_snap();
+    float largest = 0.0f;
+    for (uint32_t t = t0; t <= t1; t++) {
+        if (with_heartbeats && t % 200 == 0) {
+            send_heartbeat(t, WF_PROTOCOL_VERSION);
+        } else {
+            wf_host_board_step(t, NULL, 0, NULL, 0);
+        }
+        const wf_host_gait_snapshot_t g = gait_snap();
+        for (int i = 0; i < 2; i++) {
+            const float change = fabsf(g.target[i] - last.target[i]);
+            const float allowed =
+                1e-3f * fmaxf(fabsf(g.rate[i]), fabsf(last.rate[i])) * 1.02f + 1e-6f;
+            largest = fmaxf(largest, change);
+            if (worst != NULL) {
+                *worst = fmaxf(*worst, change / allowed);
+            }
+        }
+        last = g;
+    }
+    return largest;
+}
+
+static void test_a_new_gait_swaps_the_targets_without_a_step(void)
+{
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t slow = table1_gait();
+    send_gait(1, 1, &slow);
+    float worst = 0.0f;
+    const float steady = largest_ms_change(2, 3000, true, &worst);
+    const wf_host_gait_snapshot_t before = gait_snap();
+    wf_cpg_params_t fast = slow;
+    fast.frequency_hz = 3.0f;
+    fast.amplitude[0] = 0.2f;
+    fast.offset[1] = -0.2f;
+    send_gait(3001, 2, &fast);
+    const wf_host_gait_snapshot_t at = gait_snap();
+    /* The state goes on (no reset, no step of r or b); only the targets changed. */
+    CHECK(at.cpg_steps == before.cpg_steps + 1 && at.gait_id == 2);
+    CHECK(fabsf(at.r[0] - before.r[0]) < 1e-3f && fabsf(at.b[1] - before.b[1]) < 1e-3f);
+    CHECK(at.params.frequency_hz == 3.0f && at.params.offset[1] == -0.2f);
+    /* Per ms the output moves no more than the oscillator's own rate allows: r * 2 pi v h at
+     * the new frequency (2.95 mrad), within a margin for the coupling and the convergence. */
+    const float after = largest_ms_change(3002, 6000, true, &worst);
+    CHECK(worst <= 1.0f);
+    CHECK(steady < 0.47f * 6.2832f * 2.0f * 1e-3f * 1.3f);
+    CHECK(after < 0.47f * 6.2832f * 3.0f * 1e-3f * 1.3f);
+    CHECK(fabsf(gait_snap().r[0] - 0.2f) < 1e-3f && fabsf(gait_snap().b[1] + 0.2f) < 1e-3f);
+}
+
+static void test_a_link_gap_coasts_then_rests_without_a_step(void)
+{
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t p = table1_gait();
+    send_gait(10, 5, &p);
+    float worst = 0.0f;
+    const float swimming = largest_ms_change(11, 2000, true, &worst);
+    /* The last host frame: a heartbeat at 2000. Lost link after 1500 ms: COASTING at 3501. */
+    float largest = largest_ms_change(2001, 3500, false, &worst);
+    CHECK((snap().status & (WF_STATUS_COASTING | WF_STATUS_RESTING)) == 0);
+    wf_host_board_step(3501, NULL, 0, NULL, 0);
+    CHECK(snap().status & WF_STATUS_COASTING);
+    CHECK(gait_snap().gap == WF_GAP_COASTING && gait_snap().params.amplitude[1] == 0.47f);
+    largest = fmaxf(largest, largest_ms_change(3502, 6500, false, &worst));
+    CHECK(gait_snap().gap == WF_GAP_COASTING && fabsf(gait_snap().r[1] - 0.47f) < 1e-4f);
+    /* 3000 ms of coasting: RESTING at 6501, targets 0 through the oscillator. */
+    wf_host_board_step(6501, NULL, 0, NULL, 0);
+    wf_host_gait_snapshot_t g = gait_snap();
+    CHECK((snap().status & WF_STATUS_RESTING) && !(snap().status & WF_STATUS_COASTING));
+    CHECK(g.params.amplitude[0] == 0.0f && g.params.offset[1] == 0.0f &&
+          g.params.frequency_hz == 2.0f && g.params.w21 == 0.64f);
+    largest = fmaxf(largest, largest_ms_change(6502, 8500, false, &worst));
+    g = gait_snap();
+    CHECK(fabsf(g.target[0]) < 1e-3f && fabsf(g.target[1]) < 1e-3f); /* at rest */
+    /* No step anywhere: each ms within the oscillator's own rate, and never much more than
+     * swimming asked for (the offset's convergence adds its rate for a moment). */
+    CHECK(worst <= 1.0f && largest <= swimming * 1.1f);
+    /* Any valid host frame: the last gait again, converging from rest. */
+    send_heartbeat(8501, WF_PROTOCOL_VERSION);
+    g = gait_snap();
+    CHECK(g.gap == WF_GAP_NONE && g.params.amplitude[0] == 0.38f && g.gait_id == 5);
+    CHECK((snap().status & (WF_STATUS_COASTING | WF_STATUS_RESTING)) == 0);
+    largest = largest_ms_change(8502, 10500, true, &worst);
+    CHECK(worst <= 1.0f && largest <= swimming * 1.1f && fabsf(gait_snap().r[0] - 0.38f) < 1e-3f);
+}
+
+static void test_coast_0_rests_at_the_link_timeout(void)
+{
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_link_config(1, 10, WF_TELEMETRY_FULL, 2000, 300, 0);
+    const wf_cpg_params_t p = table1_gait();
+    send_gait(2, 1, &p);
+    run_until(3, 302);
+    CHECK(gait_snap().gap == WF_GAP_NONE);
+    wf_host_board_step(303, NULL, 0, NULL, 0);
+    CHECK(gait_snap().gap == WF_GAP_RESTING && (snap().status & WF_STATUS_RESTING));
+}
+
+static void test_servo_cmd_in_gait_mode_returns_to_stream_mode(void)
+{
+    static wf_host_msg_t out[256];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t p = table1_gait();
+    send_gait(1, 5, &p);
+    run_until(2, 100);
+    send_command(101, 0.3f, -0.3f);
+    const wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(!g.gait_mode && g.gait_id == 0 && g.target[0] == 0.3f);
+    CHECK(snap().status == 0);
+    board_output(out, 256);
+    run_until(102, 110);
+    const size_t n = board_output(out, 256);
+    const size_t t = find(out, n, WF_MSG_TELEMETRY);
+    CHECK(t < n && out[t].n[0] == 0);
+    /* Back to gait mode: from rest again. */
+    send_gait(111, 6, &p);
+    CHECK(gait_snap().gait_mode && gait_snap().cpg_steps == 0 && gait_snap().target[0] == 0.0f);
+}
+
+static void test_another_version_leaves_gait_mode_and_slews_to_neutral(void)
+{
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t p = table1_gait();
+    send_gait(1, 5, &p);
+    run_until(2, 1000);
+    const float at = gait_snap().target[1];
+    CHECK(fabsf(at) > 0.05f);
+    send_heartbeat(1001, 1);
+    const wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(!g.gait_mode && (snap().status & WF_STATUS_VERSION_MISMATCH));
+    CHECK(fabsf(g.target[1] - at) <= 2.0f * 1e-3f + 1e-6f); /* slewing, not a step */
+}
+
+static void test_link_config_is_applied_at_once_and_acked(void)
+{
+    static wf_host_msg_t out[512];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    board_output(out, 512);
+    const uint16_t seq = send_link_config(3, 100, WF_TELEMETRY_COMPACT, 0, 500, 1000);
+    size_t n = board_output(out, 512);
+    size_t a = find(out, n, WF_MSG_ACK);
+    CHECK(a < n && out[a].n[0] == WF_MSG_LINK_CONFIG && out[a].n[1] == seq && out[a].n[2] == 0);
+    CHECK(count(out, n, WF_MSG_TELEMETRY) == 0);
+    wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(g.telemetry_period_ms == 100 && g.telemetry_form == WF_TELEMETRY_COMPACT);
+    CHECK(g.health_period_ms == 0 && g.link_timeout_ms == 500 && g.coast_ms == 1000);
+    run_until(4, 5003);
+    n = board_output(out, 512);
+    CHECK(count(out, n, WF_MSG_TELEMETRY) == 0 && count(out, n, WF_MSG_HEALTH) == 0);
+    CHECK(count(out, n, WF_MSG_TELEMETRY_COMPACT) == 50); /* 103, 203, ..., 5003 */
+    const size_t c = find(out, n, WF_MSG_TELEMETRY_COMPACT);
+    CHECK(out[c].n[0] == 103);
+    /* Out of range, each field in turn: ACK 6, nothing changes, no ERROR. */
+    const uint16_t bad[6][5] = {{9, 0, 2000, 1500, 3000},    {1001, 0, 2000, 1500, 3000},
+                                {10, 2, 2000, 1500, 3000},   {10, 0, 199, 1500, 3000},
+                                {10, 0, 2000, 99, 3000},     {10, 0, 2000, 1500, 60001}};
+    for (int i = 0; i < 6; i++) {
+        const uint16_t s = send_link_config(5004 + (uint32_t)i, bad[i][0], (uint8_t)bad[i][1],
+                                            bad[i][2], bad[i][3], bad[i][4]);
+        n = board_output(out, 512);
+        a = find(out, n, WF_MSG_ACK);
+        CHECK(a < n && out[a].n[1] == s && out[a].n[2] == WF_ERR_COMMAND_OUT_OF_RANGE);
+        CHECK(count(out, n, WF_MSG_ERROR) == 0);
+        g = gait_snap();
+        CHECK(g.telemetry_period_ms == 100 && g.link_timeout_ms == 500 && g.coast_ms == 1000);
+    }
+    /* Back to FULL at 10 ms with HEALTH every 200 ms: both at once. */
+    send_link_config(6000, 10, WF_TELEMETRY_FULL, 200, 1500, 3000);
+    run_until(6001, 6400);
+    n = board_output(out, 512);
+    CHECK(count(out, n, WF_MSG_TELEMETRY) == 40 && count(out, n, WF_MSG_HEALTH) == 2);
+}
+
+static void test_acks_go_out_one_per_poll_from_a_bounded_queue(void)
+{
+    static wf_host_msg_t out[256];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    board_output(out, 256);
+    const wf_cpg_params_t p = table1_gait();
+    uint8_t chunk[6 * WF_MAX_WIRE];
+    size_t len = 0;
+    for (int i = 0; i < 6; i++) {
+        wf_msg_t msg = {.type = WF_MSG_GAIT, .seq = (uint16_t)(100 + i)};
+        msg.u.gait.gait_id = (uint16_t)(10 + i);
+        msg.u.gait.params = p;
+        len += frame_of(&msg, chunk + len);
+    }
+    wf_host_board_step(1, chunk, len, NULL, 0);
+    CHECK(gait_snap().gait_id == 15 && gait_snap().acks_dropped == 2);
+    for (uint32_t t = 1; t <= 5; t++) {
+        if (t > 1) {
+            wf_host_board_step(t, NULL, 0, NULL, 0);
+        }
+        const size_t n = board_output(out, 256);
+        const size_t a = find(out, n, WF_MSG_ACK);
+        CHECK(count(out, n, WF_MSG_ACK) == (t <= 4 ? 1u : 0u));
+        if (t <= 4) {
+            CHECK(out[a].n[1] == 99 + t); /* oldest first */
+        }
+    }
+}
+
+static void test_compact_telemetry_rounds_and_saturates(void)
+{
+    wf_telemetry_t t = {.board_time_ms = 0xDEADBEEFu, .roll = 3.14159f, .pitch = -0.00015f,
+                        .yaw = NAN, .gyro = {40.0f, -40.0f, -0.0024999f},
+                        .accel = {39.2f, -39.2f, 9.80665f}, .servo = {1.5707963f, -0.000051f},
+                        .battery_v = 70.0f, .status = 0x0141, .gait_id = 65535};
+    wf_telemetry_compact_t c;
+    wf_telemetry_compact(&t, &c);
+    CHECK(c.board_time_ms == 0xDEADBEEFu && c.roll == 31416 && c.pitch == -2 && c.yaw == 0);
+    CHECK(c.gyro[0] == 32767 && c.gyro[1] == -32768 && c.gyro[2] == -2);
+    CHECK(c.accel[0] == 32767 && c.accel[1] == -32768 && c.accel[2] == 9807);
+    CHECK(c.servo[0] == 15708 && c.servo[1] == -1); /* -0.51 count: the nearest */
+    CHECK(c.battery_mv == 65535 && c.status == 0x0141 && c.gait_id == 65535);
+    t.battery_v = -1.0f;
+    wf_telemetry_compact(&t, &c);
+    CHECK(c.battery_mv == 0);
+    /* On the wire and back: 32 bytes of payload, the values as they were. */
+    wf_msg_t msg = {.type = WF_MSG_TELEMETRY_COMPACT, .seq = 3};
+    msg.u.compact = c;
+    uint8_t wire[WF_MAX_WIRE];
+    const size_t len = frame_of(&msg, wire);
+    wf_host_msg_t back[2];
+    CHECK(wf_host_decode_stream(wire, len, back, 2, NULL) == 1);
+    CHECK(back[0].n[0] == 0xDEADBEEFu && back[0].n[1] == 31416 && back[0].n[5] == -32768);
+    CHECK(back[0].n[12] == 0 && back[0].n[14] == 65535);
+}
+
+static void test_health_once_after_boot_and_every_period(void)
+{
+    static wf_host_msg_t out[1024];
+    fresh_board();
+    wf_host_set_uart_overruns(7);
+    wf_host_board_step(0, NULL, 0, NULL, 0);
+    size_t n = board_output(out, 1024);
+    size_t h = find(out, n, WF_MSG_HEALTH);
+    CHECK(count(out, n, WF_MSG_HEALTH) == 1);
+    CHECK(out[h].n[0] == WF_RESET_POWER_ON && out[h].n[1] == WF_CLOCK_EMULATED);
+    CHECK(out[h].n[7] == 0 && out[h].n[10] == 7); /* uptime, the port's UART overruns */
+    /* Drops of each kind, a transmit queue too small for a frame. */
+    const uint8_t garbage[] = {0x00, 0x07, 0x01, 0x00, 0x02, 0x05, 0x00}; /* bad COBS, short */
+    wf_host_board_step(1, garbage, sizeof garbage, NULL, 0);
+    wf_msg_t bad_crc = {.type = WF_MSG_SERVO_CMD, .seq = 9};
+    bad_crc.u.servo_cmd.servo[0] = 0.5f;
+    uint8_t wire[WF_MAX_WIRE];
+    size_t len = frame_of(&bad_crc, wire);
+    wire[3] ^= 0x10; /* one bit of the seq: the CRC fails */
+    wf_host_board_step(30, wire, len, NULL, 0);
+    wf_msg_t nan_cmd = {.type = WF_MSG_SERVO_CMD};
+    nan_cmd.u.servo_cmd.servo[1] = NAN;
+    len = frame_of(&nan_cmd, wire);
+    wf_host_board_step(60, wire, len, NULL, 0);
+    board_output(out, 1024);
+    wf_host_set_tx_capacity(20);
+    run_until(61, 1999);
+    wf_host_take_output((uint8_t[WF_HOST_TX_CAPACITY]){0}, WF_HOST_TX_CAPACITY);
+    wf_host_set_tx_capacity(WF_HOST_TX_CAPACITY);
+    run_until(2000, 2000);
+    n = board_output(out, 1024);
+    h = find(out, n, WF_MSG_HEALTH);
+    CHECK(h < n && count(out, n, WF_MSG_HEALTH) == 1 && out[h].n[7] == 2000);
+    wf_health_t health;
+    wf_host_board_health(&health);
+    CHECK(out[h].n[11] == health.tx_bytes_dropped && health.tx_bytes_dropped > 10000);
+    CHECK(out[h].n[12] == 1 && out[h].n[13] == 2 && out[h].n[14] == 0 && out[h].n[15] == 0);
+    CHECK(out[h].n[16] == 1 && out[h].n[17] == 0 && out[h].n[18] == 0);
+    run_until(2001, 6000);
+    n = board_output(out, 1024);
+    CHECK(count(out, n, WF_MSG_HEALTH) == 2); /* 4000, 6000 */
+}
+
+static void test_the_imu_lost_and_found_is_counted(void)
+{
+    memset(mpu_regs, 0, sizeof mpu_regs);
+    mpu_regs[0x75] = 0x68;
+    fresh_board();
+    wf_host_set_i2c_device(tiny_mpu, NULL);
+    run_until(0, 100);
+    wf_host_set_i2c_device(NULL, NULL);
+    run_until(101, 110);
+    wf_host_set_i2c_device(tiny_mpu, NULL);
+    run_until(111, 2100);
+    wf_health_t h;
+    wf_host_board_health(&h);
+    CHECK(h.imu_faults == 1 && h.imu_recoveries == 1);
+}
+
+static void test_the_lone_cpg_follows_eq_1(void)
+{
+    const wf_cpg_params_t p = table1_gait();
+    wf_host_cpg_init(&p);
+    float state[10];
+    wf_host_cpg_state(state);
+    for (int i = 0; i < 10; i++) {
+        CHECK(state[i] == 0.0f); /* at rest */
+    }
+    wf_host_cpg_run(3000, NULL, NULL);
+    wf_host_cpg_state(state);
+    /* alpha 20: critically damped with time constant 2 / alpha = 0.1 s, 30 of them in 3 s. */
+    CHECK(fabsf(state[2] - 0.38f) < 1e-5f && fabsf(state[3] - 0.47f) < 1e-5f);
+    CHECK(fabsf(state[7] - 0.1f) < 1e-5f && fabsf(state[4]) < 1e-4f);
+    /* Locked: the phase difference xi1 - xi2 settles where the coupling terms balance. */
+    float a[2], r[2];
+    wf_host_cpg_output(a, r);
+    CHECK(fabsf(a[0] - (state[2] * cosf(state[0]) + state[6])) < 1e-6f);
+    /* The rate: -r (2 pi v + coupling) sin xi, the coupling at most |w12| R2 = 0.19 rad/s. */
+    CHECK(fabsf(r[0] + 0.38f * 2.0f * 6.2831853f * sinf(state[0])) < 0.38f * 0.41f * 0.47f);
+    float clipped[2] = {2.0f, -0.5f}, rates[2] = {1.0f, 1.0f};
+    CHECK(wf_cpg_clamp(clipped, rates, 1.5f) && clipped[0] == 1.5f && rates[0] == 0.0f);
+    CHECK(clipped[1] == -0.5f && rates[1] == 1.0f);
+    CHECK(!wf_cpg_params_valid(&(wf_cpg_params_t){.frequency_hz = 1.0f, .alpha = INFINITY},
+                               1.5f));
 }
 
 int main(void)
@@ -489,6 +973,19 @@ int main(void)
     test_imu_absent_sets_imu_fault();
     test_battery_below_threshold_sets_low_battery();
     test_imu_sample_reaches_the_telemetry();
-    printf("test_core: 22 tests, %d checks passed\n", checks);
+    test_gait_is_acked_and_the_board_runs_eq_1_at_1_khz();
+    test_an_invalid_gait_is_refused_with_error_6_and_ack_6();
+    test_a_new_gait_swaps_the_targets_without_a_step();
+    test_a_link_gap_coasts_then_rests_without_a_step();
+    test_coast_0_rests_at_the_link_timeout();
+    test_servo_cmd_in_gait_mode_returns_to_stream_mode();
+    test_another_version_leaves_gait_mode_and_slews_to_neutral();
+    test_link_config_is_applied_at_once_and_acked();
+    test_acks_go_out_one_per_poll_from_a_bounded_queue();
+    test_compact_telemetry_rounds_and_saturates();
+    test_health_once_after_boot_and_every_period();
+    test_the_imu_lost_and_found_is_counted();
+    test_the_lone_cpg_follows_eq_1();
+    printf("test_core: 36 tests, %d checks passed\n", checks);
     return 0;
 }

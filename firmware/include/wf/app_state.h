@@ -128,10 +128,9 @@ typedef struct {
     uint32_t gaits_accepted;
     uint32_t gaits_refused;
 
-    /* What HEALTH reports. The port writes its own fields (reset cause, clock source, flags,
-     * fault record, stack, UART overruns, I2C bus recoveries) after wf_app_init and whenever
-     * they change; the core writes the rest (uptime, decoder and transmit drops, IMU faults and
-     * recoveries) when it sends the message. */
+    /* What HEALTH reports: the port's fields from wf_hal_health_port (at wf_app_init and
+     * before each HEALTH), the core's (uptime, decoder and transmit drops, IMU faults and
+     * recoveries) from its own counters. */
     wf_health_t health;
 } wf_app_t;
 

@@ -205,7 +205,8 @@ size_t wf_hal_uart_read(uint8_t *buf, size_t max)
 
 size_t wf_hal_uart_write(const uint8_t *buf, size_t len)
 {
-    const size_t room = board.tx_capacity - board.tx_len;
+    /* A capacity lowered below what the queue holds leaves no room (not a wrapped size). */
+    const size_t room = board.tx_len < board.tx_capacity ? board.tx_capacity - board.tx_len : 0;
     const size_t n = len < room ? len : room;
     memcpy(board.tx + board.tx_len, buf, n);
     board.tx_len += n;

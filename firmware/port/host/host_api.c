@@ -104,22 +104,6 @@ size_t wf_host_gait_snapshot_size(void) { return sizeof(wf_host_gait_snapshot_t)
 
 void wf_host_board_health(wf_health_t *health) { *health = the_app.health; }
 
-void wf_host_board_set_port_health(const wf_health_t *in)
-{
-    wf_health_t *h = &the_app.health;
-    h->reset_cause = in->reset_cause;
-    h->clock_source = in->clock_source;
-    h->flags = in->flags;
-    h->fault_pc = in->fault_pc;
-    h->fault_lr = in->fault_lr;
-    h->fault_cfsr = in->fault_cfsr;
-    h->fault_hfsr = in->fault_hfsr;
-    h->stack_free_min = in->stack_free_min;
-    h->stack_size = in->stack_size;
-    h->uart_rx_overruns = in->uart_rx_overruns;
-    h->i2c_bus_recoveries = in->i2c_bus_recoveries;
-}
-
 size_t wf_host_health_size(void) { return sizeof(wf_health_t); }
 
 /* --- a lone CPG ------------------------------------------------------------------------- */

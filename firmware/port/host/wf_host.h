@@ -133,9 +133,6 @@ void wf_host_board_gait(wf_host_gait_snapshot_t *snapshot);
 size_t wf_host_gait_snapshot_size(void);
 /* The board's wf_health_t as last sent (the core fills its fields when it sends HEALTH). */
 void wf_host_board_health(wf_health_t *health);
-/* Writes the port's fields of the board's health (reset cause, clock source, flags, fault
- * record, stack, UART overruns, I2C bus recoveries) from health; the core's are left alone. */
-void wf_host_board_set_port_health(const wf_health_t *health);
 size_t wf_host_health_size(void);
 
 /* A lone CPG (wf/cpg.h) next to the board, for the parity with wirefish_cpg. */
