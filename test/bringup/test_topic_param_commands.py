@@ -130,3 +130,42 @@ def test_a_node_that_is_not_there_is_one_line(ros_env):
     missing = wirefish(ros_env, 'param', 'get', '/nobody_here', 'gain')
     assert missing.returncode == 1 and len(missing.stderr.strip().splitlines()) == 1
     assert 'no node /nobody_here' in missing.stderr
+
+
+@pytest.mark.ros
+def test_a_misspelled_topic_is_said_at_once_with_the_closest_name(graph, ros_env):
+    _listed_once_found(ros_env, f'{NAMESPACE}/stream')  # the graph is discovered by now
+    shown = wirefish(ros_env, 'topic', 'echo', 'strem', '--namespace', NAMESPACE, '--once')
+    assert shown.returncode == 1, shown.stdout
+    lines = shown.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f'wirefish topic echo: topic {NAMESPACE}/strem does not exist; did you mean '
+        f'{NAMESPACE}/stream'), shown.stderr
+
+
+@pytest.mark.ros
+def test_param_set_takes_an_integer_for_a_double_and_says_what_to_type(graph, ros_env):
+    put = wirefish(ros_env, 'param', 'set', 'talker', 'gain', '2', '--namespace', NAMESPACE)
+    assert put.returncode == 0, put.stderr
+    assert graph.get_parameter('gain').value == 2.0
+    wrong = wirefish(ros_env, 'param', 'set', 'talker', 'gain', 'abc', '--namespace', NAMESPACE)
+    assert wrong.returncode == 2
+    assert wrong.stderr.strip() == ("wirefish param set: gain is a Double, 'abc' is a String: "
+                                    'give a number such as 0.3'), wrong.stderr
+    assert graph.get_parameter('gain').value == 2.0
+
+
+@pytest.mark.ros
+def test_a_misspelled_parameter_or_node_names_the_closest(graph, ros_env):
+    name = wirefish(ros_env, 'param', 'set', 'talker', 'gian', '1.0', '--namespace', NAMESPACE)
+    assert name.returncode == 1
+    assert name.stderr.strip() == (f'wirefish param set: {NAMESPACE}/talker has no parameter '
+                                   'gian; did you mean gain?'), name.stderr
+    started = time.monotonic()
+    node = wirefish(ros_env, 'param', 'get', 'talkr', 'gain', '--namespace', NAMESPACE)
+    # Said once the graph shows its other nodes (NODE_DISCOVERY_S), not after the services'
+    # 10 s wait: a bound of the message's kind, not of the machine's speed.
+    assert node.returncode == 1
+    assert node.stderr.strip() == (f'wirefish param get: no node {NAMESPACE}/talkr; did you '
+                                   f'mean {NAMESPACE}/talker?'), node.stderr
+    assert 'within' not in node.stderr and time.monotonic() - started < 30.0

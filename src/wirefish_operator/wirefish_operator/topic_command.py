@@ -12,6 +12,7 @@ prints the rate every second, as ``ros2 topic hz`` does. A relative name is take
 from __future__ import annotations
 
 import argparse
+import difflib
 import enum
 import math
 import sys
@@ -58,6 +59,24 @@ def full_name(topic: str, namespace: str) -> str:
     if topic.startswith('/'):
         return topic
     return f'{namespace.rstrip("/")}/{topic}'
+
+
+def missing_topic_text(topic: str, names: list[str]) -> str | None:
+    """
+    Return why ``topic`` cannot be echoed when the graph around it is known, else None.
+
+    The graph is known when its namespace has topics: a name that is not among them is a
+    typo or a node that is not running (the closest names are offered, as ros2cli's "does not
+    appear to be published yet" does not). An empty namespace may only be undiscovered yet.
+    """
+    if topic in names:
+        return None
+    namespace = topic.rsplit('/', 1)[0] + '/'
+    if not any(name.startswith(namespace) for name in names if name != topic):
+        return None
+    close = difflib.get_close_matches(topic, names, n=3)
+    hint = f'; did you mean {" or ".join(close)}?' if close else ''
+    return (f'topic {topic} does not exist{hint} (wirefish topic list shows what there is)')
 
 
 def plain(value):
@@ -136,7 +155,16 @@ def run(args: argparse.Namespace) -> int:
         if args.verb == TopicVerb.LIST:
             return _list(probe, args)
         topic = full_name(args.topic, args.namespace)
-        type_name = probe.type_of(topic, WAIT_S)
+        type_name = probe.type_of(topic, DISCOVERY_S)
+        if type_name is None:
+            names = [name for name, _ in probe.node.get_topic_names_and_types()]
+            missing = missing_topic_text(topic, names)
+            if missing is not None:  # the graph is there, the topic is not: say it at once
+                print(f'wirefish topic {args.verb}: {missing}', file=sys.stderr)
+                return 1
+            print(f'wirefish topic {args.verb}: waiting up to {WAIT_S:g} s for a publisher of '
+                  f'{topic} (Ctrl-C stops)', file=sys.stderr, flush=True)
+            type_name = probe.type_of(topic, WAIT_S - DISCOVERY_S)
         if type_name is None:
             print(f'wirefish topic {args.verb}: no publisher of {topic} within {WAIT_S:g} s '
                   '(wirefish topic list shows what there is)', file=sys.stderr)
