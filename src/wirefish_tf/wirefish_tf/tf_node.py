@@ -14,6 +14,9 @@ Subscribes
 Publishes
     ``/tf`` (tf2_msgs/TFMessage, reliable depth 100, as tf2's broadcaster) and ``/tf_static``
     (reliable, transient local: ``base_link`` -> ``imu_link``, ``base_link`` -> ``tail_base``,
+    again whenever the geometry changes); ``robot_description`` (std_msgs/String, the fish's
+    URDF from ``model.fish_urdf``, reliable and transient local as robot_state_publisher
+    publishes it; link names without the frame prefix, as robot_state_publisher keeps them;
     again whenever the geometry changes).
 Parameters: ``odom_source`` (``auto``: ground truth once sim/ground_truth is heard, dead
 reckoning until then; ``ground_truth``; ``dead_reckoning``), ``odom_rate_hz``, ``imu_x``,
@@ -31,15 +34,17 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Imu
+from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA, TF, TF_STATIC
+from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA, TF, TF_STATIC
 from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
 from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, quaternion_yaw,
                                 tail_base_in_base_link, tail_frames)
+from wirefish_tf.model import fish_urdf
 from wirefish_tf.tf_messages import tf_message, transform
 from wirefish_tf.tf_node_parameters import (consistent_geometry, GEOMETRY_NAMES, SPECS,
                                             TF_PARAMETERS)
@@ -74,6 +79,7 @@ class TfNode(Node):
         self._last_odom_s = -math.inf
         self._tf_pub = self.create_publisher(TFMessage, '/tf', TF)
         self._static_pub = self.create_publisher(TFMessage, '/tf_static', TF_STATIC)
+        self._description_pub = self.create_publisher(String, 'robot_description', LATCHED)
         self.create_subscription(BodyWave, 'body_wave', self._on_body_wave, SENSOR_DATA)
         self.create_subscription(Odometry, 'sim/ground_truth', self._on_ground_truth,
                                  GROUND_TRUTH_QOS)
@@ -106,6 +112,8 @@ class TfNode(Node):
             transform(base, self._frame[Frame.IMU_LINK], imu, stamp),
             transform(base, self._frame[Frame.TAIL_BASE],
                       tail_base_in_base_link(self._geometry), stamp)]))
+        self._description_pub.publish(String(data=fish_urdf(
+            self._geometry, (imu.x, imu.y, imu.z))))
 
     # --- the moving tail ------------------------------------------------------------------
     def _on_body_wave(self, msg: BodyWave) -> None:
