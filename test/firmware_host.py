@@ -96,7 +96,8 @@ class ServoCal(ctypes.Structure):
     """wf_servo_cal_t."""
 
     _fields_ = [('neutral_us', ctypes.c_float), ('us_per_rad', ctypes.c_float),
-                ('direction', ctypes.c_int8)]
+                ('direction', ctypes.c_int8), ('min_us', ctypes.c_float),
+                ('max_us', ctypes.c_float)]
 
 
 class Config(ctypes.Structure):

@@ -51,6 +51,8 @@ void wf_config_defaults(wf_config_t *config)
         config->servo_cal[i].neutral_us = 1500.0f;
         config->servo_cal[i].us_per_rad = 636.619772f;
         config->servo_cal[i].direction = 1;
+        config->servo_cal[i].min_us = 500.0f;
+        config->servo_cal[i].max_us = 2500.0f;
     }
     /* The board's mounting: the MPU6050's +Y to the head, +X to the fish's right, +Z up. */
     config->imu_axes[0] = 2;
@@ -109,7 +111,8 @@ bool wf_config_valid(const wf_config_t *c)
         const wf_servo_cal_t *cal = &c->servo_cal[i];
         ok = ok && in_range(cal->neutral_us, 0.0f, 20000.0f) &&
              in_range(cal->us_per_rad, 0.0f, 100000.0f) &&
-             (cal->direction == 1 || cal->direction == -1);
+             (cal->direction == 1 || cal->direction == -1) &&
+             wf_servo_cal_fits(cal, c->servo_limit_rad, frame_us(c));
     }
     return ok;
 }

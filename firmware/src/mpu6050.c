@@ -33,22 +33,73 @@ bool wf_mpu6050_axes_valid(const int8_t axes[3])
     return det == 1;
 }
 
+bool wf_mpu6050_known_id(uint8_t who_am_i)
+{
+    static const uint8_t known[WF_MPU6050_KNOWN_ID_COUNT] = WF_MPU6050_KNOWN_IDS;
+    for (unsigned i = 0; i < WF_MPU6050_KNOWN_ID_COUNT; i++) {
+        if (who_am_i == known[i]) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* What the driver writes, register after register from SMPLRT_DIV (0x19): 1 kHz / (1 + 4) =
+ * 200 Hz sample rate; DLPF 44 Hz; the full scales. */
+static const uint8_t configuration[4] = {0x04, 0x03, WF_MPU6050_FS_SEL << 3,
+                                         WF_MPU6050_AFS_SEL << 3};
+/* PWR_MGMT_1: awake (SLEEP is set at power-up) with the X gyro's PLL as clock (more stable
+ * than the internal oscillator, the datasheet's recommendation). */
+#define PWR_MGMT_1_VALUE 0x01u
+
+static bool configuration_intact(void)
+{
+    uint8_t back[4];
+    uint8_t power = 0;
+    return read_registers(WF_MPU6050_SMPLRT_DIV, back, sizeof back) &&
+           memcmp(back, configuration, sizeof back) == 0 &&
+           read_registers(WF_MPU6050_PWR_MGMT_1, &power, 1) && power == PWR_MGMT_1_VALUE;
+}
+
+static void clear_values(wf_mpu6050_t *imu)
+{
+    memset(imu->raw_accel, 0, sizeof imu->raw_accel);
+    memset(imu->raw_gyro, 0, sizeof imu->raw_gyro);
+    memset(imu->accel, 0, sizeof imu->accel);
+    memset(imu->gyro, 0, sizeof imu->gyro);
+}
+
+static bool lose(wf_mpu6050_t *imu)
+{
+    imu->present = false;
+    clear_values(imu);
+    return false;
+}
+
 bool wf_mpu6050_init(wf_mpu6050_t *imu)
 {
-    memset(imu, 0, sizeof *imu);
+    imu->present = false;
+    imu->same_count = 0;
+    imu->reads_since_check = 0;
+    clear_values(imu);
     uint8_t who = 0;
-    if (!read_registers(WF_MPU6050_WHO_AM_I, &who, 1) || who != WF_MPU6050_WHO_AM_I_VALUE) {
+    if (!read_registers(WF_MPU6050_WHO_AM_I, &who, 1) || !wf_mpu6050_known_id(who)) {
         return false;
     }
-    /* Wake up (SLEEP is set at power-up) with the X gyro's PLL as clock (more stable than the
-     * internal oscillator, the datasheet's recommendation); DLPF 44 Hz; 1 kHz / (1 + 4) =
-     * 200 Hz sample rate; the full scales. */
-    imu->present = write_register(WF_MPU6050_PWR_MGMT_1, 0x01) &&
-                   write_register(WF_MPU6050_CONFIG, 0x03) &&
-                   write_register(WF_MPU6050_SMPLRT_DIV, 0x04) &&
-                   write_register(WF_MPU6050_GYRO_CONFIG, WF_MPU6050_FS_SEL << 3) &&
-                   write_register(WF_MPU6050_ACCEL_CONFIG, WF_MPU6050_AFS_SEL << 3);
-    return imu->present;
+    imu->who_am_i = who;
+    bool ok = write_register(WF_MPU6050_PWR_MGMT_1, PWR_MGMT_1_VALUE);
+    for (unsigned i = 0; ok && i < sizeof configuration; i++) {
+        ok = write_register((uint8_t)(WF_MPU6050_SMPLRT_DIV + i), configuration[i]);
+    }
+    ok = ok && configuration_intact();
+    if (ok && imu->stuck) {
+        uint8_t data[14];
+        ok = read_registers(WF_MPU6050_ACCEL_XOUT_H, data, sizeof data) &&
+             memcmp(data, imu->last_data, sizeof data) != 0;
+        imu->stuck = !ok;
+    }
+    imu->present = ok;
+    return ok;
 }
 
 static int16_t big_endian_i16(const uint8_t *p)
@@ -68,8 +119,22 @@ bool wf_mpu6050_read(wf_mpu6050_t *imu, const int8_t axes[3])
 {
     uint8_t rx[14]; /* accel x, y, z; temperature; gyro x, y, z */
     if (!read_registers(WF_MPU6050_ACCEL_XOUT_H, rx, sizeof rx)) {
-        memset(imu, 0, sizeof *imu);
-        return false;
+        return lose(imu);
+    }
+    if (memcmp(rx, imu->last_data, sizeof rx) == 0) {
+        if (++imu->same_count >= WF_MPU6050_STUCK_SAMPLES - 1) {
+            imu->stuck = true;   /* STUCK_SAMPLES equal reads: this one and the ones before */
+            return lose(imu);
+        }
+    } else {
+        imu->same_count = 0;
+        memcpy(imu->last_data, rx, sizeof rx);
+    }
+    if (++imu->reads_since_check >= WF_MPU6050_CHECK_PERIOD) {
+        imu->reads_since_check = 0;
+        if (!configuration_intact()) {
+            return lose(imu);
+        }
     }
     float accel[3];
     float gyro[3];

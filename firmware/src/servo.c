@@ -11,13 +11,21 @@ float wf_servo_clamp(float angle, float limit)
     return angle;
 }
 
+bool wf_servo_cal_fits(const wf_servo_cal_t *cal, float limit_rad, float frame_us)
+{
+    const float swing = cal->us_per_rad * limit_rad;
+    return cal->min_us > 0.0f && cal->min_us < cal->max_us && cal->max_us <= frame_us &&
+           cal->neutral_us - swing >= cal->min_us && cal->neutral_us + swing <= cal->max_us;
+}
+
 float wf_servo_pulse_us(const wf_servo_cal_t *cal, float angle, float max_us)
 {
     const float pulse = cal->neutral_us + (float)cal->direction * cal->us_per_rad * angle;
-    if (!(pulse > 0.0f)) {
-        return 0.0f;
+    const float high = cal->max_us < max_us ? cal->max_us : max_us;
+    if (!(pulse > cal->min_us)) {
+        return cal->min_us > 0.0f && cal->min_us < high ? cal->min_us : 0.0f; /* NaN too */
     }
-    return pulse < max_us ? pulse : max_us;
+    return pulse < high ? pulse : high;
 }
 
 uint32_t wf_servo_compare(const wf_servo_cal_t *cal, float angle, uint32_t ticks_per_us,

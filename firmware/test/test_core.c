@@ -397,13 +397,18 @@ static void test_a_pulse_never_outlasts_its_frame(void)
     wf_config_t c;
     wf_config_defaults(&c);
     c.servo_frame_hz = 333; /* a 3003 us frame */
-    c.servo_cal[0].us_per_rad = 20000.0f;
+    c.servo_cal[0].max_us = 3100.0f; /* a servo range longer than the frame: refused */
+    CHECK(!wf_config_valid(&c));
+    c.servo_cal[0].min_us = 1.0f;
+    c.servo_cal[0].max_us = 3003.0f;
+    c.servo_cal[0].us_per_rad = 950.0f; /* 1500 +- 950 x pi/2 = 8..2992 us: within */
     wf_host_reset();
     wf_host_board_init(&c);
     host_seq = 0;
+    CHECK(!snap().config_rejected);
     send_heartbeat(0, WF_PROTOCOL_VERSION);
     send_command(1, 1.5f, -1.5f);
-    CHECK(wf_host_compare(0) == 3003 && wf_host_compare(1) == 545);
+    CHECK(wf_host_compare(0) == 2925 && wf_host_compare(1) == 545);
 }
 
 static void test_imu_absent_sets_imu_fault(void)
@@ -440,6 +445,9 @@ static bool tiny_mpu(void *context, uint8_t address7, const uint8_t *tx, size_t 
         reg = (uint8_t)((reg + 1) & 0x7F);
     }
     const bool data_read = reg == 0x3B && rx_len == 14;
+    if (reg == 0x3B) {
+        mpu_regs[0x42] ^= 1u; /* the temperature's noise bit: live data never stands still */
+    }
     for (size_t i = 0; i < rx_len; i++) {
         rx[i] = mpu_regs[reg];
         reg = (uint8_t)((reg + 1) & 0x7F);
