@@ -1,9 +1,11 @@
 /*
- * Cycles per received frame and per telemetry frame, host build (make cycles).
+ * Cycles per received frame, per telemetry frame and per CPG step, host build (make cycles).
  *
- * Each figure is one wf_app_poll: one that finds one frame in the UART (nothing else due), and
- * one that sends the telemetry (with the IMU sample, failsafe and servo update of that poll),
- * timed with the x86 time-stamp counter (TSC ticks: cycles at the nominal clock; other CPUs:
+ * Each figure but the last two is one wf_app_poll: one that finds one frame in the UART
+ * (nothing else due), and one that sends the telemetry (with the IMU sample, failsafe and servo
+ * update of that poll). "cpg_step" is one wf_cpg_step (eq 1, one RK4 step of 1 ms) alone;
+ * "gait_poll" one poll in gait mode with nothing else due (a CPG step, its output, the compares).
+ * All timed with the x86 time-stamp counter (TSC ticks: cycles at the nominal clock; other CPUs:
  * nanoseconds from clock_gettime). The board's run is deterministic (same clock, same bytes),
  * so it is repeated REPEATS times from reset and each poll keeps its fastest repeat: what the
  * code costs, without the interrupts and preemption of a shared machine, which would have to
@@ -78,9 +80,15 @@ static size_t frame(uint8_t type, uint16_t seq, uint8_t *wire)
     } else if (type == WF_MSG_SERVO_CMD) {
         msg.u.servo_cmd.servo[0] = 0.3f + 1e-5f * (float)seq;
         msg.u.servo_cmd.servo[1] = -0.7f;
+    } else if (type == WF_MSG_GAIT) {
+        const wf_cpg_params_t p = {.frequency_hz = 2.0f, .amplitude = {0.38f, 0.47f},
+                                   .w12 = -0.41f, .w21 = 0.64f, .phi12 = 1.76f,
+                                   .phi21 = 1.06f, .alpha = 20.0f};
+        msg.u.gait.gait_id = 1;
+        msg.u.gait.params = p;
     } else {
-        msg.u.telemetry.roll = 0.1f;
-        msg.u.telemetry.battery_v = 8.0f;
+        msg.u.health.uptime_ms = 0x01020304u; /* no zero bytes: the longest COBS run */
+        msg.u.health.reset_cause = 1;
     }
     return wf_encode_frame(&msg, wire, WF_MAX_WIRE);
 }
@@ -99,8 +107,9 @@ static uint64_t timed_poll(wf_app_t *app, uint32_t t, const uint8_t *in, size_t 
 
 int main(void)
 {
-    static uint64_t command[RUNS], frame_in[RUNS], telemetry_out[RUNS];
-    uint64_t command_max = 0, frame_in_max = 0, telemetry_max = 0;
+    static uint64_t command[RUNS], frame_in[RUNS], telemetry_out[RUNS], cpg_step[RUNS],
+        gait_poll[RUNS];
+    uint64_t command_max = 0, frame_in_max = 0, telemetry_max = 0, cpg_max = 0, gait_max = 0;
     static wf_app_t app;
     wf_config_t config;
     wf_config_defaults(&config);
@@ -118,18 +127,57 @@ int main(void)
             /* t % 10 == 1 and 3: no telemetry, heartbeat or IMU sample is due. */
             keep(command, &command_max, i,
                  timed_poll(&app, t, wire, frame(WF_MSG_SERVO_CMD, seq++, wire)), repeat);
-            /* The longest frame the decoder takes whole (62 bytes; the fish then ignores it). */
+            /* The longest frame the decoder takes whole (a HEALTH, 69 bytes; the fish then
+             * ignores it). */
             keep(frame_in, &frame_in_max, i,
-                 timed_poll(&app, t + 2, wire, frame(WF_MSG_TELEMETRY, seq++, wire)), repeat);
+                 timed_poll(&app, t + 2, wire, frame(WF_MSG_HEALTH, seq++, wire)), repeat);
             t += 9; /* a poll that sends the telemetry (and the IMU sample of its 5 ms) */
             keep(telemetry_out, &telemetry_max, i, timed_poll(&app, t, NULL, 0), repeat);
             t += 1;
         }
     }
+    const uint32_t applied = app.commands_applied;
+    /* Eq 1 alone: RUNS consecutive steps of Table 1 at 2 Hz from rest, each its fastest of
+     * REPEATS runs from the same start. */
+    static wf_cpg_t cpg;
+    const wf_cpg_params_t table1 = {.frequency_hz = 2.0f, .amplitude = {0.38f, 0.47f},
+                                    .w12 = -0.41f, .w21 = 0.64f, .phi12 = 1.76f,
+                                    .phi21 = 1.06f, .alpha = 20.0f};
+    float sink_angle[2] = {0};
+    for (int repeat = 0; repeat < REPEATS; repeat++) {
+        wf_cpg_init(&cpg, &table1);
+        for (size_t i = 0; i < RUNS; i++) {
+            const uint64_t start = counter_now();
+            wf_cpg_step(&cpg);
+            keep(cpg_step, &cpg_max, i, counter_now() - start, repeat);
+        }
+        wf_cpg_output(&cpg, sink_angle, NULL);
+    }
+    /* Gait mode: a GAIT at 1, then one poll per ms with nothing else due (no telemetry, IMU
+     * sample or heartbeat: those ms are skipped, unmeasured). */
+    uint32_t gaits = 0;
+    for (int repeat = 0; repeat < REPEATS; repeat++) {
+        wf_host_reset();
+        wf_app_init(&app, &config);
+        uint16_t seq = 0;
+        timed_poll(&app, 0, wire, frame(WF_MSG_HEARTBEAT, seq++, wire));
+        timed_poll(&app, 1, wire, frame(WF_MSG_GAIT, seq++, wire));
+        uint32_t t = 2;
+        for (size_t i = 0; i < RUNS; i++) {
+            while (t % 5 == 0 || t % 10 == 0 || t % 500 == 0 || t % 2000 == 0) {
+                timed_poll(&app, t++, NULL, 0);
+            }
+            keep(gait_poll, &gait_max, i, timed_poll(&app, t++, NULL, 0), repeat);
+        }
+        gaits += app.gait_mode && app.cpg.steps == t - 2;
+    }
     printf("{\"counter\": \"%s\", \"repeats\": %d, ", COUNTER, REPEATS);
     print_figure("servo_cmd_received", command, command_max, ", ");
     print_figure("longest_frame_received", frame_in, frame_in_max, ", ");
-    print_figure("telemetry_sent", telemetry_out, telemetry_max, "");
-    printf(", \"commands_applied\": %u}\n", app.commands_applied);
-    return app.commands_applied == RUNS ? 0 : 1;
+    print_figure("telemetry_sent", telemetry_out, telemetry_max, ", ");
+    print_figure("cpg_step", cpg_step, cpg_max, ", ");
+    print_figure("gait_poll", gait_poll, gait_max, "");
+    printf(", \"commands_applied\": %u, \"cpg_angle\": [%.6f, %.6f]}\n", applied,
+           (double)sink_angle[0], (double)sink_angle[1]);
+    return applied == RUNS && gaits == REPEATS ? 0 : 1;
 }
