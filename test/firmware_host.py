@@ -3,9 +3,10 @@ The firmware's host build from Python: the make step and ctypes bindings of wf_h
 
 ``build_firmware`` runs ``make -C firmware`` once per process under a file lock (pytest-xdist
 workers share the tree); ``FirmwareHost`` wraps ``build/host/libwirefish_fw.so``: the process's
-one board (init, step at a time, snapshot, I2C device model, ADC) and the batch codec;
-``random_messages`` draws valid messages as flat records and ``to_python`` makes the
-wirefish_bridge message of one.
+one board (init, step at a time, snapshots of its state, its gait mode and its health, I2C
+device model, ADC), a lone CPG and the batch codec; ``random_messages`` draws valid messages of
+every type as flat records, ``to_python`` makes the wirefish_bridge message of one and
+``to_record`` the record of a message.
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ from pathlib import Path
 import subprocess
 
 import numpy as np
-from wirefish_bridge.protocol import (ErrorReport, Heartbeat, ProtocolMessage, Role, ServoCommand,
-                                      Telemetry)
+from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat, LinkConfig,
+                                      MsgType, ProtocolMessage, Role, ServoCommand, Telemetry,
+                                      TelemetryCompact)
 
 WORKSPACE = Path(__file__).resolve().parents[1]
 FIRMWARE = WORKSPACE / 'firmware'
@@ -26,15 +28,30 @@ BUILD = FIRMWARE / 'build'
 LIBRARY = BUILD / 'host' / 'libwirefish_fw.so'
 FUZZ_DRIVER = BUILD / 'asan' / 'fuzz_decoder'
 
-# wf_host_msg_t: every field of every message type, flat (firmware/port/host/wf_host.h).
+# wf_host_msg_t: every field of every message type, flat (firmware/port/host/wf_host.h); ``n``
+# holds the integer fields the first part has no place for, widened, in wire order.
+MSG_INTS = 20
 MSG_DTYPE = np.dtype([('type', 'u1'), ('code', 'u1'), ('role', 'u1'), ('pad', 'u1'),
-                      ('seq', '<u2'), ('ref', '<u2'), ('time', '<u4'), ('f', '<f4', (12,))])
+                      ('seq', '<u2'), ('ref', '<u2'), ('time', '<u4'), ('f', '<f4', (12,)),
+                      ('pad2', '<u4'), ('n', '<i8', (MSG_INTS,))])
 # wf_decoder_stats_t, in order: the same names as the bridge's DecoderStats.
 STATS_FIELDS = ('bytes_in', 'frames_ok', 'cobs_errors', 'short_frames', 'crc_errors',
                 'unknown_type', 'length_errors', 'invalid_payload', 'overflows', 'resyncs',
                 'seq_gaps', 'seq_resets')
 I2cDevice = Callable[[int, bytes, int], 'bytes | None']
-MESSAGE_TYPES = np.array([0x01, 0x10, 0x20, 0x7F], np.uint8)
+MESSAGE_TYPES = np.array([int(kind) for kind in MsgType], np.uint8)
+U8, U16, I16, U32 = (0, 0xFF), (0, 0xFFFF), (-0x8000, 0x7FFF), (0, 0xFFFFFFFF)
+# The ranges of the integers in ``n`` per type (wire order); a type not named has none there.
+INT_FIELDS: dict[int, tuple[tuple[int, int], ...]] = {
+    MsgType.TELEMETRY: (U16,),
+    MsgType.LINK_CONFIG: (U16, U8, U16, U16, U16),
+    MsgType.ACK: (U8, U16, U8),
+    MsgType.GAIT: (U16,),
+    MsgType.TELEMETRY_COMPACT: (U32,) + (I16,) * 11 + (U16,) * 3,
+    MsgType.HEALTH: (U8,) * 3 + (U32,) * 5 + (U16,) * 2 + (U32,) * 7 + (U16,) * 3,
+}
+# How many of ``f`` each type carries.
+FLOATS = {MsgType.SERVO_CMD: 2, MsgType.GAIT: 10, MsgType.TELEMETRY: 12}
 
 
 def random_messages(rng: np.random.Generator, count: int) -> np.ndarray:
@@ -51,17 +68,26 @@ def random_messages(rng: np.random.Generator, count: int) -> np.ndarray:
     bits[not_finite] &= 0xBFFFFFFF  # clear the top exponent bit: finite, sign kept
     bits[rng.random((count, 12)) < 0.02] = 0x80000000  # -0.0 is a value of its own
     records['f'] = bits.view(np.float32)
-    is_heartbeat = records['type'] == 0x01
-    is_servo = records['type'] == 0x10
-    is_telemetry = records['type'] == 0x20
-    is_error = records['type'] == 0x7F
+    # Integers of every width at their edges now and then: 0, the extremes, one inside.
+    edges = rng.random((count, MSG_INTS)) < 0.05
+    uniform = rng.random((count, MSG_INTS))
+    types = records['type']
+    is_heartbeat = types == MsgType.HEARTBEAT
+    is_telemetry = types == MsgType.TELEMETRY
+    is_error = types == MsgType.ERROR
     # Only the fields a type carries (the C side leaves the others zero).
-    records['time'][is_servo | is_error] = 0
-    records['ref'][is_heartbeat | is_servo] = 0
-    records['code'][is_servo | is_telemetry] = 0
+    records['time'][~(is_heartbeat | is_telemetry)] = 0
+    records['ref'][~(is_telemetry | is_error)] = 0
+    records['code'][~(is_heartbeat | is_error)] = 0
     records['role'][~is_heartbeat] = 0
-    records['f'][~(is_servo | is_telemetry)] = 0.0
-    records['f'][is_servo, 2:] = 0.0
+    for kind in MsgType:
+        rows = types == kind
+        records['f'][rows, FLOATS.get(kind, 0):] = 0.0
+        for i, (low, high) in enumerate(INT_FIELDS.get(kind, ())):
+            values = np.floor(low + uniform[rows, i] * (high - low + 1)).astype(np.int64)
+            pick = edges[rows, i]
+            values[pick] = np.where(uniform[rows, i][pick] < 0.5, low, high)
+            records['n'][rows, i] = np.minimum(values, high)
     return records
 
 
@@ -69,15 +95,59 @@ def to_python(record: np.void) -> ProtocolMessage:
     """Return the wirefish_bridge message of one record."""
     kind = int(record['type'])
     f = record['f'].tolist()
-    if kind == 0x01:
+    n = [int(v) for v in record['n']]
+    if kind == MsgType.HEARTBEAT:
         return Heartbeat(int(record['code']), Role(int(record['role'])), int(record['time']))
-    if kind == 0x10:
+    if kind == MsgType.SERVO_CMD:
         return ServoCommand(f[0], f[1])
-    if kind == 0x20:
+    if kind == MsgType.TELEMETRY:
         return Telemetry(board_time_ms=int(record['time']), roll=f[0], pitch=f[1], yaw=f[2],
                          gyro=tuple(f[3:6]), accel=tuple(f[6:9]), servo_1=f[9],
-                         servo_2=f[10], battery_v=f[11], status=int(record['ref']))
+                         servo_2=f[10], battery_v=f[11], status=int(record['ref']),
+                         gait_id=n[0])
+    if kind == MsgType.LINK_CONFIG:
+        return LinkConfig(*n[:5])
+    if kind == MsgType.ACK:
+        return Ack(*n[:3])
+    if kind == MsgType.GAIT:
+        return Gait(n[0], *f[:10])
+    if kind == MsgType.TELEMETRY_COMPACT:
+        return TelemetryCompact(n[0], n[1], n[2], n[3], tuple(n[4:7]), tuple(n[7:10]), n[10],
+                                n[11], n[12], n[13], n[14])
+    if kind == MsgType.HEALTH:
+        return Health(*n[:20])
     return ErrorReport(int(record['code']), int(record['ref']))
+
+
+def to_record(message: ProtocolMessage, seq: int) -> np.ndarray:
+    """Return the one-record array (MSG_DTYPE) of ``message`` with ``seq``: to_python's inverse."""
+    record = np.zeros(1, MSG_DTYPE)
+    m = message
+    kind = type(m).KIND
+    record['type'], record['seq'] = int(kind), seq
+    ints: list[int] = []
+    if isinstance(m, Heartbeat):
+        record['code'], record['role'], record['time'] = m.version, int(m.role), m.uptime_ms
+    elif isinstance(m, ServoCommand):
+        record['f'][0, :2] = (m.servo_1, m.servo_2)
+    elif isinstance(m, Telemetry):
+        record['time'], record['ref'] = m.board_time_ms, int(m.status)
+        record['f'][0] = (m.roll, m.pitch, m.yaw, *m.gyro, *m.accel, m.servo_1, m.servo_2,
+                          m.battery_v)
+        ints = [m.gait_id]
+    elif isinstance(m, ErrorReport):
+        record['code'], record['ref'] = int(m.code), m.ref_seq
+    elif isinstance(m, Gait):
+        record['f'][0, :10] = m.to_wire()[1:]
+        ints = [m.gait_id]
+    else:  # LINK_CONFIG, ACK, TELEMETRY_COMPACT, HEALTH: integers only, in wire order
+        ints = [int(v) for v in _flat(m.to_wire())]
+    record['n'][0, :len(ints)] = ints
+    return record
+
+
+def _flat(values: tuple) -> list:
+    return [v for value in values for v in (value if isinstance(value, tuple) else (value,))]
 
 
 def build_firmware(*targets: str) -> None:
@@ -109,7 +179,51 @@ class Config(ctypes.Structure):
                 ('servo_limit_rad', ctypes.c_float), ('servo_cal', ServoCal * 2),
                 ('imu_axes', ctypes.c_int8 * 3), ('imu_mode', ctypes.c_uint8),
                 ('attitude_tau_s', ctypes.c_float), ('battery_v_per_count', ctypes.c_float),
-                ('low_battery_v', ctypes.c_float)]
+                ('low_battery_v', ctypes.c_float), ('health_period_ms', ctypes.c_uint32),
+                ('link_timeout_ms', ctypes.c_uint32), ('coast_ms', ctypes.c_uint32),
+                ('telemetry_form', ctypes.c_uint8), ('failsafe_slew_rad_s', ctypes.c_float)]
+
+
+class CpgParams(ctypes.Structure):
+    """wf_cpg_params_t (firmware/include/wf/cpg.h): GAIT's floats in wire order."""
+
+    _fields_ = [('frequency_hz', ctypes.c_float), ('amplitude', ctypes.c_float * 2),
+                ('offset', ctypes.c_float * 2), ('w12', ctypes.c_float),
+                ('w21', ctypes.c_float), ('phi12', ctypes.c_float), ('phi21', ctypes.c_float),
+                ('alpha', ctypes.c_float)]
+
+
+class GaitSnapshot(ctypes.Structure):
+    """wf_host_gait_snapshot_t: the board's gait mode, CPG and link settings."""
+
+    _fields_ = [('gait_mode', ctypes.c_uint8), ('gap', ctypes.c_uint8),
+                ('gait_id', ctypes.c_uint16), ('cpg_time_ms', ctypes.c_uint32),
+                ('cpg_steps', ctypes.c_uint32), ('phase', ctypes.c_float * 2),
+                ('r', ctypes.c_float * 2), ('dr', ctypes.c_float * 2),
+                ('b', ctypes.c_float * 2), ('db', ctypes.c_float * 2),
+                ('output', ctypes.c_float * 2), ('rate', ctypes.c_float * 2),
+                ('target', ctypes.c_float * 2), ('compare', ctypes.c_uint32 * 2),
+                ('status', ctypes.c_uint16), ('ack_count', ctypes.c_uint8),
+                ('telemetry_form', ctypes.c_uint8), ('acks_dropped', ctypes.c_uint32),
+                ('gaits_accepted', ctypes.c_uint32), ('gaits_refused', ctypes.c_uint32),
+                ('telemetry_period_ms', ctypes.c_uint32), ('health_period_ms', ctypes.c_uint32),
+                ('link_timeout_ms', ctypes.c_uint32), ('coast_ms', ctypes.c_uint32),
+                ('params', CpgParams)]
+
+
+class HealthRecord(ctypes.Structure):
+    """wf_health_t (firmware/include/wf/health.h)."""
+
+    _fields_ = [('reset_cause', ctypes.c_uint8), ('clock_source', ctypes.c_uint8),
+                ('flags', ctypes.c_uint8), ('fault_pc', ctypes.c_uint32),
+                ('fault_lr', ctypes.c_uint32), ('fault_cfsr', ctypes.c_uint32),
+                ('fault_hfsr', ctypes.c_uint32), ('uptime_ms', ctypes.c_uint32),
+                ('stack_free_min', ctypes.c_uint16), ('stack_size', ctypes.c_uint16),
+                ('uart_rx_overruns', ctypes.c_uint32), ('tx_bytes_dropped', ctypes.c_uint32),
+                ('rx_crc', ctypes.c_uint32), ('rx_frame', ctypes.c_uint32),
+                ('rx_unknown_type', ctypes.c_uint32), ('rx_length', ctypes.c_uint32),
+                ('rx_invalid', ctypes.c_uint32), ('imu_faults', ctypes.c_uint16),
+                ('imu_recoveries', ctypes.c_uint16), ('i2c_bus_recoveries', ctypes.c_uint16)]
 
 
 class Snapshot(ctypes.Structure):
@@ -154,6 +268,12 @@ class FirmwareHost:
             'wf_host_board_snapshot': (None, [ctypes.POINTER(Snapshot)]),
             'wf_host_config_size': (_SIZE, []),
             'wf_host_snapshot_size': (_SIZE, []),
+            'wf_host_board_gait': (None, [ctypes.POINTER(GaitSnapshot)]),
+            'wf_host_gait_snapshot_size': (_SIZE, []),
+            'wf_host_board_health': (None, [ctypes.POINTER(HealthRecord)]),
+            'wf_host_health_size': (_SIZE, []),
+            'wf_host_msg_size': (_SIZE, []),
+            'wf_host_cpg_params_size': (_SIZE, []),
             'wf_host_decode_stream': (_SIZE, [_BYTES, _SIZE, ctypes.c_void_p, _SIZE,
                                               ctypes.c_void_p]),
             'wf_host_encode_stream': (_SIZE, [ctypes.c_void_p, _SIZE, ctypes.c_void_p, _SIZE]),
@@ -163,9 +283,17 @@ class FirmwareHost:
             function = getattr(lib, name)
             function.restype = restype
             function.argtypes = argtypes
-        if (lib.wf_host_config_size() != ctypes.sizeof(Config)
-                or lib.wf_host_snapshot_size() != ctypes.sizeof(Snapshot)):
-            raise RuntimeError('firmware_host.py and wf_host.h disagree on a structure')
+        sizes = {'wf_config_t': (lib.wf_host_config_size(), ctypes.sizeof(Config)),
+                 'wf_host_snapshot_t': (lib.wf_host_snapshot_size(), ctypes.sizeof(Snapshot)),
+                 'wf_host_gait_snapshot_t': (lib.wf_host_gait_snapshot_size(),
+                                             ctypes.sizeof(GaitSnapshot)),
+                 'wf_health_t': (lib.wf_host_health_size(), ctypes.sizeof(HealthRecord)),
+                 'wf_host_msg_t': (lib.wf_host_msg_size(), MSG_DTYPE.itemsize),
+                 'wf_cpg_params_t': (lib.wf_host_cpg_params_size(), ctypes.sizeof(CpgParams))}
+        wrong = {name: size for name, size in sizes.items() if size[0] != size[1]}
+        if wrong:
+            raise RuntimeError(f'firmware_host.py and wf_host.h disagree on {wrong} '
+                               '(C size, Python size)')
         self.lib = lib
         self._out = ctypes.create_string_buffer(1 << 16)
         self._i2c: object = None  # the ctypes callback, kept alive while the board uses it
@@ -218,6 +346,18 @@ class FirmwareHost:
         self.lib.wf_host_board_snapshot(ctypes.byref(snapshot))
         return snapshot
 
+    def gait(self) -> GaitSnapshot:
+        """Return the board's gait mode, CPG state and link settings now."""
+        snapshot = GaitSnapshot()
+        self.lib.wf_host_board_gait(ctypes.byref(snapshot))
+        return snapshot
+
+    def health(self) -> HealthRecord:
+        """Return the board's health record as last sent."""
+        record = HealthRecord()
+        self.lib.wf_host_board_health(ctypes.byref(record))
+        return record
+
     def compare(self, servo: int) -> int:
         """Return the compare value last written to servo channel 0 or 1."""
         return int(self.lib.wf_host_compare(servo))
@@ -235,7 +375,7 @@ class FirmwareHost:
     def encode_stream(self, messages: np.ndarray) -> bytes:
         """Encode ``messages`` (MSG_DTYPE, their own seq) in C, frame after frame."""
         messages = np.ascontiguousarray(messages, MSG_DTYPE)
-        capacity = 64 * len(messages) + 64
+        capacity = 70 * len(messages) + 70
         out = ctypes.create_string_buffer(capacity)
         n = self.lib.wf_host_encode_stream(messages.ctypes.data, len(messages), out, capacity)
         if n == 0 and len(messages):

@@ -18,11 +18,15 @@ from cobs import cobs
 from firmware_host import FUZZ_DRIVER, random_messages, STATS_FIELDS, to_python
 import numpy as np
 from wirefish_bridge.codec import encode_body, encode_frame, StreamDecoder
+from wirefish_bridge.protocol import MsgType, PAYLOAD_SIZES
 
 COUNT = 1_000_000
 BATCH = 20_000
 POOL = 4096
-KNOWN_SIZES = {0x01: 6, 0x10: 8, 0x20: 54, 0x7F: 3}
+KNOWN_SIZES = {int(kind): size for kind, size in PAYLOAD_SIZES.items()}
+KINDS = sorted(KNOWN_SIZES)
+# Where a type's binary32 fields start in its payload (4-byte steps from there).
+FLOATS_AT = {MsgType.SERVO_CMD: 0, MsgType.GAIT: 2, MsgType.TELEMETRY: 4}
 NON_FINITE = (b'\x00\x00\x80\x7f', b'\x00\x00\x80\xff', b'\x00\x00\xc0\x7f', b'\x01\x00\x80\xff')
 
 
@@ -33,13 +37,14 @@ def valid_pool(rng: np.random.Generator) -> list[bytes]:
 
 def crafted(draw: list[int], rng_bytes: bytes) -> bytes:
     """Return a run whose CRC is right: any type, a payload size near the type's, odd values."""
-    kind = (0x01, 0x10, 0x20, 0x7F, draw[0] % 256)[draw[1] % 5]
-    size = KNOWN_SIZES.get(kind, draw[2] % 60)
-    size = (size, size, size - 1, size + 1, draw[2] % 70)[draw[3] % 5]
+    kind = KINDS[draw[1] % len(KINDS)] if draw[1] % 10 else draw[0] % 256
+    size = KNOWN_SIZES.get(kind, draw[2] % 66)
+    size = (size, size, size - 1, size + 1, draw[2] % 72)[draw[3] % 5]
     payload = bytearray(rng_bytes[:max(size, 0)].ljust(max(size, 0), b'\x01'))
     if payload and draw[4] % 3 == 0:
-        at = (draw[5] % max(1, len(payload) // 4)) * 4
-        payload[at:at + 4] = NON_FINITE[draw[6] % 4][:len(payload) - at]
+        base = FLOATS_AT.get(kind, 0)
+        at = base + (draw[5] % max(1, (len(payload) - base) // 4)) * 4
+        payload[at:at + 4] = NON_FINITE[draw[6] % 4][:max(0, len(payload) - at)]
     if kind == 0x01 and len(payload) > 1:
         payload[1] = draw[7] % 4  # roles 0 and 1 are known, 2 and 3 not
     body = struct.pack('<BH', kind, draw[8]) + bytes(payload)
@@ -71,7 +76,7 @@ def mutated(frame: bytes, draw: list[int], other: bytes) -> bytes:
 def inputs(rng: np.random.Generator, pool: list[bytes], count: int) -> list[bytes]:
     """Return ``count`` inputs: valid frames, mutated ones, crafted runs and random bytes."""
     draws = rng.integers(0, 1 << 16, (count, 16)).tolist()
-    noise = rng.integers(0, 256, count * 72, dtype=np.uint8).tobytes()
+    noise = rng.integers(0, 256, count * 80, dtype=np.uint8).tobytes()
     out = []
     for i, draw in enumerate(draws):
         kind = draw[15] % 20
@@ -81,10 +86,10 @@ def inputs(rng: np.random.Generator, pool: list[bytes], count: int) -> list[byte
         elif kind < 11:  # 40 %: a valid frame, damaged
             out.append(mutated(frame, draw, pool[draw[12] % POOL]))
         elif kind < 16:  # 25 %: a run with a right CRC and odd contents
-            out.append(b'\x00' + crafted(draw, noise[72 * i:72 * i + 72]) + b'\x00')
+            out.append(b'\x00' + crafted(draw, noise[80 * i:80 * i + 80]) + b'\x00')
         else:           # 20 %: random bytes, 0 to 100 of them, often with zeros
             length = draw[0] % 101
-            chunk = noise[72 * i:72 * i + min(length, 72)] * 2
+            chunk = noise[80 * i:80 * i + min(length, 80)] * 2
             out.append(chunk[:length].replace(b'\x07', b'\x00'))
     return out
 

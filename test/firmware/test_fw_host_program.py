@@ -8,7 +8,8 @@ import pytest
 from ros_utils import stop_process
 import serial
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import Heartbeat, Role, ServoCommand, Status, Telemetry
+from wirefish_bridge.protocol import (Heartbeat, PROTOCOL_VERSION, Role, ServoCommand, Status,
+                                      Telemetry)
 
 PROGRAM = BUILD / 'host' / 'wirefish-fw-host'
 
@@ -43,7 +44,7 @@ def test_program_identifies_itself_and_applies_commands_on_its_pty(board_pty: st
         decoder, encoder = StreamDecoder(), FrameEncoder()
         read_until(port, decoder, lambda ms: any(
             isinstance(m, Heartbeat) and m.role == Role.FISH for m in ms))
-        port.write(encoder.encode(Heartbeat(1, Role.HOST, 0)) +
+        port.write(encoder.encode(Heartbeat(PROTOCOL_VERSION, Role.HOST, 0)) +
                    encoder.encode(ServoCommand(0.25, -3.0)))
         messages = read_until(port, decoder, lambda ms: any(
             isinstance(m, Telemetry) and m.servo_1 == 0.25 for m in ms))

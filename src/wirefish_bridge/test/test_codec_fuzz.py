@@ -4,15 +4,19 @@ from dataclasses import fields
 
 import numpy as np
 from wirefish_bridge.codec import DecoderStats, FrameEncoder, MAX_ENCODED_FRAME, StreamDecoder
-from wirefish_bridge.protocol import (ErrorReport, Heartbeat, Role, ServoCommand, Telemetry)
+from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat, LinkConfig, Role,
+                                      ServoCommand, Telemetry, TelemetryCompact)
 
 FRAMES = 100_000
 SEED = 20260522
 
 
 def _random_message(rng: np.random.Generator):
+    """Return a random valid message of any type of protocol version 2."""
     floats = rng.normal(0.0, 3.0, 12).astype(np.float32).astype(float).tolist()
-    kind = rng.integers(4)
+    ints = rng.integers(0, 2**32, 20, dtype=np.uint64).tolist()
+    i16 = rng.integers(-2**15, 2**15, 11).tolist()
+    kind = rng.integers(9)
     if kind == 0:
         return Heartbeat(int(rng.integers(256)), Role(int(rng.integers(2))),
                          int(rng.integers(2**32)))
@@ -20,7 +24,20 @@ def _random_message(rng: np.random.Generator):
         return ServoCommand(floats[0], floats[1])
     if kind == 2:
         return Telemetry(int(rng.integers(2**32)), *floats[:3], tuple(floats[3:6]),
-                         tuple(floats[6:9]), *floats[9:12], int(rng.integers(2**16)))
+                         tuple(floats[6:9]), *floats[9:12], int(rng.integers(2**16)),
+                         int(rng.integers(2**16)))
+    if kind == 3:
+        return LinkConfig(ints[0] % 2**16, ints[1] % 256, *(v % 2**16 for v in ints[2:5]))
+    if kind == 4:
+        return Ack(ints[0] % 256, ints[1] % 2**16, ints[2] % 256)
+    if kind == 5:
+        return Gait(ints[0] % 2**16, *floats[:10])
+    if kind == 6:
+        return TelemetryCompact(ints[0], *i16[:3], tuple(i16[3:6]), tuple(i16[6:9]), *i16[9:11],
+                                *(v % 2**16 for v in ints[1:4]))
+    if kind == 7:
+        return Health(*(v % 256 for v in ints[:3]), *ints[3:8], *(v % 2**16 for v in ints[8:10]),
+                      *ints[10:17], *(v % 2**16 for v in ints[17:20]))
     return ErrorReport(int(rng.integers(256)), int(rng.integers(2**16)))
 
 
