@@ -1,4 +1,4 @@
-"""The example frames of PROTOCOL.md (version 2), produced and accepted byte for byte by the C core."""
+"""The example frames of PROTOCOL.md (v2), produced and accepted byte for byte by the C core."""
 
 from pathlib import Path
 import re
