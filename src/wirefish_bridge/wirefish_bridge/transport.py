@@ -319,7 +319,8 @@ def _write_without_blocking(port: serial.Serial, data: bytes) -> int:
     try:
         fd = port.fileno()
     except (AttributeError, serial.SerialException):
-        return port.write(data)
+        written: int = port.write(data)  # pyserial has no types
+        return written
     try:
         return os.write(fd, data)
     except BlockingIOError:

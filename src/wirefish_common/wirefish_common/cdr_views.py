@@ -58,7 +58,8 @@ class CdrReader:
 
     def count(self, what: str) -> int:
         """Read a uint32: a sequence's count or a string's length."""
-        return self._u32.unpack_from(self.data, self._take(4, 4, what))[0]
+        count: int = self._u32.unpack_from(self.data, self._take(4, 4, what))[0]
+        return count
 
     def string(self, what: str) -> str:
         """Read a UTF-8 string: NUL-terminated, at most ``MAX_NAME_BYTES`` long."""

@@ -9,10 +9,12 @@ time window centred on each sample, over what there is at the ends (no dip towar
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 
-def legend_beside(ax, **options):
+def legend_beside(ax: Any, **options: Any) -> Any:
     """Draw ``ax``'s legend outside, to its right (``options`` go to ``ax.legend``)."""
     settings = {'loc': 'upper left', 'bbox_to_anchor': (1.01, 1.0), 'borderaxespad': 0.0,
                 'fontsize': 8, **options}

@@ -45,7 +45,8 @@ def envelope_time(t: ArrayLike, alpha: float) -> np.ndarray:
     a = 0.5 * float(alpha)
     t = np.asarray(t, dtype=float)
     decay = np.exp(-a * t)
-    return t - 2.0 * (1.0 - decay) / a + t * decay
+    tau: np.ndarray = t - 2.0 * (1.0 - decay) / a + t * decay
+    return tau
 
 
 def phases_from_rest(t: ArrayLike, frequency_hz: ArrayLike, r1: ArrayLike, r2: ArrayLike,

@@ -156,7 +156,8 @@ def rk4_step(state: np.ndarray, step_s: float, net: NetworkArrays) -> np.ndarray
     k2 = eq1_derivative(state + 0.5 * step_s * k1, net)
     k3 = eq1_derivative(state + 0.5 * step_s * k2, net)
     k4 = eq1_derivative(state + step_s * k3, net)
-    return state + (step_s / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    later: np.ndarray = state + (step_s / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    return later
 
 
 def output_angles(state: np.ndarray, net: NetworkArrays) -> tuple[np.ndarray, np.ndarray]:

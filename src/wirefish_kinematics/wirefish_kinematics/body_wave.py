@@ -49,7 +49,8 @@ def sinc_derivative(u: ArrayLike) -> np.ndarray:
         series = series * u2 + coefficient
     safe = np.where(small, 1.0, u)
     closed = (safe * np.cos(safe) - np.sin(safe)) / (safe * safe)
-    return np.where(small, -u * series, closed)
+    derivative: np.ndarray = np.where(small, -u * series, closed)
+    return derivative
 
 
 def arc_point(arc_length: ArrayLike, turn: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -132,7 +133,8 @@ def tangent_angles(q: ArrayLike, beta1: ArrayLike, beta2: ArrayLike, geometry: F
                    ) -> np.ndarray:
     """Return the body-axis direction (rad) from +x at stations q, (..., S): phi1 + phi2."""
     chain = _Chain(q, beta1, beta2, geometry)
-    return chain.phi1 + chain.phi2
+    direction: np.ndarray = chain.phi1 + chain.phi2
+    return direction
 
 
 def lateral_slope(q: ArrayLike, beta1: ArrayLike, beta2: ArrayLike, geometry: FishGeometry
@@ -142,7 +144,8 @@ def lateral_slope(q: ArrayLike, beta1: ArrayLike, beta2: ArrayLike, geometry: Fi
 
     q is arc length, so dy/dq is the sine of the tangent angle on every link.
     """
-    return np.sin(tangent_angles(q, beta1, beta2, geometry))
+    slope: np.ndarray = np.sin(tangent_angles(q, beta1, beta2, geometry))
+    return slope
 
 
 def lateral_bend_derivatives(q: ArrayLike, beta1: ArrayLike, beta2: ArrayLike,
@@ -176,8 +179,9 @@ def lateral_velocity(q: ArrayLike, beta1: ArrayLike, beta2: ArrayLike, beta1_rat
         *(np.asarray(v, dtype=float) for v in (beta1, beta2, beta1_rate, beta2_rate)))
     d_beta1, d_beta2 = lateral_bend_derivatives(q, beta1, beta2, geometry)
     trailing = (1,) * np.ndim(q)
-    return (d_beta1 * rate1.reshape(rate1.shape + trailing)
-            + d_beta2 * rate2.reshape(rate2.shape + trailing))
+    velocity: np.ndarray = (d_beta1 * rate1.reshape(rate1.shape + trailing)
+                            + d_beta2 * rate2.reshape(rate2.shape + trailing))
+    return velocity
 
 
 def swing_angles(beta1: ArrayLike, beta2: ArrayLike, geometry: FishGeometry

@@ -33,7 +33,8 @@ def desired_lateral_position(q: ArrayLike, t: ArrayLike, c1: float, c2: float, k
     q = np.asarray(q, dtype=float)
     t = np.asarray(t, dtype=float)
     phase = k * q + time_sign * 2.0 * math.pi * frequency_hz * t
-    return (c1 * q + c2 * q * q) * np.sin(phase)
+    y: np.ndarray = (c1 * q + c2 * q * q) * np.sin(phase)
+    return y
 
 
 def desired_swing_angles(t: ArrayLike, c1: float, c2: float, k: float, frequency_hz: float,

@@ -30,7 +30,8 @@ def instantaneous_thrust(tip_lateral_velocity: ArrayLike, tip_slope: ArrayLike,
     slope = np.asarray(tip_slope, dtype=float)
     u = np.asarray(speed, dtype=float)
     area = geometry.tip_cross_section_area
-    return 0.5 * geometry.water_density * area * (v * v - u * u * slope * slope)
+    thrust: np.ndarray = 0.5 * geometry.water_density * area * (v * v - u * u * slope * slope)
+    return thrust
 
 
 def drag_force(speed: ArrayLike, geometry: FishGeometry) -> np.ndarray:
@@ -41,7 +42,8 @@ def drag_force(speed: ArrayLike, geometry: FishGeometry) -> np.ndarray:
     """
     u = np.asarray(speed, dtype=float)
     g = geometry
-    return 0.5 * g.drag_coefficient * g.water_density * u * np.abs(u) * g.wetted_area
+    drag: np.ndarray = 0.5 * g.drag_coefficient * g.water_density * u * np.abs(u) * g.wetted_area
+    return drag
 
 
 def steady_speed(mean_square_lateral_velocity: ArrayLike, mean_square_slope: ArrayLike,

@@ -61,7 +61,7 @@ def root_problem() -> str | None:
     return None
 
 
-def _run(*args: str, check: bool = True) -> subprocess.CompletedProcess:
+def _run(*args: str, check: bool = True) -> subprocess.CompletedProcess[str]:
     try:
         done = subprocess.run(args, capture_output=True, text=True, timeout=COMMAND_TIMEOUT_S)
     except (OSError, subprocess.TimeoutExpired) as error:

@@ -121,7 +121,7 @@ class QemuBoard:
         self.link = link
         self.console = console
         self.ports: BoardPorts | None = None
-        self._proc: subprocess.Popen | None = None
+        self._proc: subprocess.Popen[bytes] | None = None
         self._output: deque[str] = deque(maxlen=50)
         self._drain: threading.Thread | None = None
 
@@ -253,7 +253,7 @@ class QemuBoard:
         self.remove_link()
 
 
-def _signal_group(proc: subprocess.Popen, signum: int) -> None:
+def _signal_group(proc: subprocess.Popen[bytes], signum: int) -> None:
     try:
         os.killpg(proc.pid, signum)
     except ProcessLookupError:

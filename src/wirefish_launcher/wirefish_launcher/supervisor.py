@@ -58,7 +58,7 @@ class Supervisor:
         self._env = dict(os.environ if env is None else env)
         self._env.setdefault('PYTHONUNBUFFERED', '1')
         self._env.setdefault('RCUTILS_COLORIZED_OUTPUT', '0')
-        self.processes: dict[str, subprocess.Popen] = {}
+        self.processes: dict[str, subprocess.Popen[bytes]] = {}
         self.specs: dict[str, NodeSpec] = {}
         self.budgets: dict[str, RestartBudget] = {}
         self.given_up: dict[str, int] = {}  # key -> its last exit code
@@ -66,7 +66,7 @@ class Supervisor:
         self._logs: dict[str, TextIO] = {}
         self.overran: list[str] = []  # the processes still running at stop()'s deadline
 
-    def start(self, spec: NodeSpec) -> subprocess.Popen:
+    def start(self, spec: NodeSpec) -> subprocess.Popen[bytes]:
         """
         Start one process of the graph; its output goes to ``<log_dir>/<key>.log``.
 
@@ -85,7 +85,7 @@ class Supervisor:
         self.budgets[key] = RestartBudget(spec.restart)
         return self._launch(key)
 
-    def _launch(self, key: str) -> subprocess.Popen:
+    def _launch(self, key: str) -> subprocess.Popen[bytes]:
         spec = self.specs[key]
         for link in spec.links:
             remove_stale_link(link)
@@ -227,7 +227,7 @@ class Supervisor:
         self._logs.clear()
         return codes
 
-    def _escalate(self, proc: subprocess.Popen) -> int | None:
+    def _escalate(self, proc: subprocess.Popen[bytes]) -> int | None:
         """SIGTERM, then SIGKILL after ``TERM_GRACE_S``; return its own exit code, or None."""
         self._signal(proc, signal.SIGTERM)
         try:
@@ -238,7 +238,7 @@ class Supervisor:
             return None
 
     @staticmethod
-    def _signal(proc: subprocess.Popen, signum: int) -> None:
+    def _signal(proc: subprocess.Popen[bytes], signum: int) -> None:
         if proc.poll() is None:
             try:
                 os.killpg(proc.pid, signum)
@@ -257,7 +257,8 @@ def remove_stale_link(link: Path) -> None:
         link.unlink()
 
 
-def wait_for_path(path: Path, procs: Sequence[subprocess.Popen], timeout_s: float) -> bool:
+def wait_for_path(path: Path, procs: Sequence[subprocess.Popen[bytes]], timeout_s: float
+                  ) -> bool:
     """Wait until ``path`` exists, giving up early if any of ``procs`` exits."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:

@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
     domain = os.environ.get('ROS_DOMAIN_ID', '0')
     stop = stop_on_signals()
-    sides: dict[Role, subprocess.Popen] = {}
+    sides: dict[Role, subprocess.Popen[bytes]] = {}
     try:
         link.create()
         if args.rate:
@@ -104,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
     return 0 if all(code == 0 for code in codes.values()) else 1
 
 
-def _stop(proc: subprocess.Popen) -> int | None:
+def _stop(proc: subprocess.Popen[bytes]) -> int | None:
     if proc.poll() is None:
         os.killpg(proc.pid, signal.SIGINT)
         try:

@@ -77,7 +77,7 @@ def simulated_cycle(position: np.ndarray, problem: WaveFitProblem, alpha: float 
     return angles, float(intrinsic)
 
 
-def simulated_body_wave_loss(position: np.ndarray, problem: WaveFitProblem, **kwargs
+def simulated_body_wave_loss(position: np.ndarray, problem: WaveFitProblem, **kwargs: float
                              ) -> float:
     """Return the loss of eqs 24-25 (m*s) of one particle (6,) by integrating eq 1."""
     angles, intrinsic = simulated_cycle(position, problem, **kwargs)
@@ -87,8 +87,9 @@ def simulated_body_wave_loss(position: np.ndarray, problem: WaveFitProblem, **kw
     return loss
 
 
-def simulated_swing_rmse_deg(position: np.ndarray, problem: WaveFitProblem, **kwargs
+def simulated_swing_rmse_deg(position: np.ndarray, problem: WaveFitProblem, **kwargs: float
                              ) -> np.ndarray:
     """Return the theta_1, theta_2 RMSE (2,) degrees of one particle by integrating eq 1."""
     angles, _ = simulated_cycle(position, problem, **kwargs)
-    return waveform_swing_rmse_deg(angles[None], problem)[0]
+    rmse: np.ndarray = waveform_swing_rmse_deg(angles[None], problem)[0]
+    return rmse

@@ -17,7 +17,7 @@ No rclpy here: the nodes translate messages to ``RetuneOrder`` and ``RetuneOutco
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 import math
 import time
@@ -124,7 +124,8 @@ class RetuneOutcome:
         return figures_phrase(self.loss, self.iterations, self.rmse_theta_deg)
 
 
-def figures_phrase(loss: float, iterations: int, rmse_theta_deg) -> str:
+def figures_phrase(loss: float, iterations: int, rmse_theta_deg: Sequence[float] | np.ndarray
+                   ) -> str:
     """Return a fit's figures in one phrase: loss (m*s), iterations, swing-angle RMSE (deg)."""
     return (f'loss {loss:.6g} m*s after {iterations} iterations, RMSE theta '
             f'{rmse_theta_deg[0]:.3f}/{rmse_theta_deg[1]:.3f} deg')

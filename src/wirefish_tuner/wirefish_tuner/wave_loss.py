@@ -47,7 +47,8 @@ from wirefish_kinematics.desired_wave import (desired_lateral_position,
                                               desired_swing_angles as wave_swing_angles,
                                               WAVE_TIME_SIGN)
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_kinematics.wave_spec import WaveSpec  # the one wave type (eq 23)
+# The one wave type (eq 23), also this module's: callers name it with the loss it defines.
+from wirefish_kinematics.wave_spec import WaveSpec as WaveSpec
 from wirefish_kinematics.wire_coupling import bend_angles
 
 PARAMETER_NAMES = ('w12', 'w21', 'phi12', 'phi21', 'amplitude_1', 'amplitude_2')
@@ -183,7 +184,8 @@ def waveform_loss(angles: np.ndarray, problem: WaveFitProblem,
     desired = problem.desired() if desired is None else desired
     error = np.abs(desired[None] - lateral_positions(angles, problem)).sum(axis=-1)
     period = 1.0 / problem.wave.frequency_hz
-    return error.mean(axis=-1) * period * problem.window_periods
+    loss: np.ndarray = error.mean(axis=-1) * period * problem.window_periods
+    return loss
 
 
 def body_wave_loss(positions: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
@@ -220,7 +222,8 @@ def desired_swing_angles(problem: WaveFitProblem, theta_bar: str = ThetaBar.AXIA
                         axis=-1)
     if theta_bar == ThetaBar.CHORD:
         ratio = problem.desired(times) / problem.stations()[None, :]
-        return np.arcsin(np.clip(ratio, -1.0, 1.0))
+        chord: np.ndarray = np.arcsin(np.clip(ratio, -1.0, 1.0))
+        return chord
     raise ValueError(f'theta_bar must be one of {tuple(d.value for d in ThetaBar)}, '
                      f'got {theta_bar!r}')
 
@@ -236,7 +239,8 @@ def waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem,
                             theta_bar: str = ThetaBar.AXIAL) -> np.ndarray:
     """Return the swing-angle RMSE (P, 2) degrees of servo angles (P, N, 2) (section 5.2)."""
     error = _swing_angles_of(angles, problem) - desired_swing_angles(problem, theta_bar)[None]
-    return np.degrees(np.sqrt(np.mean(error ** 2, axis=-2)))
+    rmse: np.ndarray = np.degrees(np.sqrt(np.mean(error ** 2, axis=-2)))
+    return rmse
 
 
 def _swing_angles_of(angles: np.ndarray, problem: WaveFitProblem) -> np.ndarray:
@@ -290,13 +294,15 @@ def literal_waveform_swing_rmse_deg(angles: np.ndarray, problem: WaveFitProblem,
     expected = desired_swing_angles(problem, theta_bar, times)
     error = _swing_angles_of(angles, problem) - expected[None]
     mean_square = _trapezoid(np.moveaxis(error ** 2, -2, -1), times) / (times[-1] - times[0])
-    return np.degrees(np.sqrt(mean_square))
+    rmse: np.ndarray = np.degrees(np.sqrt(mean_square))
+    return rmse
 
 
 def _trapezoid(values: np.ndarray, times: np.ndarray) -> np.ndarray:
     """Return the trapezoid rule over the last axis of ``values`` sampled at ``times``."""
     step = np.diff(times)
-    return np.sum(0.5 * (values[..., 1:] + values[..., :-1]) * step, axis=-1)
+    integral: np.ndarray = np.sum(0.5 * (values[..., 1:] + values[..., :-1]) * step, axis=-1)
+    return integral
 
 
 def check_mode(mode: str) -> FitMode:
