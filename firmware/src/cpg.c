@@ -106,7 +106,9 @@ void wf_cpg_step(wf_cpg_t *cpg)
     const wf_cpg_params_t *p = &cpg->params;
     const float delta0 =
         (cpg->phase_hi[1] - cpg->phase_hi[0]) + (cpg->phase_lo[1] - cpg->phase_lo[0]);
-    float c[4][2], kr[4][2], kdr[4][2], kb[4][2], kdb[4][2];
+    /* Each stage's rates, and their RK4 sums k1 + 2 k2 + 2 k3 + k4 (summed in that order). */
+    float c[2], ddr[2], ddb[2];
+    float sum_c[2] = {0}, sum_r[2] = {0}, sum_dr[2] = {0}, sum_b[2] = {0}, sum_db[2] = {0};
     float r[2], dr[2], b[2], db[2];
     float delta = delta0;
     memcpy(r, cpg->r, sizeof r);
@@ -114,33 +116,38 @@ void wf_cpg_step(wf_cpg_t *cpg)
     memcpy(b, cpg->b, sizeof b);
     memcpy(db, cpg->db, sizeof db);
     static const float weight[3] = {WF_CPG_STEP_S * 0.5f, WF_CPG_STEP_S * 0.5f, WF_CPG_STEP_S};
+    static const float multiple[4] = {1.0f, 2.0f, 2.0f, 1.0f};
     for (unsigned k = 0; k < 4; k++) {
-        coupling(p, delta, r, c[k]);
-        memcpy(kr[k], dr, sizeof dr);
-        memcpy(kb[k], db, sizeof db);
-        damped(p, r, dr, b, db, kdr[k], kdb[k]);
+        coupling(p, delta, r, c);
+        damped(p, r, dr, b, db, ddr, ddb);
+        for (unsigned i = 0; i < 2; i++) {
+            sum_c[i] += multiple[k] * c[i];
+            sum_r[i] += multiple[k] * dr[i];
+            sum_dr[i] += multiple[k] * ddr[i];
+            sum_b[i] += multiple[k] * db[i];
+            sum_db[i] += multiple[k] * ddb[i];
+        }
         if (k == 3) {
             break;
         }
         /* The next stage's state: the step's start plus weight * this stage's rates (the
          * free-running 2 pi v of both phases cancels in their difference). */
         const float w = weight[k];
-        delta = delta0 + w * (c[k][1] - c[k][0]);
+        delta = delta0 + w * (c[1] - c[0]);
         for (unsigned i = 0; i < 2; i++) {
-            r[i] = cpg->r[i] + w * kr[k][i];
-            dr[i] = cpg->dr[i] + w * kdr[k][i];
-            b[i] = cpg->b[i] + w * kb[k][i];
-            db[i] = cpg->db[i] + w * kdb[k][i];
+            const float rate_r = dr[i], rate_b = db[i];
+            r[i] = cpg->r[i] + w * rate_r;
+            dr[i] = cpg->dr[i] + w * ddr[i];
+            b[i] = cpg->b[i] + w * rate_b;
+            db[i] = cpg->db[i] + w * ddb[i];
         }
     }
     for (unsigned i = 0; i < 2; i++) {
-        const float phase_rest =
-            cpg->omega_h_lo + SIXTH_H * (c[0][i] + 2.0f * c[1][i] + 2.0f * c[2][i] + c[3][i]);
-        add_to_phase(cpg, i, phase_rest);
-        cpg->r[i] += SIXTH_H * (kr[0][i] + 2.0f * kr[1][i] + 2.0f * kr[2][i] + kr[3][i]);
-        cpg->dr[i] += SIXTH_H * (kdr[0][i] + 2.0f * kdr[1][i] + 2.0f * kdr[2][i] + kdr[3][i]);
-        cpg->b[i] += SIXTH_H * (kb[0][i] + 2.0f * kb[1][i] + 2.0f * kb[2][i] + kb[3][i]);
-        cpg->db[i] += SIXTH_H * (kdb[0][i] + 2.0f * kdb[1][i] + 2.0f * kdb[2][i] + kdb[3][i]);
+        add_to_phase(cpg, i, cpg->omega_h_lo + SIXTH_H * sum_c[i]);
+        cpg->r[i] += SIXTH_H * sum_r[i];
+        cpg->dr[i] += SIXTH_H * sum_dr[i];
+        cpg->b[i] += SIXTH_H * sum_b[i];
+        cpg->db[i] += SIXTH_H * sum_db[i];
     }
     cpg->steps++;
 }
