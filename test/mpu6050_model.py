@@ -19,7 +19,8 @@ The faults the firmware must survive, modelled at the level it sees them:
   master in the middle of a read leaves it: it drives SDA with the byte's bits, one per SCL
   clock, until the byte and its ACK slot are clocked out and it sees a NACK (SDA released);
   ``sda_shorted`` holds SDA low from outside (a short, a part that never lets go). While SDA
-  or SCL is low no transaction starts (None: the master's START fails). ``line`` answers the
+  or SCL is low no transaction starts (None: the master's START fails); a START on a free
+  bus ends whatever byte the part was sending. ``line`` answers the
   host port's open-drain line operations (wf_host.h) for the bus recovery, and counts the SCL
   pulses it was given.
 """
@@ -154,8 +155,9 @@ class Mpu6050Model:
 
     def transfer(self, address: int, tx: bytes, rx_len: int) -> bytes | None:
         """Do one I2C transaction: write ``tx``, then read ``rx_len``; None is a NACK."""
-        if not self.bus_idle():
+        if not (self.master_scl and self.sda_level()):
             return None  # a held line: the master cannot even send its START
+        self.sending = None  # a START ends whatever the part was in the middle of
         if address != ADDRESS or not tx:
             return None
         self.transfers += 1
