@@ -31,7 +31,28 @@ REFUSED = {
                               'an empty namespace'),
     'report missing': (['report', '/nonexistent'], 2, '/nonexistent does not exist'),
     'bag reindex missing': (['bag', 'reindex', '/nonexistent'], 2, 'does not exist'),
+    'mission circle': (['mission', 'circle'], 2, 'shipped: square'),
+    'gaits list --library missing': (['gaits', 'list', '--library', '/nonexistent.yaml'], 1,
+                                     'no gait library at /nonexistent.yaml: the file does not '
+                                     'exist'),
 }
+# A misspelled option: the verb's own usage (not the top-level one), and the closest option.
+MISSPELLED = {
+    'drive --namesapce': (['drive', '--namesapce', '/x'], 'usage: wirefish drive',
+                          '(did you mean --namespace?)'),
+    'record --durration': (['record', '--durration', '5'], 'usage: wirefish record',
+                           '(did you mean --duration?)'),
+}
+
+
+@pytest.mark.parametrize('args, usage, hint', MISSPELLED.values(), ids=MISSPELLED.keys())
+def test_a_misspelled_option_prints_the_verbs_usage_and_the_closest(tmp_path, args, usage,
+                                                                    hint):
+    result = subprocess.run([*CLI, *args], cwd=tmp_path, capture_output=True, text=True,
+                            timeout=60, stdin=subprocess.DEVNULL)
+    assert result.returncode == 2
+    assert result.stderr.startswith(usage), result.stderr
+    assert result.stderr.rstrip().endswith(hint), result.stderr
 
 
 def _one_line_refusal(result: subprocess.CompletedProcess, code: int, says: str) -> None:

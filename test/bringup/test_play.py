@@ -73,6 +73,7 @@ def test_play_publishes_every_message_in_order_with_its_qos(ros_context, ros_env
                                 timeout=120)
         assert result.returncode == 0, result.stderr
         assert f'played {COUNT + 1} messages of 2 topics' in result.stdout
+        assert 'deprecated' not in result.stderr, result.stderr  # rcl read no --remap of ours
         deadline = time.monotonic() + 10.0
         while len(heard) < COUNT and time.monotonic() < deadline:
             time.sleep(0.1)

@@ -136,7 +136,9 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
     if not wanted:
         print(f'wirefish play: none of {args.topics} is in {args.bag}', file=sys.stderr)
         return 2
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    # Not sys.argv: rcl would read play's own --remap FROM:=TO as a deprecated ROS remap rule
+    # (and warn); ROS arguments reach it after --ros-args only, and play takes none.
+    rclpy.init(args=sys.argv[:1], signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node('wirefish_play', start_parameter_services=False)
     try:
         publishers = {}

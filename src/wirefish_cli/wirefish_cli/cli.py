@@ -8,6 +8,7 @@ packages (``wirefish_cli.api.verbs``): a fish computer has `up`, a shore compute
 
 import argparse
 import ast
+import difflib
 import importlib
 import importlib.util
 from pathlib import Path
@@ -44,6 +45,7 @@ def build_parser(argv: list[str]) -> argparse.ArgumentParser:
             sub = commands.add_parser(name, help=help_text, description=help_text)
             module.add_arguments(sub)
             sub.set_defaults(run=module.run)
+            parser.set_defaults(verb_parser=sub)
         else:
             commands.add_parser(name, help=_help_of(module_name))
     return parser
@@ -53,8 +55,19 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the `wirefish` executable."""
     # ros2 run passes the ROS arguments through: they are not ours.
     argv = without_ros_args(sys.argv[1:] if argv is None else argv)
-    args = build_parser(argv).parse_args(argv)
+    parser = build_parser(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # the verb's own usage and the option it has closest to what was typed
+        unknown_option(getattr(args, 'verb_parser', parser), extra)
     return run_verb(args.run, args, f'wirefish {args.command}')
+
+
+def unknown_option(parser: argparse.ArgumentParser, extra: list[str]) -> None:
+    """Exit through ``parser``'s error: its usage, the words it does not know, the closest."""
+    known = [option for action in parser._actions for option in action.option_strings]
+    close = difflib.get_close_matches(extra[0], known, n=1) if extra[0].startswith('-') else []
+    hint = f' (did you mean {close[0]}?)' if close else ''
+    parser.error(f'unrecognized arguments: {" ".join(extra)}{hint}')
 
 
 if __name__ == '__main__':

@@ -24,7 +24,7 @@ from wirefish_bringup.dds_profile import graph_environment, write_profile
 from wirefish_bringup.graph import (DEFAULT_NAMESPACE, fish_graph, NodeSpec, Role,
                                     validate_namespace)
 from wirefish_cli.api import duration_s
-from wirefish_common.input_checks import params_file_problem, serial_port_problem
+from wirefish_common.input_checks import params_file_problem, parse_speed, serial_port_problem
 from wirefish_common.progress import duration_text, Progress
 from wirefish_launcher.errors import QemuBoardError
 from wirefish_launcher.status_view import LiveStatus, TerminalBlock
@@ -70,6 +70,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='sim: the virtual fish (as --sim); qemu: the firmware on an '
                         'emulated STM32F405 (QEMU; built with make -C firmware qemu), the bridge '
                         'on its pty (no physics: no sim/ground_truth)')
+    parser.add_argument('--speed', type=speed_option, default=None, metavar='X',
+                        help='the virtual fish owns the clock: every node on simulated time '
+                        "(/clock, use_sim_time), stepped in lockstep with the CPG's commands "
+                        'at X times real time: 1 (default) is real time when the machine keeps '
+                        'up, max as fast as the graph answers; the live status shows the '
+                        'real-time factor. Only with the virtual fish on one host: a real '
+                        'fish, the emulated board and a radio run on the wall clock')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
                         help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
     parser.add_argument('--role', choices=[role.value for role in Role],
@@ -123,6 +130,21 @@ def port_number(text: str) -> int:
     if not 1 <= value <= 65535:
         raise argparse.ArgumentTypeError(f'a port is 1..65535, got {value}')
     return value
+
+
+def speed_option(text: str) -> str:
+    """Return a --speed option as given (``1``, ``4``, ``max``) once it is valid (argparse)."""
+    try:
+        parse_speed(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+    return text.strip().lower()
+
+
+# The pace of the simulated-time road when `wirefish up --sim` is given no --speed: real time, so
+# what a user watches, drives or records keeps the pace of the world; a loaded machine slows
+# it down instead of changing it (`max` is for experiments: wirefish sweep, the benchmarks).
+DEFAULT_SPEED = '1'
 
 
 def fleet_size(text: str) -> int:
@@ -211,9 +233,10 @@ def _wait_ready(node, executor, namespace: str, specs: list[NodeSpec], superviso
 def _effective_params(args: argparse.Namespace, run_dir: Path
                       ) -> tuple[Path, dict, dict]:
     """
-    Write the run's parameter file: the defaults, the user's file and the options on top.
+    Return the run's parameter file: the defaults, the user's file and the options on top.
 
-    Returns (its path, the user's file as read, the merged content). The user's file overrides
+    Returns (its path, the user's file as read, the merged content): ``_write_params`` writes
+    it once the inputs are judged. The user's file overrides
     only what it names (``params_overlay``); the options --start-swimming, --view-port,
     --view-http-port and --baud are values on top of both.
     """
@@ -239,11 +262,16 @@ def _effective_params(args: argparse.Namespace, run_dir: Path
     if args.baud is not None:
         put('/**/bridge_node', 'baudrate', args.baud)
     merged = overlaid(overlaid(defaults, user), options)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    path = run_dir / 'params.yaml'
+    return run_dir / 'params.yaml', user, merged
+
+
+def _write_params(path: Path, merged: dict) -> None:
+    """Write the run's parameter file (once every input is judged: bad input writes nothing)."""
+    import yaml
+
+    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text('# wirefish up: the installed defaults, --params-file and the options on '
                     'top\n' + yaml.safe_dump(merged, sort_keys=False), encoding='utf-8')
-    return path, user, merged
 
 
 def _view_ports_problem(params: dict, namespace: str) -> str | None:
@@ -346,6 +374,13 @@ def _run(args: argparse.Namespace) -> int:
             if qemu:
                 from wirefish_launcher.qemu_board import build_image
                 build_image()
+        if sim and args.role == Role.ALL:
+            from wirefish_bringup.graph import on_simulated_time
+            specs = on_simulated_time(specs, args.speed or DEFAULT_SPEED)
+        elif args.speed is not None:
+            raise ValueError("--speed sets the virtual fish's simulated time: a real fish "
+                             '(--port), the emulated board (--fish qemu) and two hosts (--role) '
+                             'run on the wall clock')
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2
@@ -362,6 +397,7 @@ def _run(args: argparse.Namespace) -> int:
                                                 for name in _node_names(spec, namespace)]):
         print(f'wirefish up: warning: --params-file {args.params_file}: {warning}',
               file=sys.stderr)
+    _write_params(params_file, merged_params)
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)

@@ -16,6 +16,7 @@ import codecs
 from dataclasses import dataclass
 import math
 import os
+import shutil
 import sys
 import time
 
@@ -118,12 +119,28 @@ def state_line(speed: float, turn: float, state, waited_s: float = 0.0,
         return f'{sent} | no planner_state yet'
     heading = '' if math.isnan(state.heading_target) else \
         f' hold {math.degrees(state.heading_target):+.0f} deg'
-    line = (f'{sent} | {state.mode:<9} {state.predicted_speed:.2f} m/s '
-            f'{state.tail_beat_hz:.2f} Hz x{state.amplitude_scale:.2f} | yaw rate '
-            f'{state.yaw_rate_target:+.2f}/{state.yaw_rate_measured:+.2f} b {state.offset:+.3f}'
-            f'{heading}')
+    line = (f'{sent} | {state.mode:<9} {state.predicted_speed:.2f} m/s at '
+            f'{state.tail_beat_hz:.2f} Hz, amplitude x{state.amplitude_scale:.2f} | yaw rate '
+            f'{state.yaw_rate_target:+.2f}/{state.yaw_rate_measured:+.2f} rad/s (asked/'
+            f'measured), offset {state.offset:+.3f} rad{heading}')
     reason = state.clamp_reason or state.note
     return f'{line} | {reason}' if reason else line
+
+
+def screen_lines(line: str, reason_shown: str, columns: int) -> tuple[str, str]:
+    """
+    Return (what to write, the reason now shown) for one redraw of the status line.
+
+    The line is cut to the terminal's ``columns``; the planner's reason (its part after the
+    last ' | ', a clamp or a note) is printed whole on a line of its own whenever it changes,
+    above the status line, so no width cuts it.
+    """
+    reason = ''
+    head, _, tail = line.rpartition(' | ')
+    if head and not tail.startswith(('yaw rate', 'no planner_state')):
+        reason = tail
+    above = (f'\r\x1b[K  planner: {reason}\n' if reason and reason != reason_shown else '')
+    return above + '\r\x1b[K' + line[:max(20, columns - 1)], reason
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -168,6 +185,7 @@ def run(args: argparse.Namespace) -> int:
     speed, turn = 0.0, 0.0
     print(__doc__.strip().split('\n\n')[1].replace('\n', ' '))
     started = time.monotonic()
+    reason_shown = ''
     try:
         tty.setcbreak(fd)
         while link.ok():
@@ -183,7 +201,9 @@ def run(args: argparse.Namespace) -> int:
             link.send(speed, turn)
             waited = time.monotonic() - started
             line = state_line(speed, turn, link.state, waited, namespace)
-            sys.stdout.write('\r\x1b[K' + line[:160])
+            text, reason_shown = screen_lines(line, reason_shown,
+                                              shutil.get_terminal_size().columns)
+            sys.stdout.write(text)
             sys.stdout.flush()
     except KeyboardInterrupt:
         pass

@@ -137,11 +137,21 @@ def reference_of(args: argparse.Namespace):
     return WaveSpec(args.c1, args.c2, args.k, 1.0)
 
 
+def missing_library_text(path: Path) -> str:
+    """Return the line of a gait library file that does not exist."""
+    return (f'no gait library at {path}: the file does not exist (`wirefish gaits build` or '
+            'a `wirefish retune` makes it; --library names another)')
+
+
 def list_gaits(args: argparse.Namespace) -> int:
     """Print every gait of the library, with its scale of the reference and eq 18 speed."""
     from wirefish_cpg.gait_family import scale_of
-    from wirefish_cpg.gait_library import load_library
+    from wirefish_cpg.gait_library import default_library_path, load_library
 
+    if not args.library.exists():
+        given = args.library != default_library_path()
+        print(f'wirefish gaits: {missing_library_text(args.library)}', file=sys.stderr)
+        return 1 if given else 0
     try:
         library = load_library(args.library)
     except (OSError, ValueError) as error:
@@ -170,6 +180,9 @@ def plot(args: argparse.Namespace) -> int:
     from wirefish_cpg.gait_library import load_library
     from wirefish_tuner.retune_core import RetuneSettings
 
+    if not args.library.exists():
+        print(f'wirefish gaits: {missing_library_text(args.library)}', file=sys.stderr)
+        return 1
     try:
         library = load_library(args.library)
     except (OSError, ValueError) as error:

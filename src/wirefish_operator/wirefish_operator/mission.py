@@ -49,10 +49,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def mission_path(text: str) -> Path:
-    """Return the YAML of ``text``: a file, or a shipped mission's name."""
+    """
+    Return the YAML of ``text``: a file, or a shipped mission's name.
+
+    Raises ValueError when it is neither, naming the shipped missions.
+    """
     path = Path(text)
-    if path.exists() or text not in SHIPPED:
+    if path.exists():
         return path
+    if text not in SHIPPED:
+        raise ValueError(f'no mission {text!r}: neither a file nor a shipped mission '
+                         f'(shipped: {", ".join(SHIPPED)}; or give a mission YAML file)')
     from ament_index_python.packages import get_package_share_directory
     return Path(get_package_share_directory('wirefish_operator'), 'missions', f'{text}.yaml')
 
@@ -88,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
         end_line()
         print(f'wirefish mission: {problem}', file=sys.stderr)
         return INTERRUPTED if interrupted else 1
+    end_line()  # the legs' bar may stop short of its end: the summary starts a line of its own
     return _report(mission, namespace, bag_path, out, t0 or 0.0, turn_gain)
 
 

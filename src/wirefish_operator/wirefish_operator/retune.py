@@ -64,6 +64,12 @@ def progress_line(iteration: int, best_loss: float, total: int, estimate: str = 
             + (f'  {estimate}' if estimate else ''))
 
 
+def bar_redraw(line: str) -> str:
+    """Return what redraws the terminal's line as ``line``: back, clear to its end, ``line``."""
+    # Without the clear, a shorter line keeps the longer one's tail ('done in 0 s' + 'ft').
+    return '\r\x1b[K' + line
+
+
 def feedback_line(iteration: int, best_loss: float, total: int, rmse,
                   estimate: str = '') -> str:
     """Return one plain line for one feedback message (when stderr is not a terminal)."""
@@ -150,8 +156,8 @@ def run(args: argparse.Namespace) -> int:
         estimate = estimate_text(f.iteration - first_iteration, f.max_iterations - first_iteration,
                                  time.monotonic() - first_at)
         if terminal:
-            print('\r' + progress_line(f.iteration, f.best_loss, f.max_iterations, estimate),
-                  end='', file=sys.stderr, flush=True)
+            print(bar_redraw(progress_line(f.iteration, f.best_loss, f.max_iterations,
+                                           estimate)), end='', file=sys.stderr, flush=True)
             seen.drawn = True
         else:
             print(feedback_line(f.iteration, f.best_loss, f.max_iterations, f.rmse_theta_deg,
