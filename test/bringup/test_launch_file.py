@@ -194,3 +194,9 @@ def test_every_node_starts_with_its_stop_signals_held(monkeypatch, overrides):
     nodes = launched_nodes(monkeypatch, **overrides)
     assert nodes and {node['prefix'] for node in nodes} == {held_start_prefix()}
     assert held_start_prefix() is not None
+
+
+def test_a_real_fish_without_a_port_names_the_launch_argument(monkeypatch):
+    with pytest.raises(ValueError, match=r'port:=/dev/ttyUSB0') as refused:
+        launched_nodes(monkeypatch, sim='false')
+    assert '--port' not in str(refused.value)

@@ -47,6 +47,9 @@ def _nodes(context):
     # A Ctrl-C while a node's interpreter starts waits for the node's own handler (every
     # registry executable unblocks the stop signals once it is in place), not a trace.
     prefix = held_start_prefix()
+    if not sim and not port:  # fish_graph's own words name wirefish up's --port
+        raise ValueError('sim:=false drives a real fish: give its serial port, e.g. '
+                         'port:=/dev/ttyUSB0')
     for spec in fish_graph(namespace, sim=sim, port=port, params_file=params_file, role=role,
                            frame_prefix=frame_prefix):
         # The recorder (the only entry that parses its own options) runs with --duration
