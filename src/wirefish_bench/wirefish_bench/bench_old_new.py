@@ -48,7 +48,7 @@ def _workspace() -> Path:
     return Path(__file__).resolve().parents[3]
 
 
-def _old_package(commit: str, package: str, into: Path) -> str:
+def old_package(commit: str, package: str, into: Path) -> str:
     """Extract ``src/<package>/<package>`` at ``commit`` into ``into``; return its path entry."""
     path = f'src/{package}/{package}'
     archive = subprocess.run(['git', '-C', str(_workspace()), 'archive', commit, path],
@@ -70,7 +70,7 @@ def _alternated(commit: str, package: str, repeats: int,
     runs: dict[str, list[dict]] = {'old': [], 'new': []}
     saved = os.environ.get('PYTHONPATH', '')
     with tempfile.TemporaryDirectory(prefix=f'wirefish_bench_{package}_') as tmp:
-        old = _old_package(commit, package, Path(tmp))
+        old = old_package(commit, package, Path(tmp))
         try:
             for _ in range(repeats):
                 for which in ('old', 'new'):
@@ -125,7 +125,7 @@ def _cpu_s(pids: list[int]) -> float:
 def simulators() -> dict:
     """Return the CPU of 8 old fish_sim processes and of one new fish_sim of 8 fish at once."""
     with tempfile.TemporaryDirectory(prefix='wirefish_bench_sim_') as tmp:
-        old_env = _with_path(_old_package(SIM_COMMIT, 'wirefish_sim', Path(tmp)))
+        old_env = _with_path(old_package(SIM_COMMIT, 'wirefish_sim', Path(tmp)))
 
         def start(links: list[str], env: dict) -> subprocess.Popen:
             args = [a for link in links for a in ('--link', link)]

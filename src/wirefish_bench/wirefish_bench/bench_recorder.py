@@ -30,7 +30,7 @@ from typing import Any
 # The last commit with the hand-written encoder (mcap_records, mcap_writer).
 OLD_COMMIT = '3f49806d7555d7fb28b1c37dc11ec565136f5ede'
 OLD_COMMAND = 'wirefish_bringup.cli'  # the `wirefish` command of that commit
-PACKAGE = 'src/wirefish_bringup/wirefish_bringup'
+OLD_PACKAGE = 'wirefish_bringup'  # where the recorder was at OLD_COMMIT
 NAMESPACE = '/bench_recorder'
 WARM_UP_S = 10.0  # graph started, every topic discovered and subscribed by both recorders
 WINDOW_S = 30.0
@@ -40,17 +40,11 @@ WRITER_FLUSH_EVERY = 200
 MODULE = 'wirefish_bench.bench_recorder'
 
 
-def _workspace() -> Path:
-    from wirefish_bench.bench import WORKSPACE
-    return WORKSPACE
-
-
-def _old_package(into: Path) -> Path:
+def _old_package(into: Path) -> str:
     """Extract the old recorder's package from git into ``into``; return its PYTHONPATH entry."""
-    archive = subprocess.run(['git', '-C', str(_workspace()), 'archive', OLD_COMMIT, PACKAGE],
-                             capture_output=True, check=True).stdout
-    subprocess.run(['tar', '-x', '-C', str(into)], input=archive, check=True)
-    return into / 'src' / 'wirefish_bringup'
+    from wirefish_bench.bench_old_new import old_package  # rclpy: not in the writer probes
+
+    return old_package(OLD_COMMIT, OLD_PACKAGE, into)
 
 
 def _cpu_s(pid: int) -> float:
@@ -220,8 +214,8 @@ def row(result: dict) -> tuple[str, str, str, str, str]:
     met = rec['ratio'] <= GOAL_RATIO and new['missing'] == 0
     return (figure, goal, measured, 'met' if met else 'missed',
             f'both recorders on one wirefish up --sim graph at once, psutil CPU over '
-            f'{rec["window_s"]:g} s after {WARM_UP_S:g} s; old = {PACKAGE} at '
-            f'{OLD_COMMIT[:7]} from git (bench_recorder.py)')
+            f'{rec["window_s"]:g} s after {WARM_UP_S:g} s; old = '
+            f'src/{OLD_PACKAGE}/{OLD_PACKAGE} at {OLD_COMMIT[:7]} from git (bench_recorder.py)')
 
 
 def main(argv: list[str] | None = None) -> int:
