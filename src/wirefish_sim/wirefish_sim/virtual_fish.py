@@ -6,19 +6,35 @@ inertia (``fish_dynamics``): the speed ripple and the time constant follow from 
 
 No ROS and no real time: ``step(dt)`` advances simulated time, so tests run the physics faster
 than real time; ``fish_sim`` drives it from the wall clock over a pseudo-terminal. The firmware
-part decodes frames (``receive``), commands neutral when servo commands or host heartbeats stop,
-and emits telemetry (100 Hz) and heartbeats as encoded frames (``take_output``).
+part speaks protocol version 2 (PROTOCOL.md) by the rules of the board's C core
+(firmware/src/app.c), held equal by test/firmware/test_fw_virtual_fish_parity.py: it decodes
+frames (``receive``); in stream mode it drives the servos to each SERVO_CMD and slews them to
+neutral at a bounded rate when commands or host heartbeats stop; in gait mode (an accepted
+GAIT) it integrates eq 1 itself with ``wirefish_cpg.oscillator.CpgIntegrator`` (RK4, 1 ms
+steps of its clock), coasts when the link is lost and comes to rest after the coast; it
+answers GAIT and LINK_CONFIG with ACKs and emits telemetry (full or compact), heartbeats and
+HEALTH as encoded frames (``take_output``).
+
+Clocks: a frame received at time t acts on the physics step that starts at t (its rules run
+at t, as the board's poll at the end of that millisecond runs them); what the step emits is
+stamped with the time at its end.
 """
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+import enum
+import math
 
 import numpy as np
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, PROTOCOL_VERSION, Role,
-                                      ServoCommand, Status, Telemetry)
+from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
+                                      Heartbeat, LinkConfig, MsgType, PROTOCOL_VERSION,
+                                      ResetCause, Role, ServoCommand, Status, Telemetry,
+                                      TelemetryCompact, TelemetryForm)
+from wirefish_cpg.oscillator import at_rest, CpgIntegrator, CpgParameters
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust, reactive_state,
                                            tail_tip_lateral_positions)
@@ -51,9 +67,32 @@ _FAILSAFE_HEARTBEAT = int(Status.FAILSAFE_HEARTBEAT)
 _VERSION_MISMATCH = int(Status.VERSION_MISMATCH)
 _SERVO_CLAMPED = int(Status.SERVO_CLAMPED)
 _LOW_BATTERY = int(Status.LOW_BATTERY)
+_COASTING = int(Status.COASTING)
+_RESTING = int(Status.RESTING)
+_GAIT_MODE = int(Status.GAIT_MODE)
 _NEUTRAL_FLAGS = _FAILSAFE_COMMAND | _FAILSAFE_HEARTBEAT | _VERSION_MISMATCH
 # The flags the failsafe check leaves as they are (it sets every other one anew).
-_KEPT_FLAGS = 0xFFFF & ~(_NEUTRAL_FLAGS | _SERVO_CLAMPED | _LOW_BATTERY)
+_KEPT_FLAGS = 0xFFFF & ~(_NEUTRAL_FLAGS | _SERVO_CLAMPED | _LOW_BATTERY | _COASTING | _RESTING
+                         | _GAIT_MODE)
+# ACKs wait in a queue of this many and leave one per millisecond, oldest first; a GAIT or
+# LINK_CONFIG that finds it full gets none (the host resends). The board's rule (app.c).
+ACK_QUEUE = 4
+
+
+class Gap(enum.IntEnum):
+    """Where gait mode is with the link: swimming, coasting (link lost), resting (past coast)."""
+
+    NONE = 0
+    COASTING = 1
+    RESTING = 2
+
+
+def _cpg_parameters(gait: Gait) -> CpgParameters:
+    """Return the CPG parameters (eq 1) that a GAIT carries."""
+    return CpgParameters(frequency_hz=gait.frequency_hz,
+                         amplitude=(gait.amplitude_1, gait.amplitude_2),
+                         offset=(gait.offset_1, gait.offset_2), w12=gait.w12, w21=gait.w21,
+                         phi12=gait.phi12, phi21=gait.phi21, alpha=gait.alpha)
 
 
 @dataclass(frozen=True)
@@ -78,8 +117,11 @@ class SimConfig:
 
     ``mass_kg`` (3.3 kg, section 2.1) and ``added_mass_kg`` (~0.27 kg, longitudinal) make the
     surge inertia with the tail's lateral momentum share (see ``fish_dynamics``).
-    ``command_timeout_s``/``heartbeat_timeout_s`` are the firmware's
-    failsafe timeouts (None: not checked, for physics runs without a host).
+    ``command_timeout_s``/``heartbeat_timeout_s`` are the firmware's stream-mode failsafe
+    timeouts (None: not checked, for physics runs without a host); ``failsafe_slew_rad_s`` the
+    rate at which its targets then move to neutral. ``telemetry_hz``, ``health_period_s`` (0:
+    only the boot report), ``link_timeout_s`` and ``coast_s`` are the link settings at boot
+    (LINK_CONFIG changes them; telemetry FULL at boot); ``cpg_step_s`` is the board CPG's step.
     """
 
     mass_kg: float = 3.3
@@ -91,6 +133,11 @@ class SimConfig:
     heartbeat_hz: float = 2.0
     command_timeout_s: float | None = 0.5
     heartbeat_timeout_s: float | None = 1.5
+    failsafe_slew_rad_s: float = 2.0
+    health_period_s: float = 2.0
+    link_timeout_s: float = 1.5
+    coast_s: float = 3.0
+    cpg_step_s: float = 0.001
     battery_full_v: float = 8.2
     battery_drain_v_per_s: float = 2e-4
     low_battery_v: float = 6.6
@@ -141,6 +188,23 @@ class VirtualFish:
         self._remainder = 0.0
         self._drops_reported = [0] * len(_DROP_REPORTS)
         self._drop_report_due_ms = [0] * len(_DROP_REPORTS)
+        # Link settings (LINK_CONFIG), gait mode and the ACK queue.
+        self._telemetry_period_s = 1.0 / c.telemetry_hz
+        self.telemetry_form = TelemetryForm.FULL
+        self._health_period_s = c.health_period_s
+        self._link_timeout_ms = round(c.link_timeout_s * 1e3)
+        self._coast_ms = round(c.coast_s * 1e3)
+        self._next_health = 0.0  # once right after boot, then every period from then
+        self._health_sent = False
+        self._reschedule = False  # a LINK_CONFIG's periods start at the next emission
+        self._acks: deque[Ack] = deque()
+        self.acks_dropped = 0
+        self.gait: Gait | None = None  # the last accepted GAIT (None in stream mode)
+        self.cpg: CpgIntegrator | None = None
+        self.gap = Gap.NONE
+        self._cpg_start_ms = 0
+        self._last_host_frame_time = 0.0
+        self._last_output_ms: int | None = None
         self._last_momentum: tuple[float, float] | None = None  # K1, K2 of the last step
         noise = c.imu_noise
         self._gyro_bias = self.rng.normal(0.0, noise.gyro_bias_rad_s, 3)
@@ -149,17 +213,26 @@ class VirtualFish:
     # --- firmware: input --------------------------------------------------------------------
     def receive(self, data: bytes) -> None:
         """Feed bytes from the host (any chunking); valid frames take effect now."""
+        self._advance_cpg()  # to now with the parameters in force until now
         for frame in self.decoder.feed(data):
             message = frame.message
-            if isinstance(message, Heartbeat) and message.role == Role.HOST:
+            if isinstance(message, Heartbeat):
+                if message.role != Role.HOST:
+                    continue  # our own heartbeat echoed back, or another fish: not a host
                 self._host_version_ok = message.version == PROTOCOL_VERSION
                 if not self._host_version_ok:
                     self._outbox.append(self.encoder.encode(
                         ErrorReport(ErrorCode.VERSION_MISMATCH, frame.seq)))
+                    self._leave_gait_mode()
                 self.heartbeat()
             elif isinstance(message, ServoCommand):
+                self._host_frame()
                 if self._host_version_ok:
                     self.command(message.servo_1, message.servo_2)
+            elif isinstance(message, Gait):
+                self._queue_ack(MsgType.GAIT, frame.seq, self.set_gait(message, frame.seq))
+            elif isinstance(message, LinkConfig):
+                self._queue_ack(MsgType.LINK_CONFIG, frame.seq, self.configure_link(message))
         stats, now_ms = self.decoder.stats, _whole_ms(self.state.time_s)
         for i, (code, counters) in enumerate(_DROP_REPORTS):
             count = sum(getattr(stats, name) for name in counters)
@@ -169,7 +242,9 @@ class VirtualFish:
                 self._outbox.append(self.encoder.encode(ErrorReport(code, 0)))
 
     def command(self, servo_1: float, servo_2: float) -> None:
-        """Register servo targets (rad) now, as a SERVO_CMD frame would."""
+        """Register servo targets (rad) now, as a SERVO_CMD frame would (stream mode)."""
+        self._host_frame()
+        self._leave_gait_mode()
         self.commands_received += 1
         self.last_command = (servo_1, servo_2)
         self._commanded = (servo_1, servo_2)
@@ -177,13 +252,120 @@ class VirtualFish:
 
     def heartbeat(self) -> None:
         """Register a host heartbeat, as a HEARTBEAT frame from the host would."""
+        self._host_frame()
         self._last_heartbeat_time = self.state.time_s
+
+    def set_gait(self, gait: Gait, seq: int = 0) -> int:
+        """
+        Apply a GAIT now as the board does; return the ACK's result (0 or an ErrorCode).
+
+        From stream mode the CPG starts from rest now; in gait mode only its targets change,
+        for the steps after now. A host of another version is refused (5), a gait out of range
+        too (6): nothing changes.
+        """
+        self._host_frame()
+        if not self._host_version_ok:
+            return ErrorCode.VERSION_MISMATCH
+        if gait.problem(self.config.servo.limit_rad) is not None:
+            return ErrorCode.COMMAND_OUT_OF_RANGE
+        params = _cpg_parameters(gait)
+        self._advance_cpg()
+        if self.cpg is None:
+            self._cpg_start_ms = _whole_ms(self.state.time_s)
+            self.cpg = CpgIntegrator(params, step_s=self.config.cpg_step_s)
+        else:
+            self.cpg.set_parameters(params)
+        self.gait = gait
+        return 0
+
+    def configure_link(self, config: LinkConfig) -> int:
+        """Apply a LINK_CONFIG now as the board does; return the ACK's result (0, 5 or 6)."""
+        self._host_frame()
+        if not self._host_version_ok:
+            return ErrorCode.VERSION_MISMATCH
+        if config.problem() is not None:
+            return ErrorCode.COMMAND_OUT_OF_RANGE
+        self._telemetry_period_s = config.telemetry_period_ms * 1e-3
+        self.telemetry_form = TelemetryForm(config.telemetry_form)
+        self._health_period_s = config.health_period_ms * 1e-3
+        self._link_timeout_ms = config.link_timeout_ms
+        self._coast_ms = config.coast_ms
+        self._reschedule = True
+        return 0
+
+    @property
+    def gait_id(self) -> int:
+        """Return the id of the gait the fish runs (0 in stream mode)."""
+        return self.gait.gait_id if self.gait is not None else 0
+
+    def _queue_ack(self, kind: MsgType, seq: int, result: int) -> None:
+        if len(self._acks) < ACK_QUEUE:
+            self._acks.append(Ack(kind, seq, int(result)))
+        else:
+            self.acks_dropped += 1
+
+    def _send_ack(self) -> None:
+        """Send the oldest waiting ACK; a refused GAIT's ERROR (its code and seq) just before."""
+        if not self._acks:
+            return
+        ack = self._acks.popleft()
+        if ack.acked_type == MsgType.GAIT and ack.result != 0:
+            self._outbox.append(self.encoder.encode(ErrorReport(ack.result, ack.acked_seq)))
+        self._outbox.append(self.encoder.encode(ack))
+
+    def _host_frame(self) -> None:
+        """Register a valid host frame now: the link is alive; a gap ends, the gait resumes."""
+        self._last_host_frame_time = self.state.time_s
+        if self.gap is not Gap.NONE:
+            if self.gap is Gap.RESTING and self.cpg is not None and self.gait is not None:
+                self._advance_cpg()
+                self.cpg.set_parameters(_cpg_parameters(self.gait))
+            self.gap = Gap.NONE
+
+    def _advance_cpg(self) -> None:
+        """Step the CPG (gait mode) to now: one RK4 step per millisecond since gait mode began."""
+        if self.cpg is not None:
+            self.cpg.advance((_whole_ms(self.state.time_s) - self._cpg_start_ms)
+                             * self.config.cpg_step_s)
+
+    def _leave_gait_mode(self) -> None:
+        self.gait, self.cpg, self.gap = None, None, Gap.NONE
 
     def _update_failsafe(self) -> None:
         # Plain ints: this runs every physics step of every fish (IntFlag arithmetic costs
         # several times more than the rest of the check).
         c, now = self.config, self.state.time_s
+        now_ms = _whole_ms(now)
         status = self.status & _KEPT_FLAGS
+        limit = c.servo.limit_rad
+        if self.cpg is not None:
+            # Stepped to now with the parameters in force until now; a gap's change of targets
+            # acts on the steps after now.
+            self._advance_cpg()
+            status |= _GAIT_MODE | self._update_gap(now)
+            wanted = self.cpg.output(self.cpg.time_s)[0]
+        else:
+            status |= self._stream_failsafe(now)
+            if status & _NEUTRAL_FLAGS:
+                # To neutral at a bounded slew from where the targets are, never a step; at
+                # most a second's worth per update (a long pause reaches neutral anyway).
+                elapsed_ms = now_ms - (self._last_output_ms if self._last_output_ms is not None
+                                       else now_ms)
+                step = c.failsafe_slew_rad_s * min(elapsed_ms, 1000) * 1e-3
+                wanted = tuple(t - min(max(t, -step), step) for t in self.target)
+            else:
+                wanted = self._commanded
+        if abs(wanted[0]) > limit or abs(wanted[1]) > limit:
+            status |= _SERVO_CLAMPED
+        self.target = (min(max(wanted[0], -limit), limit), min(max(wanted[1], -limit), limit))
+        self._last_output_ms = now_ms
+        if self.battery_voltage() < c.low_battery_v:
+            status |= _LOW_BATTERY
+        self.status = status
+
+    def _stream_failsafe(self, now: float) -> int:
+        """Return the stream mode's neutral flags of now."""
+        c, status = self.config, 0
         if c.command_timeout_s is not None and (
                 self._last_command_time is None
                 or _whole_ms(now - self._last_command_time) > c.command_timeout_s * 1e3):
@@ -194,13 +376,20 @@ class VirtualFish:
             status |= _FAILSAFE_HEARTBEAT
         if not self._host_version_ok:
             status |= _VERSION_MISMATCH
-        self.target = (0.0, 0.0) if status & _NEUTRAL_FLAGS else self._commanded
-        limit = c.servo.limit_rad
-        if abs(self.target[0]) > limit or abs(self.target[1]) > limit:
-            status |= _SERVO_CLAMPED
-        if self.battery_voltage() < c.low_battery_v:
-            status |= _LOW_BATTERY
-        self.status = status
+        return status
+
+    def _update_gap(self, now: float) -> int:
+        """Return gait mode's gap flags of now; past the coast the CPG's targets go to rest."""
+        silent_ms = _whole_ms(now - self._last_host_frame_time)
+        if silent_ms > self._link_timeout_ms + self._coast_ms:
+            if self.gap is not Gap.RESTING and self.cpg is not None:
+                self.cpg.set_parameters(at_rest(self.cpg.parameters))
+            self.gap = Gap.RESTING
+            return _RESTING
+        if silent_ms > self._link_timeout_ms:
+            self.gap = Gap.COASTING
+            return _COASTING
+        return 0
 
     # --- physics ----------------------------------------------------------------------------
     def step(self, dt: float) -> None:
@@ -227,13 +416,26 @@ class VirtualFish:
     # --- firmware: output -------------------------------------------------------------------
     def _emit_due(self, servo_angles: np.ndarray) -> None:
         now = self.state.time_s
+        if self._reschedule:  # LINK_CONFIG: the new periods count from its poll
+            self._reschedule = False
+            self._next_telemetry = now + self._telemetry_period_s
+            self._next_health = now + self._health_period_s if self._health_period_s else math.inf
+        self._send_ack()
         if now + 1e-9 >= self._next_telemetry:
-            self._next_telemetry += 1.0 / self.config.telemetry_hz
-            self._outbox.append(self.encoder.encode(self.telemetry(servo_angles)))
+            self._next_telemetry += self._telemetry_period_s
+            telemetry = self.telemetry(servo_angles)
+            self._outbox.append(self.encoder.encode(
+                TelemetryCompact.from_telemetry(telemetry)
+                if self.telemetry_form is TelemetryForm.COMPACT else telemetry))
         if now + 1e-9 >= self._next_heartbeat:
             self._next_heartbeat += 1.0 / self.config.heartbeat_hz
             self._outbox.append(self.encoder.encode(
                 Heartbeat(PROTOCOL_VERSION, Role.FISH, round(now * 1000.0))))
+        if now + 1e-9 >= self._next_health:
+            base = self._next_health if self._health_sent else now
+            self._next_health = base + self._health_period_s if self._health_period_s else math.inf
+            self._health_sent = True
+            self._outbox.append(self.encoder.encode(self.health()))
 
     def telemetry(self, servo_angles: np.ndarray | None = None) -> Telemetry:
         """Return the telemetry message of now: the IMU model applied to the ground truth."""
@@ -251,7 +453,24 @@ class VirtualFish:
                          yaw=wrap_angle(s.yaw + float(attitude[2])),
                          gyro=tuple(gyro.tolist()), accel=tuple(accel.tolist()),
                          servo_1=float(servo_angles[0]), servo_2=float(servo_angles[1]),
-                         battery_v=self.battery_voltage(), status=int(self.status))
+                         battery_v=self.battery_voltage(), status=int(self.status),
+                         gait_id=self.gait_id)
+
+    def health(self) -> Health:
+        """
+        Return the HEALTH of now: the virtual fish's honest values.
+
+        It started at power-on on an emulated clock, has no fault record, brown-out, clock
+        security or stack to report (0 of 0 bytes), no UART, I2C bus or IMU to fail; what it
+        has is its decoder's drops.
+        """
+        stats = self.decoder.stats
+        return Health(ResetCause.POWER_ON, ClockSource.EMULATED, 0,
+                      uptime_ms=round(self.state.time_s * 1000.0) & 0xFFFFFFFF,
+                      rx_crc=stats.crc_errors,
+                      rx_frame=stats.cobs_errors + stats.short_frames + stats.overflows,
+                      rx_unknown_type=stats.unknown_type, rx_length=stats.length_errors,
+                      rx_invalid=stats.invalid_payload)
 
     def take_output(self) -> list[bytes]:
         """Return and clear the encoded frames emitted since the last call, in order."""

@@ -1,0 +1,225 @@
+"""The virtual fish's firmware rules of protocol version 2 (no ROS, no pty, simulated time)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from wirefish_bridge.codec import FrameEncoder, StreamDecoder
+from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
+                                      Heartbeat, LinkConfig, MsgType, ResetCause, Role,
+                                      ServoCommand, Status, Telemetry, TelemetryCompact,
+                                      TelemetryForm)
+from wirefish_bridge.telemetry_limits import telemetry_problem
+from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
+from wirefish_sim.virtual_fish import Gap, ImuNoise, SimConfig, VirtualFish
+
+TABLE_1 = Gait(1, 1.0, 0.38, 0.47, 0.0, 0.0, -0.41, 0.64, 1.76, 1.06, 20.0)
+FAST = Gait(2, 2.5, 0.3, 0.5, 0.1, -0.1, -0.41, 0.64, 1.76, 1.06, 30.0)
+
+
+class Host:
+    """A host talking to one virtual fish, 1 ms at a time; keeps every frame the fish sent."""
+
+    def __init__(self, **config) -> None:
+        self.fish = VirtualFish(SimConfig(imu_noise=ImuNoise().scaled(0.0), **config))
+        self.encoder, self.decoder = FrameEncoder(), StreamDecoder()
+        self.frames: list[tuple[int, object]] = []   # (ms of emission, message)
+        self.targets: list[tuple[float, float]] = []
+        self.statuses: list[int] = []
+
+    def run(self, ms: int, *messages, every_ms: dict | None = None) -> list:
+        """Send ``messages`` now, then run ``ms`` milliseconds; return the frames emitted."""
+        seqs = []
+        data = b''
+        for message in messages:
+            seqs.append(self.encoder.next_seq)
+            data += self.encoder.encode(message)
+        start = len(self.frames)
+        for k in range(ms):
+            chunk = data if k == 0 else b''
+            for period, message in (every_ms or {}).items():
+                if k and k % period == 0:
+                    chunk += self.encoder.encode(message)
+            self.fish.receive(chunk)
+            self.fish.step(0.001)
+            now = round(self.fish.state.time_s * 1000)
+            self.frames += [(now, f.message) for f in self.decoder.feed(
+                b''.join(self.fish.take_output()))]
+            self.targets.append(self.fish.target)
+            self.statuses.append(self.fish.status)
+        self.last_seqs = seqs
+        return [m for _, m in self.frames[start:]]
+
+
+def of(frames, kind):
+    return [m for m in frames if isinstance(m, kind)]
+
+
+def test_a_gait_is_acked_and_run_as_wirefish_cpg_integrates_it():
+    host = Host()
+    host.run(5, Heartbeat())
+    out = host.run(2000, TABLE_1, every_ms={200: Heartbeat()})
+    assert of(out, Ack)[0] == Ack(MsgType.GAIT, host.last_seqs[0], 0)
+    telemetry = of(out, Telemetry)
+    assert all(t.gait_id == 1 and t.status & Status.GAIT_MODE for t in telemetry)
+    assert all(telemetry_problem(t) is None or 'servo' in telemetry_problem(t)
+               for t in telemetry)
+    # The same equations from rest, one RK4 step per ms from the GAIT's millisecond.
+    f32 = [float(np.float32(v)) for v in TABLE_1.to_wire()[1:]]  # as the GAIT carried them
+    cpg = CpgIntegrator(CpgParameters(f32[0], tuple(f32[1:3]), tuple(f32[3:5]), *f32[5:]))
+    expected = []
+    for k in range(2000):
+        cpg.advance(k * 1e-3)
+        expected.append(cpg.output(cpg.time_s)[0])
+    np.testing.assert_allclose(host.targets[5:], expected, atol=1e-12)
+    assert max(abs(a) for a, _ in host.targets[-1000:]) == pytest.approx(0.38, abs=0.02)
+
+
+def test_a_new_gait_changes_the_tail_without_a_step():
+    host = Host()
+    host.run(5, Heartbeat())
+    host.run(1500, TABLE_1, every_ms={200: Heartbeat()})
+    host.run(1500, FAST, every_ms={200: Heartbeat()})
+    steps = np.abs(np.diff(np.array(host.targets), axis=0))
+    # The output's rate is at most ~ 2 pi f (R + r_overshoot): 2 pi x 2.5 x 0.6 rad/s.
+    assert steps.max() < 2 * np.pi * 2.5 * 0.6 * 1e-3
+    assert host.fish.gait_id == 2 and host.fish.cpg.parameters.frequency_hz == 2.5
+
+
+@pytest.mark.parametrize('change', [{'gait_id': 0}, {'frequency_hz': 11.0},
+                                    {'amplitude_1': 1.6}, {'offset_2': -1.6}, {'alpha': 0.0}])
+def test_a_gait_out_of_range_gets_error_6_then_ack_6_and_changes_nothing(change):
+    host = Host()
+    host.run(5, Heartbeat())
+    out = host.run(5, dataclasses.replace(TABLE_1, **change))
+    seq = host.last_seqs[0]
+    refusal = [m for m in out if isinstance(m, (Ack, ErrorReport))]
+    assert refusal == [ErrorReport(ErrorCode.COMMAND_OUT_OF_RANGE, seq),
+                       Ack(MsgType.GAIT, seq, ErrorCode.COMMAND_OUT_OF_RANGE)]
+    assert host.fish.gait is None and not host.fish.status & Status.GAIT_MODE
+
+
+def test_a_servo_command_in_gait_mode_goes_back_to_stream_mode():
+    host = Host()
+    host.run(5, Heartbeat())
+    host.run(300, TABLE_1)
+    out = host.run(20, ServoCommand(0.2, -0.3))
+    telemetry = of(out, Telemetry)[-1]
+    assert (telemetry.gait_id, telemetry.status & Status.GAIT_MODE) == (0, 0)
+    assert host.fish.target == pytest.approx((0.2, -0.3), abs=1e-7)  # binary32 on the wire
+
+
+def test_a_gap_in_gait_mode_coasts_then_rests_without_a_step_and_the_gait_resumes():
+    host = Host(link_timeout_s=0.3, coast_s=0.5)
+    host.run(5, Heartbeat())
+    host.run(1000, TABLE_1, every_ms={100: Heartbeat()})
+    before = len(host.statuses)
+    host.run(2000)                         # the host falls silent
+    statuses = host.statuses[before:]
+    gap = [s & (Status.COASTING | Status.RESTING) for s in statuses]
+    # The last host frame came at 1000 ms minus one heartbeat period's remainder (900 ms).
+    first_coast = gap.index(Status.COASTING)
+    first_rest = gap.index(Status.RESTING)
+    assert first_rest - first_coast == 500
+    assert all(s & Status.GAIT_MODE for s in statuses)
+    targets = np.array(host.targets[before:])
+    assert np.abs(np.diff(targets, axis=0)).max() < 2 * np.pi * 1.0 * 0.5 * 1e-3
+    assert np.abs(targets[-200:]).max() < 0.01      # at rest: 1.5 s of alpha = 20 after coast
+    assert host.fish.gap is Gap.RESTING
+    out = host.run(1500, Heartbeat(), every_ms={100: Heartbeat()})
+    assert not of(out, Telemetry)[-1].status & (Status.COASTING | Status.RESTING)
+    assert max(abs(a) for a, _ in host.targets[-1000:]) == pytest.approx(0.38, abs=0.02)
+    assert np.abs(np.diff(np.array(host.targets[-1500:]), axis=0)).max() < 0.003
+
+
+def test_stream_failsafe_slews_to_neutral_at_the_bounded_rate():
+    host = Host(command_timeout_s=0.5)
+    host.run(5, Heartbeat())
+    host.run(100, ServoCommand(1.2, -0.8), every_ms={200: Heartbeat()})
+    start = len(host.targets)
+    host.run(1500, every_ms={200: Heartbeat()})
+    targets = np.array(host.targets[start:])
+    steps = np.abs(np.diff(targets, axis=0))
+    assert steps.max() <= 2.0e-3 + 1e-12          # 2 rad/s x 1 ms
+    timeout = next(i for i, s in enumerate(host.statuses[start:])
+                   if s & Status.FAILSAFE_COMMAND)
+    assert targets[timeout + 299, 0] == pytest.approx(1.2 - 0.6, abs=1e-6)
+    assert tuple(targets[-1]) == (0.0, 0.0)       # 1.2 rad at 2 rad/s: 0.6 s, then held
+
+
+def test_link_config_sets_compact_telemetry_its_period_and_health():
+    host = Host()
+    host.run(5, Heartbeat())
+    out = host.run(1000, LinkConfig(50, TelemetryForm.COMPACT, 200, 1500, 3000),
+                   every_ms={200: Heartbeat()})
+    assert of(out, Ack) == [Ack(MsgType.LINK_CONFIG, host.last_seqs[0], 0)]
+    assert of(out, Telemetry) == []
+    compact = [(t, m) for t, m in host.frames[-len(out):] if isinstance(m, TelemetryCompact)]
+    times = [t for t, _ in compact]
+    assert np.all(np.diff(times) == 50) and times[0] == 6 + 50 and len(compact) == 19
+    assert all(telemetry_problem(m) is None for _, m in compact)
+    assert compact[-1][1].expanded().battery_v == pytest.approx(8.2, abs=1e-3)
+    assert len(of(out, Health)) == 4  # at 206, 406, 606 and 806 ms
+
+
+def test_link_config_out_of_range_is_acked_6_and_changes_nothing():
+    host = Host()
+    host.run(5, Heartbeat())
+    out = host.run(100, LinkConfig(5, TelemetryForm.COMPACT, 2000, 1500, 3000))
+    assert of(out, Ack) == [Ack(MsgType.LINK_CONFIG, host.last_seqs[0], 6)]
+    assert of(out, ErrorReport) == [] and len(of(out, Telemetry)) == 10
+
+
+def test_health_once_after_boot_then_every_period_with_the_honest_values():
+    host = Host()
+    host.run(4500)
+    health = [(t, m) for t, m in host.frames if isinstance(m, Health)]
+    assert [t for t, _ in health] == [1, 2001, 4001]
+    assert health[-1][1] == Health(ResetCause.POWER_ON, ClockSource.EMULATED, 0,
+                                   uptime_ms=4001)
+
+
+def test_health_counts_the_decoders_drops():
+    fish = VirtualFish(SimConfig())
+    fish.receive(b'\x00\x05\x01\x02\x00' + b'\x00\x03\x10\x07\x01\x01\x03\x80\x3e\x01\x00')
+    health = fish.health()
+    assert (health.rx_frame, health.rx_crc) == (1, 1)
+
+
+def test_a_host_of_another_version_ends_gait_mode_and_its_gaits_are_refused_with_5():
+    host = Host()
+    host.run(5, Heartbeat())
+    host.run(300, TABLE_1)
+    out = host.run(400, Heartbeat(version=1, role=Role.HOST))
+    assert ErrorReport(ErrorCode.VERSION_MISMATCH, host.last_seqs[0]) in out
+    telemetry = of(out, Telemetry)
+    assert telemetry[-1].gait_id == 0 and telemetry[-1].status & Status.VERSION_MISMATCH
+    steps = np.abs(np.diff(np.array(host.targets[-400:]), axis=0))
+    assert steps.max() <= 2.0e-3 + 1e-12 and host.targets[-1] == (0.0, 0.0)
+    out = host.run(5, FAST)
+    seq = host.last_seqs[0]
+    assert [m for m in out if isinstance(m, (Ack, ErrorReport))] == [
+        ErrorReport(ErrorCode.VERSION_MISMATCH, seq), Ack(MsgType.GAIT, seq, 5)]
+
+
+def test_acks_leave_one_per_millisecond_from_a_queue_of_four():
+    host = Host()
+    host.run(5, Heartbeat())
+    gaits = [dataclasses.replace(TABLE_1, gait_id=i) for i in range(1, 7)]
+    host.run(10, *gaits)
+    acks = [(t, m) for t, m in host.frames if isinstance(m, Ack)]
+    assert [m.acked_seq for _, m in acks] == host.last_seqs[:4]
+    assert [t for t, _ in acks] == [6, 7, 8, 9]
+    assert host.fish.acks_dropped == 2 and host.fish.gait_id == 6
+
+
+def test_each_millisecond_emits_at_most_one_of_each_kind():
+    host = Host()
+    host.run(5, Heartbeat())
+    host.run(3000, LinkConfig(10, TelemetryForm.FULL, 200, 1500, 3000), TABLE_1,
+             *[dataclasses.replace(TABLE_1, gait_id=i) for i in range(2, 9)],
+             every_ms={1: Heartbeat()})
+    by_ms: dict = {}
+    for t, m in host.frames:
+        by_ms.setdefault((t, type(m)), []).append(m)
+    assert max(len(ms) for (_, kind), ms in by_ms.items() if kind is not ErrorReport) == 1
