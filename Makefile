@@ -31,11 +31,10 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
 # owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
 # files are dealt in collection order, which puts the longest first (test/module_order.py).
-# Most of test/ waits on real-time graphs (a fish swims in real time): on the 2-core reference
-# machine one worker took 14 min, two 10.4 min, three 7.4 min; but three workers starved the
-# real-time streams of the modules that load the machine themselves (the loaded recording, QEMU,
-# the dashboard) beside two others, so those hold two of the machine's three slots and run one
-# at a time (test/machine_share.py).
+# Most of test/ waits on real-time graphs (a fish swims in real time), so it runs on more workers
+# than cores. A module that loads the machine itself (the loaded recording, QEMU, the dashboard)
+# would starve the real-time streams of the modules beside it, so it holds two of the machine's
+# three slots and such modules run one at a time (test/machine_share.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
 	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder test \

@@ -10,7 +10,7 @@ pytestmark = pytest.mark.ros
 
 VALID = Telemetry(board_time_ms=0, roll=0.0, pitch=0.1, yaw=-0.2, gyro=(0.0, 0.0, 0.3),
                   accel=(0.1, 0.0, 9.8), servo_1=0.2, servo_2=-0.1, battery_v=8.0, status=0)
-# One impossible field each (the issue's roll 3.4e38 first), the rest of the frame valid.
+# One impossible field each (first a roll of 3.4e38, near float32's largest), the rest valid.
 FORGED = [
     {'roll': 3.4e38}, {'pitch': 2.0}, {'yaw': -4.0}, {'gyro': (0.0, 1.0e3, 0.0)},
     {'accel': (0.0, 0.0, 1.0e4)}, {'servo_1': 10.0}, {'servo_2': -3.0},

@@ -6,8 +6,9 @@ discovery and traffic reach the recorder's participant too) and two busy loops h
 (at nice 19, so the other tests of a full run are slowed no more than a batch job would slow
 them; the graphs still share the cores with them). What the bag holds is checked from the bag
 alone: no number missing from the publishers' sequences of the 100 Hz and 20 Hz streams, no
-message that waited more than a second between its publication and the bag (the issue's
-bound; the recorder's poll is 0.05 s), and everything published before the stop is in it.
+message that waited more than a second between its publication and the bag (the bound a
+recording is held to; the recorder's poll is 0.05 s), and everything published before the
+stop is in it.
 """
 
 from pathlib import Path

@@ -37,8 +37,8 @@ class Probe:
 
         A request still unanswered after ``resend_after_s`` is sent again, as a robust client
         does: rmw_fastrtps can lose the answer to a client its server has only just discovered
-        (seen 2026-12-01: the tuner fitted and stored the gait, the probe heard nothing in
-        30 s). The first answer to any of the copies is returned.
+        (seen: the tuner fitted and stored the gait, and the probe heard nothing in 30 s). The
+        first answer to any of the copies is returned.
         """
         assert spin_until(self.executor, client.service_is_ready, WAIT_S), client.srv_name
         deadline = time.monotonic() + timeout_s

@@ -203,8 +203,8 @@ def test_fish_and_shore_on_two_hosts_through_a_radio_that_fails(hosts):
     for row in CROSSING:
         if row.rate_hz > 0:
             # An on-change topic (cpg_params, planner_state) crosses at most once per relay tick
-            # that finds a change on the fish (changes may come in bursts: 2026-12-01, 16 in a
-            # window crossed as 5); one message of slack for the window's ends.
+            # that finds a change on the fish (changes come in bursts: 16 in one window were
+            # seen to cross as 5); one message of slack for the window's ends.
             wanted = min(row.rate_hz, figures[True][4].get(row.topic, row.rate_hz))
             slack = 1.0 / RATE_WINDOW_S if row.topic in FISH_SOURCES else 0.0
             assert figures[True][2][row.topic] >= RATE_FRACTION * wanted - slack, row.topic

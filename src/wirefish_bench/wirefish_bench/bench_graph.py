@@ -41,8 +41,8 @@ def ros_session(domain_id: int, executor_kind: str | None = None):
     The benchmark's own receiver spins on the executor of the graph it measures (``events``
     unless ``executor_kind`` says ``classic``), as a node of that graph would: a Python
     executor's wake-up on the receiving side (a few hundred us) is part of what a classic
-    graph costs, not of what an events graph costs. Until 2026-12-01 (third session) it was
-    always the classic executor, which put its own wake-ups into both rows' receiver figures.
+    graph costs, not of what an events graph costs. A receiver always on the classic executor
+    would put its own wake-ups into both rows' receiver figures.
     """
     import rclpy
     from rclpy.context import Context

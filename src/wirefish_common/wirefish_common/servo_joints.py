@@ -14,7 +14,7 @@ without names, "the first two positions" is a guess about who published, and the
 guess is a servo driven by some other joint's angle (any JointState publisher remapped onto
 ``servo_cmd``, e.g. a joint-state GUI for another robot). Every publisher in the graph names its
 joints, so the strict rule costs nothing; a hand-typed ``ros2 topic pub`` must name them too.
-The bridge used to accept unnamed positions and kinematics refused them; this is the one rule.
+Every reader of servo angles (the bridge, the kinematics) applies this one rule.
 
 Message types only (no rclpy node), so it is testable without a ROS graph. The readers take a
 JointState or what a raw intake reads from its bytes (``cdr_views.JointStateView``: the

@@ -15,7 +15,7 @@ However many signals arrive, the process stops once and exits 0:
 - a signal that arrives while the node is being destroyed finds its guard condition gone
   (rclpy's ``InvalidHandle``): the stop is already under way, so it is dropped;
 - Python's own finalisation puts the default action (die of the signal: exit -2 / -15) back on
-  every signal that has a Python handler, so a late Ctrl-C used to kill a process that had
+  every signal that has a Python handler, so a late Ctrl-C would kill a process that had
   already stopped cleanly; from ``atexit`` on, SIGINT and SIGTERM are ignored instead.
 
 Nodes use it through ``wirefish_common.node_main.run_node``, which spins with

@@ -11,7 +11,7 @@ the history is not re-scanned at every tick. It reports:
   history spans ``max_period_s`` and then at most once per ``max_period_s``;
 * the phase of y(q1)'s fundamental (paper eq 25 aligns at O1), for the desired-wave overlay.
 
-Everything the node used to reset in two places lives here: ``reset`` (a new source) forgets
+Everything the node resets lives here, in two depths: ``reset`` (a new source) forgets
 samples and beats, ``forget_beat`` (a new geometry) only the overlay's phase.
 """
 
