@@ -36,7 +36,6 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     import rclpy
-    from rclpy.logging import LoggingSeverity
     from rclpy.signals import SignalHandlerOptions
 
     from wirefish_bag.recorder import BagRecorder
@@ -58,15 +57,15 @@ def run(args: argparse.Namespace) -> int:
     # are drained and the bag is closed cleanly.
     signals = SignalShutdown()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    # On a terminal its 'recording <topic>' lines would break the bar: the summary lists them.
+    progress_on_terminal = sys.stderr.isatty()
     try:
-        recorder = BagRecorder(bag_path, namespace, resume=args.resume)
+        recorder = BagRecorder(bag_path, namespace, resume=args.resume,
+                               announce=not progress_on_terminal)
     except (OSError, ValueError) as error:  # not a bag, or one that cannot be recovered
         rclpy.try_shutdown()
         print(f'wirefish record: {error}', file=sys.stderr)
         return 2
-    if progress_on_terminal := sys.stderr.isatty():
-        # Its 'recording <topic>' lines would break the bar: the summary lists the topics.
-        recorder.get_logger().set_level(LoggingSeverity.WARN)
     started_ns = time.time_ns()
     progress = (Progress(f'record {bag_path.name}', math.ceil(args.duration))
                 if args.duration is not None else None)

@@ -68,9 +68,12 @@ class _Stream:
 class BagRecorder(Node):
     """Subscribes to every topic under a namespace (and /diagnostics) and writes a bag."""
 
-    def __init__(self, bag_path: Path, namespace: str, resume: bool = False) -> None:
+    def __init__(self, bag_path: Path, namespace: str, resume: bool = False,
+                 announce: bool = True) -> None:
+        """Open the bag and subscribe; ``announce``: log each topic it starts recording."""
         # Nothing spins this node: parameter services would only hang their callers.
         super().__init__('wirefish_recorder', start_parameter_services=False)
+        self._announce = announce
         self.bag_path = bag_path
         self._namespace = namespace
         self._typestore = wirefish_typestore()
@@ -106,7 +109,8 @@ class BagRecorder(Node):
             subscription = self.create_subscription(
                 msg_class, topic, _unused_callback, qos_profile, raw=True)
             self._streams.append(_Stream(topic, subscription, channel, account))
-            self.get_logger().info(f'recording {topic} [{type_name}]')
+            if self._announce:
+                self.get_logger().info(f'recording {topic} [{type_name}]')
 
     def take_all(self, published_before_ns: int | None = None) -> int:
         """

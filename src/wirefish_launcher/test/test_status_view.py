@@ -59,3 +59,13 @@ def test_the_block_is_redrawn_in_place():
     block.forget()
     block.draw(['f'])
     assert stream.getvalue().endswith('d\ne\n\x1b[Jf\n')  # below what was left
+
+
+def test_the_planners_mode_is_shown_as_what_the_tail_does():
+    from wirefish_launcher.status_view import MODE_MEANINGS, planner_text
+    from wirefish_planner.planner_core import PlannerMode
+
+    assert planner_text(SimpleNamespace(mode='still')) == (
+        'still: servos at neutral until the first command')
+    assert planner_text(SimpleNamespace(mode='turn')) == 'turn'
+    assert set(MODE_MEANINGS) <= {mode.value for mode in PlannerMode}

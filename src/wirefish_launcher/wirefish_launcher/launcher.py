@@ -109,10 +109,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         'applied or start service)')
     parser.add_argument('--view-port', type=port_number, default=None, metavar='PORT',
                         help="with --view: the Foxglove WebSocket port (view_node's port, "
-                        'default 8765)')
+                        'default 8765; 0: any free one)')
     parser.add_argument('--view-http-port', type=port_number, default=None, metavar='PORT',
                         help="with --view: the dashboard's HTTP port (view_node's http_port, "
-                        'default 8080)')
+                        'default 8080; 0: any free one)')
     parser.add_argument('--baud', type=int, default=None,
                         help="the serial link's baud rate (bridge_node's baudrate, default "
                         '115200)')
@@ -122,13 +122,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def port_number(text: str) -> int:
-    """Return a TCP port option: a whole number in 1..65535 (argparse type)."""
+    """Return a TCP port option: a whole number in 0..65535, 0 any free one (argparse type)."""
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'not a port number: {text!r}') from None
-    if not 1 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f'a port is 1..65535, got {value}')
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f'a port is 0..65535 (0: any free one), got {value}')
     return value
 
 
@@ -145,6 +145,11 @@ def speed_option(text: str) -> str:
 # what a user watches, drives or records keeps the pace of the world; a loaded machine slows
 # it down instead of changing it (`max` is for experiments: wirefish sweep, the benchmarks).
 DEFAULT_SPEED = '1'
+
+
+def on_simulated_time_road(args: argparse.Namespace) -> bool:
+    """Return whether the graph runs on the virtual fish's clock: the virtual fish, one host."""
+    return args.port is None and args.fish != Fish.QEMU and args.role == Role.ALL
 
 
 def fleet_size(text: str) -> int:
@@ -261,6 +266,10 @@ def _effective_params(args: argparse.Namespace, run_dir: Path
         put('/**/view_node', 'http_port', args.view_http_port)
     if args.baud is not None:
         put('/**/bridge_node', 'baudrate', args.baud)
+    if on_simulated_time_road(args):  # see graph.SIM_TIME_COMMAND_RATE_HZ; a -p loses to the
+        # file's /**/bridge_node section, so the value goes here
+        from wirefish_bringup.graph import SIM_TIME_COMMAND_RATE_HZ
+        put('/**/bridge_node', 'max_command_rate_hz', float(SIM_TIME_COMMAND_RATE_HZ))
     merged = overlaid(overlaid(defaults, user), options)
     return run_dir / 'params.yaml', user, merged
 
@@ -374,7 +383,7 @@ def _run(args: argparse.Namespace) -> int:
             if qemu:
                 from wirefish_launcher.qemu_board import build_image
                 build_image()
-        if sim and args.role == Role.ALL:
+        if on_simulated_time_road(args):
             from wirefish_bringup.graph import on_simulated_time
             specs = on_simulated_time(specs, args.speed or DEFAULT_SPEED)
         elif args.speed is not None:
