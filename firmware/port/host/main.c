@@ -146,6 +146,7 @@ int main(int argc, char **argv)
     clock_gettime(CLOCK_MONOTONIC, &start);
     wf_host_reset();
     static wf_app_t app;
+    wf_host_boot(); /* the port's start-up: a power-on reset, the I2C bus idle */
     wf_app_init(&app, &config);
     int input_open = 1;
     while (!stop_requested) {
