@@ -445,9 +445,12 @@ def fish_graph(namespace: str = DEFAULT_NAMESPACE, *, sim: bool = True,
     return specs
 
 
-# On the simulated-time road a step of fish_sim's clock waits for the bridge's SERVO_CMD, so
-# the bridge's rate limit (100 Hz of wall time) would cap `--speed max` near real time: there
-# it is set to the parameter's most (at most 10 times real time), and the lockstep paces it.
+# On the simulated-time road a step of fish_sim's clock waits for the bridge's SERVO_CMD, and
+# the bridge's rate limit counts wall time: at 100 Hz a command that came a few ms early (after
+# a late one) was held until the next command or command tick, both of which wait for the
+# clock, so the clock waited out its grace (5 times in 20 s at --speed 1); and it would cap
+# `--speed max` near real time. There the limit is the parameter's most (1 kHz: at most 10
+# times real time), and the lockstep paces the commands: one per step.
 SIM_TIME_COMMAND_RATE_HZ = '1000.0'
 
 
@@ -459,7 +462,7 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
     SERVO_CMD, ``wirefish_sim.lockstep``); every other ROS node of the graph gets
     ``use_sim_time`` (the single-process host: ``--sim-time``), so its timers, stamps and
     timeouts run on simulated time; the bridge's command rate limit is lifted to its most
-    above real time (``SIM_TIME_COMMAND_RATE_HZ``). ``speed`` is ``--speed``'s text (``1``,
+    (``SIM_TIME_COMMAND_RATE_HZ``). ``speed`` is ``--speed``'s text (``1``,
     ``4``, ``max``). A process that parses its own options (the recorder) keeps the wall clock
     for its receive times; the messages it records carry simulated stamps.
     """
@@ -467,7 +470,6 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
     if not any(s.executable == simulator.executable and s.package == simulator.package
                for s in specs):
         raise ValueError("simulated time is the virtual fish's clock: this graph has none")
-    faster = speed.strip().lower() == 'max' or float(speed) > 1.0
     timed = []
     for spec in specs:
         if (spec.package, spec.executable) == (simulator.package, simulator.executable):
@@ -476,7 +478,7 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
             spec = replace(spec, arguments=(*spec.arguments, '--sim-time'))
         elif spec.namespace is not None:
             extra = {'use_sim_time': 'true'}
-            if spec.executable == 'bridge_node' and faster:
+            if spec.executable == 'bridge_node':
                 extra['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
             spec = replace(spec, parameters={**spec.parameters, **extra})
         timed.append(spec)

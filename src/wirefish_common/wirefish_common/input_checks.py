@@ -1,11 +1,14 @@
 """
-Checks of what a user names on the command line: a serial port, a parameter file, a bag.
+Checks of what a user names on the command line: a port, a parameter file, a bag, a speed.
+
+The speed is the pace of the virtual fish's clock (``parse_speed``).
 
 Each check returns why its input cannot work, in one line, or None. `wirefish up` checks
 before it starts anything: the graph would otherwise start and fail where a user does not
 look (the bridge's log, a node's traceback).
 """
 
+import math
 import os
 from pathlib import Path
 import stat
@@ -83,3 +86,26 @@ def bag_directory_problem(bag: Path) -> str | None:
     if not any(bag.glob('*.mcap')):
         return f'{bag} holds no .mcap file: not a rosbag2 bag, nothing was recorded there'
     return None
+
+
+def parse_speed(text: str) -> float:
+    """
+    Return a ``--speed`` (the virtual fish's pace): a factor on real time > 0, or ``max``.
+
+    ``max`` is ``math.inf``: as fast as the graph answers. Raises ValueError saying why not.
+    """
+    if text.strip().lower() == 'max':
+        return math.inf
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f'--speed takes a factor on real time (e.g. 1, 4) or max, got {text!r}'
+                         ) from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f'--speed must be finite and > 0 (or max), got {text!r}')
+    return value
+
+
+def speed_text(speed: float) -> str:
+    """Return ``speed`` as ``--speed`` spells it (``max`` for ``math.inf``)."""
+    return 'max' if math.isinf(speed) else f'{speed:g}'

@@ -13,6 +13,7 @@ The QoS profiles of every wirefish topic and service client, defined once.
   ``latched(depth)`` keeps the last ``depth`` for a late joiner (the tuner's feedback).
 - ``TF``, ``TF_STATIC``, ``TF_STATIC_LISTENER``: tf2_ros's own profiles for /tf (broadcaster
   and listener alike), the /tf_static broadcaster and the /tf_static listener.
+- ``CLOCK``: /clock, the simulated time fish_sim owns (reliable, keep last 1).
 """
 
 from __future__ import annotations
@@ -42,3 +43,6 @@ TF_STATIC = latched(1)
 # Deep enough to keep every latched /tf_static message when several broadcasters (a fleet's
 # tf_nodes) answer one late subscriber at once; a depth of 1 would keep only the last writer's.
 TF_STATIC_LISTENER = latched(100)
+# /clock of the simulated-time road (fish_sim): rclpy's TimeSource takes it best effort, depth 1;
+# a reliable writer serves it as well as a reader that wants every step (a test's probe).
+CLOCK = reliable(1)

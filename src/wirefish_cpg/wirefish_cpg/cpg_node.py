@@ -4,10 +4,14 @@ cpg_node: the fish's two-oscillator CPG (paper eq 1) driving the servos.
 Publishes
     ``servo_cmd`` (sensor_msgs/JointState, sensor-data QoS) at ``publish_rate_hz``: joints
     ``servo_1``, ``servo_2`` (``wirefish_common.servo_joints``); position (rad) and velocity
-    (rad/s), stamped with the node clock (so ``use_sim_time`` works: a tick at which simulated
-    time has not advanced publishes nothing). The ticks come from a ``FixedRateLoop`` thread,
-    not an executor timer: at 1 kHz the executor's own overhead was ~90 % of the node's CPU
-    (see fixed_rate.py).
+    (rad/s), stamped with the node clock. On the wall clock the ticks come from a
+    ``FixedRateLoop`` thread, not an executor timer: at 1 kHz the executor's own overhead was
+    ~90 % of the node's CPU (see fixed_rate.py). With ``use_sim_time`` (fish_sim's /clock, the
+    virtual fish's lockstep road) they come from a timer on the node clock instead: one tick at
+    every multiple of the period that simulated time reaches, so each step of fish_sim's clock
+    (one period) draws exactly the one command it waits for; a tick at which simulated time
+    has not moved publishes nothing, and a clock that jumps back (a restarted fish_sim) re-bases
+    the CPG's clock, keeping its state.
     ``cpg_params`` (wirefish_msgs/CpgParams, reliable, transient local, depth 1): the targets
     the CPG runs, re-published whenever they change (from a command or a parameter set).
     ``cpg_status`` (wirefish_msgs/CpgStatus, reliable, transient local, depth 1): which source
@@ -35,6 +39,7 @@ import threading
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.timer import Timer
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 from wirefish_common.node_main import run_node
@@ -87,13 +92,19 @@ class CpgNode(Node):
         self.add_post_set_parameters_callback(self._apply)
         self._params_pub.publish(to_message(params))
         self._publish_status()
-        self._loop = FixedRateLoop(1.0 / self._values['publish_rate_hz'], self._on_tick,
-                                   name='cpg_publish')
-        self._loop.start()
+        period_s = 1.0 / self._values['publish_rate_hz']
+        self._loop: FixedRateLoop | None = None
+        self._timer: Timer | None = None
+        if self.get_parameter('use_sim_time').value:
+            self._timer = self.create_timer(period_s, self._on_tick)
+        else:
+            self._loop = FixedRateLoop(period_s, self._on_tick, name='cpg_publish')
+            self._loop.start()
 
     def destroy_node(self) -> None:
         """Stop the publish loop before the publisher goes away."""
-        self._loop.stop()
+        if self._loop is not None:
+            self._loop.stop()
         super().destroy_node()
 
     def _now_s(self) -> float:
@@ -112,7 +123,11 @@ class CpgNode(Node):
             if 'integration_step_s' in names:
                 self._cpg.step_s = float(self._values['integration_step_s'])
             if 'publish_rate_hz' in names:
-                self._loop.period_s = 1.0 / self._values['publish_rate_hz']
+                period_s = 1.0 / self._values['publish_rate_hz']
+                if self._loop is not None:
+                    self._loop.period_s = period_s
+                elif self._timer is not None:
+                    self._timer.timer_period_ns = round(period_s * 1e9)
             if names & set(CPG_PARAMETER_NAMES):  # a manual override (cpg_control)
                 self._control.parameters_set(self._values)
                 params = self._control.targets
@@ -176,14 +191,15 @@ class CpgNode(Node):
             self._publish_command()
         except Exception as error:  # noqa: B902 (the loop's thread must survive; say why)
             if not self.context.ok():  # shut down under the loop (Ctrl-C): nothing to say
-                self._loop.stop()
+                if self._loop is not None:
+                    self._loop.stop()
                 return
             self.get_logger().error(f'servo_cmd tick failed: {error!r}',
                                     throttle_duration_sec=2.0)
 
     def _publish_command(self) -> None:
         now_ns = self.get_clock().now().nanoseconds
-        if now_ns <= self._last_tick_ns:  # simulated time stands still
+        if now_ns == self._last_tick_ns:  # simulated time stands still (back: re-based below)
             return
         self._last_tick_ns = now_ns
         t = now_ns * 1e-9

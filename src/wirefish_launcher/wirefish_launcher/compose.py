@@ -16,7 +16,8 @@ import sys
 import threading
 
 from wirefish_bringup.graph import (composable_entries, DEFAULT_NAMESPACE, default_params_file,
-                                    resolve, ros_arguments, validate_namespace)
+                                    resolve, ros_arguments, SIM_TIME_COMMAND_RATE_HZ,
+                                    validate_namespace)
 from wirefish_common.executors import ExecutorKind
 
 # Beside the executors a node process may spin on (ExecutorKind), the one process of all the
@@ -37,6 +38,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         '(SingleThreadedExecutor) or multi (MultiThreadedExecutor); default: '
                         'the one WIREFISH_EXECUTOR names, events if unset, as in one process '
                         'per node; the tuner always has its own')
+    parser.add_argument('--sim-time', action='store_true',
+                        help='every node on simulated time (use_sim_time: the clock fish_sim '
+                        'publishes on /clock, wirefish up --sim --speed)')
 
 
 def node_class(path: str | None) -> type:
@@ -80,6 +84,10 @@ def run(args: argparse.Namespace) -> int:
         for entry in composable_entries():
             parameters = {k: resolve(v, device=args.port, namespace=namespace)
                           for k, v in entry.parameters.items()}
+            if args.sim_time:  # as on_simulated_time sets them for one process per node
+                parameters['use_sim_time'] = 'true'
+                if entry.name == 'bridge_node':
+                    parameters['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
             cli_args = list(ros_arguments(entry.name, namespace, params, parameters))
             node = node_class(entry.node_class)(cli_args=cli_args)
             nodes.append(node)

@@ -19,10 +19,18 @@ Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns th
 disturbances apply to every fish, each fish with its own device, schedule state and
 Generators (fish k, from 0: ``--seed`` + 2k for its IMU, + 2k + 1 for its faults).
 
-The loop wakes every ``tick_s`` (half a telemetry period, 5 ms at 100 Hz): it reads every
-device, steps the physics of every fish by the wall-clock time since the last tick, and writes
-what each firmware emitted. A command takes effect at the tick after it arrived (the servos'
-own PWM frame is 3 ms), however many fish share the process.
+Two clocks. Without ``--speed`` (the wall-clock road: benchmarks, a radio) the loop wakes every
+``tick_s`` (half a telemetry period, 5 ms at 100 Hz): it reads every device, steps the physics
+of every fish by the wall-clock time since the last tick, and writes what each firmware
+emitted; a process behind real time drops time (``MAX_STEP_S``). A command takes effect at the
+tick after it arrived (the servos' own PWM frame is 3 ms), however many fish share the process.
+With ``--speed X`` (the simulated-time road of `wirefish up --sim`) the process owns the graph's
+clock: it steps simulated time by ``1 / --step-hz`` (10 ms) at a time, in lockstep with the
+host's SERVO_CMD stream and paced at X times real time (``max``: as fast as the graph
+answers; see ``wirefish_sim.lockstep``), and with ``--ros`` publishes every step on ``/clock``
+(rosgraph_msgs/Clock), which every other node of the graph follows with ``use_sim_time``. Under
+load simulated time slows down; it is never dropped. The faults' schedules run on the process's
+own clock (simulated time on that road).
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from collections.abc import Sequence
 from dataclasses import fields
 import math
 from pathlib import Path
+import select
 import sys
 import time
 from typing import NoReturn
@@ -39,9 +48,11 @@ from typing import NoReturn
 import numpy as np
 
 from wirefish_common.frames import frame_prefix_problem
+from wirefish_common.input_checks import parse_speed, speed_text
 from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
+from wirefish_sim.lockstep import clock_origin_ns, DEFAULT_GRACE_S, LockstepClock
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
@@ -94,7 +105,26 @@ def build_parser() -> argparse.ArgumentParser:
                    'fish (rad/s, + turns left)')
     p.add_argument('--surge-disturbance', type=float, default=0.0,
                    help='constant surge force of a current (N, + pushes forward)')
+    p.add_argument('--speed', type=_speed, default=None, metavar='X',
+                   help="own the clock: simulated time in lockstep with the host's SERVO_CMD, "
+                   'paced at X times real time (1 = real time when the machine keeps up; max = '
+                   'as fast as the host answers), published on /clock with --ros; absent: '
+                   'the wall clock')
+    p.add_argument('--step-hz', type=float, default=100.0,
+                   help='with --speed: steps of simulated time per second, the rate of the '
+                   "host's SERVO_CMD stream (the CPG's publish_rate_hz)")
+    p.add_argument('--lockstep-grace', type=float, default=DEFAULT_GRACE_S,
+                   help='with --speed: wall seconds a streaming host may keep the clock waiting '
+                   'for its command before the fish stops waiting for it')
     return p
+
+
+def _speed(text: str) -> float:
+    """Return a --speed value (argparse type)."""
+    try:
+        return parse_speed(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def config_from(args: argparse.Namespace) -> SimConfig:
@@ -145,10 +175,27 @@ class GroundTruthPublisher:
         self._odometry = Odometry
         self.publishers = [self.node.create_publisher(
             Odometry, prefixed(name, 'sim/ground_truth'), RELIABLE) for name in names]
+        self._clock_publisher = None
 
-    def publish(self, school: Sequence[VirtualFish]) -> None:
-        """Publish the ground truth of every fish now (one stamp: one clock)."""
-        stamp = self.node.get_clock().now().to_msg()
+    def publish_clock(self, time_ns: int) -> None:
+        """Publish ``time_ns`` on /clock (the publisher is made at the first call)."""
+        from builtin_interfaces.msg import Time
+        from rosgraph_msgs.msg import Clock
+        from wirefish_common.qos import CLOCK
+
+        if self._clock_publisher is None:
+            self._clock_publisher = self.node.create_publisher(Clock, '/clock', CLOCK)
+        sec, nanosec = divmod(time_ns, 1_000_000_000)
+        self._clock_publisher.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
+
+    def publish(self, school: Sequence[VirtualFish], time_ns: int | None = None) -> None:
+        """Publish the ground truth of every fish at ``time_ns`` (None: the node clock's now)."""
+        if time_ns is None:
+            stamp = self.node.get_clock().now().to_msg()
+        else:
+            from builtin_interfaces.msg import Time
+            sec, nanosec = divmod(time_ns, 1_000_000_000)
+            stamp = Time(sec=sec, nanosec=nanosec)
         for fish, frames, publisher in zip(school, self._frames, self.publishers):
             s = fish.state
             msg = self._odometry()
@@ -242,40 +289,15 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
     disturbance = Disturbance(args.yaw_disturbance, args.surge_disturbance)
     stalls = Schedule(args.stall_every, args.stall_for)
     reopens = Schedule(args.reopen_every, args.reopen_delay, args.reopen_count)
-    tick_s = max(0.0005, min(0.01, 1.0 / args.telemetry_hz / 2.0))
-    dropped_s = 0.0
     try:
         for link in links:
             print(link.device.open_pair(), flush=True)
-        start = last = next_tick = time.monotonic()
-        next_truth = start
-        while not signals.requested:
-            now = time.monotonic()
-            elapsed = now - start
-            closing = reopens.index(elapsed)
-            stalled = stalls.index(elapsed) is not None
-            for fish, link in zip(fleet.fish, links):
-                _reopen(link, closing)
-                data = link.device.read()
-                if data and not stalled:
-                    fish.receive(data)
-            step_s, dropped = loop_step(now - last)
-            dropped_s += dropped
-            fleet.step(step_s)
-            for fish in fleet.fish if disturbance.active else ():
-                disturb(fish.state, disturbance, step_s, fish.config.yaw_time_constant_s,
-                        fish.total_mass)
-            last = now
-            for fish, link in zip(fleet.fish, links):
-                output = fish.take_output()
-                if link.device.is_open and not stalled and output:
-                    link.device.write(link.faults.apply(output))
-            if ground_truth is not None and now >= next_truth:
-                ground_truth.publish(fleet.fish)
-                next_truth = max(next_truth + 1.0 / args.ground_truth_hz, now)  # no backlog
-            # One wake-up per tick for every fish, whatever the host writes in between.
-            next_tick = max(next_tick + tick_s, now)
-            time.sleep(max(0.0, next_tick - time.monotonic()))
+        if args.speed is not None:
+            _run_lockstep(args, fleet, links, disturbance, stalls, reopens, ground_truth,
+                          signals)
+        else:
+            _run_wall_clock(args, fleet, links, disturbance, stalls, reopens, ground_truth,
+                            signals)
     finally:
         bound_teardown()  # closing the devices and the ROS side must not hang the stop
         for link in links:
@@ -283,10 +305,118 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
             link.device.remove_link()
         if ground_truth is not None:
             ground_truth.close()
+    return 0
+
+
+def _exchange(fleet: VirtualFleet, links: Sequence[_FishLink], closing: int | None,
+              stalled: bool) -> list[int]:
+    """Read every device into its fish; return the fish that received a SERVO_CMD."""
+    commanded = []
+    for index, (fish, link) in enumerate(zip(fleet.fish, links)):
+        _reopen(link, closing)
+        data = link.device.read()
+        if data and not stalled:
+            before = fish.commands_received
+            fish.receive(data)
+            if fish.commands_received != before:
+                commanded.append(index)
+    return commanded
+
+
+def _step(fleet: VirtualFleet, links: Sequence[_FishLink], disturbance: Disturbance,
+          step_s: float, stalled: bool) -> None:
+    """Advance every fish by ``step_s`` of simulated time and write what each emitted."""
+    fleet.step(step_s)
+    for fish in fleet.fish if disturbance.active else ():
+        disturb(fish.state, disturbance, step_s, fish.config.yaw_time_constant_s,
+                fish.total_mass)
+    for fish, link in zip(fleet.fish, links):
+        output = fish.take_output()
+        if link.device.is_open and not stalled and output:
+            link.device.write(link.faults.apply(output))
+
+
+# While the clock waits for a command, /clock is said again this often (wall s): the nodes
+# take /clock best effort, and a node that missed the last one must not hold the clock.
+CLOCK_REPEAT_S = 0.02
+
+
+def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence[_FishLink],
+                  disturbance: Disturbance, stalls: Schedule, reopens: Schedule,
+                  ground_truth: GroundTruthPublisher | None, signals: SignalShutdown) -> None:
+    """Run on simulated time, owned by this process (``--speed``), until a stop."""
+    step_ns = round(1e9 / args.step_hz)
+    clock = LockstepClock(clock_origin_ns(time.time_ns(), step_ns), step_ns, args.speed,
+                          len(fleet), time.monotonic(), args.lockstep_grace)
+    start_ns, step_s = clock.time_ns, step_ns * 1e-9
+    truth_period_ns = round(1e9 / args.ground_truth_hz)
+    next_truth_ns = start_ns
+    started_wall = said_wall = time.monotonic()
+    if ground_truth is not None:
+        ground_truth.publish_clock(clock.time_ns)
+    print(f'fish_sim: simulated time from {start_ns * 1e-9:.2f} s in steps of '
+          f'{step_s * 1e3:g} ms, lockstep with the host, speed {speed_text(args.speed)}',
+          file=sys.stderr, flush=True)
+    while not signals.requested:
+        elapsed = (clock.time_ns - start_ns) * 1e-9
+        closing = reopens.index(elapsed)
+        stalled = stalls.index(elapsed) is not None
+        for index in _exchange(fleet, links, closing, stalled):
+            clock.on_command(index)
+        now = time.monotonic()
+        if clock.ready(now):
+            _step(fleet, links, disturbance, step_s, stalled)
+            clock.advance(now)
+            if ground_truth is not None:
+                ground_truth.publish_clock(clock.time_ns)
+                said_wall = now
+                if clock.time_ns >= next_truth_ns:
+                    ground_truth.publish(fleet.fish, clock.time_ns)
+                    next_truth_ns += truth_period_ns
+            continue
+        if ground_truth is not None and now - said_wall >= CLOCK_REPEAT_S:
+            ground_truth.publish_clock(clock.time_ns)
+            said_wall = now
+        devices = [link.device for link in links if link.device.is_open]
+        timeout = min(clock.wait_s(now), CLOCK_REPEAT_S)
+        if timeout > 0.0:
+            select.select(devices, [], [], timeout)  # a command ends the wait at once
+    counters, wall_s = clock.counters, time.monotonic() - started_wall
+    simulated_s = (clock.time_ns - start_ns) * 1e-9
+    print(f'fish_sim: {simulated_s:.2f} s of simulated time in {wall_s:.2f} s '
+          f'(real-time factor {simulated_s / max(wall_s, 1e-9):.2f}); {counters.steps} steps, '
+          f'{counters.lockstep_steps} in lockstep; the host went silent {counters.releases} '
+          'times', file=sys.stderr, flush=True)
+
+
+def _run_wall_clock(args: argparse.Namespace, fleet: VirtualFleet,
+                    links: Sequence[_FishLink], disturbance: Disturbance, stalls: Schedule,
+                    reopens: Schedule, ground_truth: GroundTruthPublisher | None,
+                    signals: SignalShutdown) -> None:
+    """Run on the wall clock (no ``--speed``) until a stop."""
+    tick_s = max(0.0005, min(0.01, 1.0 / args.telemetry_hz / 2.0))
+    dropped_s = 0.0
+    start = last = next_tick = time.monotonic()
+    next_truth = start
+    while not signals.requested:
+        now = time.monotonic()
+        elapsed = now - start
+        closing = reopens.index(elapsed)
+        stalled = stalls.index(elapsed) is not None
+        _exchange(fleet, links, closing, stalled)
+        step_s, dropped = loop_step(now - last)
+        dropped_s += dropped
+        last = now
+        _step(fleet, links, disturbance, step_s, stalled)
+        if ground_truth is not None and now >= next_truth:
+            ground_truth.publish(fleet.fish)
+            next_truth = max(next_truth + 1.0 / args.ground_truth_hz, now)  # no backlog
+        # One wake-up per tick for every fish, whatever the host writes in between.
+        next_tick = max(next_tick + tick_s, now)
+        time.sleep(max(0.0, next_tick - time.monotonic()))
     if dropped_s > 0.0:
         print(f'fish_sim: ran behind real time; {dropped_s:.2f} s of simulated time dropped',
               file=sys.stderr, flush=True)
-    return 0
 
 
 def _reopen(link: _FishLink, closing: int | None) -> None:
@@ -321,7 +451,7 @@ def main(argv: list[str] | None = None) -> NoReturn:
 def flags_problem(args: argparse.Namespace) -> str | None:
     """Return why the flags cannot make a virtual fish, or None."""
     for name in ('ground_truth_hz', 'telemetry_hz', 'heartbeat_hz',
-                 'command_timeout', 'heartbeat_timeout'):
+                 'command_timeout', 'heartbeat_timeout', 'step_hz', 'lockstep_grace'):
         value = getattr(args, name)
         if not (math.isfinite(value) and value > 0.0):
             return f'--{name.replace("_", "-")} must be finite and > 0, got {value}'
