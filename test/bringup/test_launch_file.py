@@ -50,6 +50,10 @@ def _stand_ins(recorded: Recorded) -> dict[str, types.ModuleType]:
         def __init__(self, entities):
             self.entities = list(entities)
 
+    class Substitution:
+        def __init__(self):
+            pass
+
     class DeclareLaunchArgument:
         def __init__(self, name, default_value='', description='', choices=None):
             assert description, f'launch argument {name} has no description'
@@ -84,6 +88,7 @@ def _stand_ins(recorded: Recorded) -> dict[str, types.ModuleType]:
         return kwargs
 
     launch.LaunchDescription = LaunchDescription
+    launch.Substitution = Substitution
     actions.DeclareLaunchArgument = DeclareLaunchArgument
     actions.OpaqueFunction = OpaqueFunction
     actions.Shutdown = Shutdown
@@ -192,8 +197,40 @@ def test_every_node_starts_with_its_stop_signals_held(monkeypatch, overrides):
     # ros2 launch starts each through env, which blocks SIGINT/SIGTERM until the node's handler
     # unblocks them: a Ctrl-C during the interpreter's start is not a trace.
     nodes = launched_nodes(monkeypatch, **overrides)
-    assert nodes and {node['prefix'] for node in nodes} == {held_start_prefix()}
+    assert nodes and {performed_prefix(node) for node in nodes} == {held_start_prefix()}
     assert held_start_prefix() is not None
+
+
+def performed_prefix(node: dict, **configurations: str) -> str:
+    """Return a Node's prefix as launch performs it (``launch-prefix``... as configured)."""
+    context = _Context(configurations)
+    return ''.join(part if isinstance(part, str) else part.perform(context)
+                   for part in node['prefix']).strip()
+
+
+@pytest.mark.parametrize('overrides', LAUNCHES.values(), ids=LAUNCHES.keys())
+def test_each_process_is_named_after_its_node(monkeypatch, overrides):
+    # launch names a process after its command's first word unless exec_name says otherwise:
+    # with the held start's env first, every process was env-1, env-2 ... in ros2 launch's
+    # output, its 'process has died' and 'was required' lines.
+    nodes = launched_nodes(monkeypatch, **overrides)
+    assert nodes and [node['exec_name'] for node in nodes] == [node['name'] for node in nodes]
+    assert len({node['name'] for node in nodes}) == len(nodes)
+
+
+def test_the_users_launch_prefix_follows_the_held_start(monkeypatch):
+    # ros2 launch --launch-prefix 'nice -n 7': a prefix set in a launch file replaces the
+    # user's, so the file composes it: env blocks the stops, then execs the user's prefix,
+    # which runs the node (gdb and valgrind then see the node, not env).
+    nodes = launched_nodes(monkeypatch, **LAUNCHES['sim'])
+    held = held_start_prefix()
+    assert {performed_prefix(n, **{'launch-prefix': 'nice -n 7'}) for n in nodes} == {
+        f'{held} nice -n 7'}
+    cpg = next(n for n in nodes if n['name'] == 'cpg_node')
+    other = next(n for n in nodes if n['name'] == 'planner_node')
+    only_cpg = {'launch-prefix': 'xterm -e', 'launch-prefix-filter': 'cpg_'}
+    assert performed_prefix(cpg, **only_cpg) == f'{held} xterm -e'
+    assert performed_prefix(other, **only_cpg) == held
 
 
 def test_a_real_fish_without_a_port_names_the_launch_argument(monkeypatch):

@@ -10,9 +10,18 @@ The nodes, names, parameters, start order and restart policies come from the reg
 `wirefish_bringup.graph`, the one `wirefish up` (the launcher for machines without ros2 launch)
 uses. launch has no back-off: a node is respawned after its policy's first delay, at most
 ``max_restarts`` times over the run; a required node that exits once more shuts the launch down.
+
+Each process is named after its node in launch's output (``[cpg_node-3]``: ``exec_name``; launch
+would name it after the first word of its command, the held start's ``env``). ``ros2 launch
+--launch-prefix 'nice -n 7'`` (gdb, valgrind, xterm ...) and ``--launch-prefix-filter`` work as
+for any package: the user's prefix follows the held start's (``_UserPrefix``), whereas a
+prefix set in a launch file otherwise replaces the user's.
 """
 
-from launch import LaunchDescription
+import os
+import re
+
+from launch import LaunchDescription, Substitution
 from launch.actions import (DeclareLaunchArgument, OpaqueFunction, SetEnvironmentVariable,
                             Shutdown)
 from launch.substitutions import EnvironmentVariable, LaunchConfiguration
@@ -36,6 +45,35 @@ def _shutdown_after_last_retry(spec):
     return on_exit
 
 
+class _UserPrefix(Substitution):
+    """The ``launch-prefix`` launch configuration, if ``launch-prefix-filter`` lets it apply."""
+
+    def __init__(self, executable):
+        """Keep the executable the filter is matched against."""
+        super().__init__()
+        self._executable = executable
+
+    def describe(self):
+        """Say what this substitutes (launch's introspection)."""
+        return f'launch-prefix (filtered) of {self._executable}'
+
+    def perform(self, context):
+        """Return the user's prefix, or '' where the filter does not match."""
+        configurations = context.launch_configurations
+        wanted = configurations.get('launch-prefix-filter', '')
+        if re.match(wanted, os.path.basename(self._executable)) is None:
+            return ''
+        return configurations.get('launch-prefix', '')
+
+
+def _prefix(held, spec):
+    """Return the held start (for executables that release it) then the user's prefix."""
+    user = _UserPrefix(spec.executable)
+    if held is None or not spec.releases_stop_signals:
+        return [user]
+    return [f'{held} ', user]
+
+
 def _nodes(context):
     sim = LaunchConfiguration('sim').perform(context).lower() in ('true', '1', 'yes')
     port = LaunchConfiguration('port').perform(context) or None
@@ -56,12 +94,13 @@ def _nodes(context):
         # under `wirefish up` only: fish_graph adds it only when given a bag.
         actions.append(Node(
             package=spec.package, executable=spec.executable, name=spec.name,
+            exec_name=spec.name,
             namespace=spec.namespace, arguments=list(spec.arguments),
             parameters=[spec.params_file, spec.typed_parameters()],
             respawn=spec.restart.respawn, respawn_delay=spec.restart.delay_s,
             respawn_max_retries=spec.restart.max_restarts,
             on_exit=_shutdown_after_last_retry(spec) if spec.restart.required else None,
-            prefix=prefix if spec.releases_stop_signals else None,
+            prefix=_prefix(prefix, spec),
             output='screen', emulate_tty=True))
     return actions
 
