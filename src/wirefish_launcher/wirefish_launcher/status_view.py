@@ -105,14 +105,70 @@ class _Watched:
     primed: bool = False  # the first take holds the backlog since subscribing: not a rate
 
 
+def clock_text(real_time_factor: float | None) -> str:
+    """Return the clock column: the wall clock, or simulated time at its real-time factor."""
+    if real_time_factor is None:
+        return 'wall'
+    return f'simulated, {real_time_factor:.2f} x real time'
+
+
+class SimulatedClock:
+    """
+    The real-time factor of /clock (the virtual fish's simulated time) over the last window.
+
+    Simulated seconds per wall second between the first and the last /clock of ``WINDOW_S``;
+    None while no /clock moves (the wall-clock roads: a real fish, the emulated board, a radio).
+    """
+
+    def __init__(self, node, wall=time.monotonic) -> None:
+        """Subscribe to /clock from ``node`` (taken at each ``refresh``, as the topics are)."""
+        from rosgraph_msgs.msg import Clock
+        from rclpy.qos import qos_profile_sensor_data
+
+        self._node, self.wall = node, wall
+        self._samples: deque[tuple[float, float]] = deque()  # (wall s, simulated s)
+        self._subscription = node.create_subscription(Clock, '/clock', _unused,
+                                                      qos_profile_sensor_data)
+
+    def refresh(self) -> None:
+        """Take the /clock messages that arrived; keep the window's (wall, simulated) pairs."""
+        now = self.wall()
+        while True:
+            got = self._subscription.handle.take_message(self._subscription.msg_type, False)
+            if got is None:
+                break
+            stamp = got[0].clock
+            self._samples.append((now, stamp.sec + 1e-9 * stamp.nanosec))
+        while len(self._samples) > 2 and self._samples[0][0] < now - WINDOW_S:
+            self._samples.popleft()
+
+    def real_time_factor(self) -> float | None:
+        """Return simulated s per wall s over the window, or None without moving /clock."""
+        if len(self._samples) < 2:
+            return None
+        (wall_0, sim_0), (wall_1, sim_1) = self._samples[0], self._samples[-1]
+        if wall_1 - wall_0 < 0.5 or sim_1 < sim_0:  # a restarted fish_sim may start earlier
+            return None
+        return (sim_1 - sim_0) / (wall_1 - wall_0)
+
+    def text(self) -> str:
+        """Return the clock column of the header."""
+        return clock_text(self.real_time_factor())
+
+    def close(self) -> None:
+        """Destroy the subscription."""
+        self._node.destroy_subscription(self._subscription)
+
+
 class LiveStatus:
     """Watches a namespace's topics from ``node``; ``refresh()`` then ``lines()``."""
 
     def __init__(self, node, namespace: str, clock=time.monotonic) -> None:
         """Subscribe to what runs now (``refresh`` subscribes to topics that appear later)."""
-        self._node, self._namespace, self._clock = node, namespace.rstrip('/'), clock
+        self._node, self._namespace = node, namespace.rstrip('/')
         self._watched: dict[str, _Watched] = {}
         self._diagnostics: dict[str, Any] = {}  # the last status of each name seen
+        self._clock = SimulatedClock(node, clock)
         self._scan()
 
     def _scan(self) -> None:
@@ -141,7 +197,8 @@ class LiveStatus:
     def refresh(self) -> None:
         """Take what every subscription holds; subscribe to topics that appeared."""
         self._scan()
-        now = self._clock()
+        self._clock.refresh()
+        now = self._clock.wall()
         for topic, watched in self._watched.items():
             subscription = watched.subscription
             raw = topic not in self._decoded()
@@ -164,6 +221,7 @@ class LiveStatus:
         for watched in self._watched.values():
             self._node.destroy_subscription(watched.subscription)
         self._watched.clear()
+        self._clock.close()
 
     def _last(self, topic: str):
         watched = self._watched.get(topic)
@@ -176,13 +234,13 @@ class LiveStatus:
         # /diagnostics is shared by every graph of the domain: this namespace's statuses only.
         ours = [s for name, s in self._diagnostics.items()
                 if name.startswith(f'{self._namespace}/')]
-        return (f'link: {link_text(ours)}'
+        return (f'clock: {self._clock.text()} | link: {link_text(ours)}'
                 f' | battery: {battery_text(battery) if battery else "no battery yet"}'
                 f' | planner: {planner_text(planner) if planner else "no planner_state yet"}')
 
     def lines(self) -> list[str]:
         """Return the header and one line per topic (name, type, rate)."""
-        now = self._clock()
+        now = self._clock.wall()
         rows = [self.header(), f'{"topic":<40} {"type":<38} {"rate":>14}']
         for topic in sorted(self._watched):
             watched = self._watched[topic]
