@@ -40,7 +40,8 @@ int main(int argc, char **argv)
     wf_host_board_init(NULL);
     static uint8_t record[1 << 16];
     static uint8_t sink[WF_HOST_TX_CAPACITY];
-    /* Each accepted frame takes >= 7 record bytes and writes <= 60: room for any record. */
+    /* Each accepted frame takes >= 7 record bytes and writes <= WF_MAX_BODY + 1 (67): room for
+     * any record. */
     static uint8_t bodies[(sizeof record / 7 + 2) * (WF_MAX_BODY + 1)];
     uint32_t index = 0;
     uint8_t header[4];

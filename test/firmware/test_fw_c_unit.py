@@ -1,4 +1,9 @@
-"""The C unit tests of the core (firmware/test/test_core.c: link, failsafe, servo output)."""
+"""
+The C unit tests of the core (firmware/test/test_core.c).
+
+Link, failsafe and its slew, servo output, and protocol v2: GAIT accepted and refused, ACK,
+LINK_CONFIG, the gap's coast and rest without a step, compact telemetry, HEALTH, the CPG.
+"""
 
 import subprocess
 

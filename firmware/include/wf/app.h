@@ -5,8 +5,10 @@
  *   wf_app_init(&app, &config);       -- once, after the port's clocks, UART, PWM, I2C, ADC
  *   for (;;) wf_app_poll(&app);       -- as often as possible (at least once a millisecond)
  *
- * wf_app_poll reads the UART, decodes and acts on frames, runs the failsafe, updates the
- * servos, samples the IMU and sends telemetry (100 Hz) and heartbeats (2 Hz) when they are due.
+ * wf_app_poll steps the board's CPG (gait mode), reads the UART, decodes and acts on frames,
+ * answers GAIT and LINK_CONFIG with an ACK, runs the gap rules or the failsafe, updates the
+ * servos, samples the IMU and sends telemetry (100 Hz by default, FULL or COMPACT), heartbeats
+ * (2 Hz) and HEALTH (at boot, then every 2 s by default) when they are due.
  * The full definition of wf_app_t and wf_config_t lives in wf/app_state.h (owned by the core).
  */
 #ifndef WF_APP_H
@@ -18,8 +20,9 @@
 extern "C" {
 #endif
 
-/* The defaults of PROTOCOL.md: 0.5 s command timeout, 1.5 s heartbeat timeout, 100 Hz
- * telemetry, 2 Hz heartbeat, 50 Hz servo frames, the virtual fish's servo limit. */
+/* The defaults of PROTOCOL.md: 0.5 s command timeout, 1.5 s heartbeat timeout, 100 Hz FULL
+ * telemetry, 2 Hz heartbeat, HEALTH every 2 s, gait mode's 1.5 s link timeout and 3 s coast,
+ * the failsafe's 2 rad/s slew, 50 Hz servo frames, the virtual fish's servo limit. */
 void wf_config_defaults(wf_config_t *config);
 
 void wf_app_init(wf_app_t *app, const wf_config_t *config);
