@@ -233,13 +233,6 @@ class VirtualFish:
                 self._queue_ack(MsgType.GAIT, frame.seq, self.set_gait(message, frame.seq))
             elif isinstance(message, LinkConfig):
                 self._queue_ack(MsgType.LINK_CONFIG, frame.seq, self.configure_link(message))
-        stats, now_ms = self.decoder.stats, _whole_ms(self.state.time_s)
-        for i, (code, counters) in enumerate(_DROP_REPORTS):
-            count = sum(getattr(stats, name) for name in counters)
-            if count != self._drops_reported[i] and now_ms >= self._drop_report_due_ms[i]:
-                self._drops_reported[i] = count
-                self._drop_report_due_ms[i] = now_ms + _ERROR_MIN_INTERVAL_MS
-                self._outbox.append(self.encoder.encode(ErrorReport(code, 0)))
 
     def command(self, servo_1: float, servo_2: float) -> None:
         """Register servo targets (rad) now, as a SERVO_CMD frame would (stream mode)."""
@@ -297,6 +290,16 @@ class VirtualFish:
     def gait_id(self) -> int:
         """Return the id of the gait the fish runs (0 in stream mode)."""
         return self.gait.gait_id if self.gait is not None else 0
+
+    def _report_drops(self, now_ms: int) -> None:
+        """Send one ERROR per kind of drop since that kind's last, at most one per 20 ms."""
+        stats = self.decoder.stats
+        for i, (code, counters) in enumerate(_DROP_REPORTS):
+            count = sum(getattr(stats, name) for name in counters)
+            if count != self._drops_reported[i] and now_ms >= self._drop_report_due_ms[i]:
+                self._drops_reported[i] = count
+                self._drop_report_due_ms[i] = now_ms + _ERROR_MIN_INTERVAL_MS
+                self._outbox.append(self.encoder.encode(ErrorReport(code, 0)))
 
     def _queue_ack(self, kind: MsgType, seq: int, result: int) -> None:
         if len(self._acks) < ACK_QUEUE:
@@ -415,7 +418,9 @@ class VirtualFish:
 
     # --- firmware: output -------------------------------------------------------------------
     def _emit_due(self, servo_angles: np.ndarray) -> None:
+        """Send what this millisecond's poll sends, in the board's order (PROTOCOL.md)."""
         now = self.state.time_s
+        self._report_drops(_whole_ms(now))
         if self._reschedule:  # LINK_CONFIG: the new periods count from its poll
             self._reschedule = False
             self._next_telemetry = now + self._telemetry_period_s
