@@ -80,6 +80,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help='firmware: neutral after this long without SERVO_CMD (s)')
     p.add_argument('--heartbeat-timeout', type=float, default=1.5,
                    help='firmware: neutral after this long without a host heartbeat (s)')
+    p.add_argument('--failsafe-slew', type=float, default=SimConfig.failsafe_slew_rad_s,
+                   help='firmware: stream mode moves to neutral this fast (rad/s)')
+    p.add_argument('--link-timeout', type=float, default=SimConfig.link_timeout_s,
+                   help='firmware, gait mode: coasting after this long without a host frame '
+                   '(s, 0.1-10; LINK_CONFIG changes it)')
+    p.add_argument('--coast', type=float, default=SimConfig.coast_s,
+                   help='firmware, gait mode: resting this long after the link timeout '
+                   '(s, 0-60; LINK_CONFIG changes it)')
     p.add_argument('--servo-rate-limit', type=float,
                    default=ServoParameters.rate_limit_rad_s, help='slew limit (rad/s)')
     p.add_argument('--servo-lag', type=float, default=ServoParameters.time_constant_s,
@@ -132,6 +140,8 @@ def config_from(args: argparse.Namespace) -> SimConfig:
     return SimConfig(
         telemetry_hz=args.telemetry_hz, heartbeat_hz=args.heartbeat_hz,
         command_timeout_s=args.command_timeout, heartbeat_timeout_s=args.heartbeat_timeout,
+        failsafe_slew_rad_s=args.failsafe_slew, link_timeout_s=args.link_timeout,
+        coast_s=args.coast,
         servo=ServoParameters(args.servo_rate_limit, args.servo_lag, args.servo_update_hz,
                               args.servo_limit),
         imu_noise=ImuNoise().scaled(args.imu_noise_scale))
@@ -451,10 +461,15 @@ def main(argv: list[str] | None = None) -> NoReturn:
 def flags_problem(args: argparse.Namespace) -> str | None:
     """Return why the flags cannot make a virtual fish, or None."""
     for name in ('ground_truth_hz', 'telemetry_hz', 'heartbeat_hz',
-                 'command_timeout', 'heartbeat_timeout', 'step_hz', 'lockstep_grace'):
+                 'command_timeout', 'heartbeat_timeout', 'step_hz', 'lockstep_grace',
+                 'failsafe_slew'):
         value = getattr(args, name)
         if not (math.isfinite(value) and value > 0.0):
             return f'--{name.replace("_", "-")} must be finite and > 0, got {value}'
+    for name, low, high in (('link_timeout', 0.1, 10.0), ('coast', 0.0, 60.0)):
+        value = getattr(args, name)  # LINK_CONFIG's ranges
+        if not low <= value <= high:
+            return f'--{name.replace("_", "-")} must be in [{low:g}, {high:g}] s, got {value}'
     for name in ('corrupt_fraction', 'drop_fraction'):
         value = getattr(args, name)
         if not 0.0 <= value <= 1.0:
