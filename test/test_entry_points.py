@@ -5,16 +5,19 @@ Importing a package changes no signal handler; each executable holds its stops i
 modules import. It is called by the function ``console_scripts`` names (the package's
 ``executables`` module), first, before that function imports anything else: called from a
 package's ``__init__`` it would act on every import (a test, a tool), and called after the
-node's imports it would hold nothing. Read from the sources and the installed entry points.
+node's imports it would hold nothing. Read from the sources and the installed entry points,
+and seen in a process: each executable's SIGTERM handler when its first heavy import (rclpy,
+numpy) begins.
 """
 
 import ast
 from importlib.metadata import entry_points
 from pathlib import Path
+import subprocess
+import sys
 
 import pytest
 
-pytestmark = pytest.mark.linter
 SRC = Path(__file__).resolve().parents[1] / 'src'
 INITS = sorted(SRC.glob('*/wirefish_*/__init__.py'))
 HOLD = 'hold_stop_signals'
@@ -54,6 +57,42 @@ def wirefish_executables() -> list:
                    if e.value.startswith('wirefish_')), key=lambda e: e.name)
 
 
+def held_executables() -> list:
+    """Return the entry points of the processes a launcher holds the stops of (the registry)."""
+    from wirefish_bringup.graph import NodeSpec
+    return [e for e in wirefish_executables()
+            if NodeSpec(e.value.split('.')[0], e.name, e.name).releases_stop_signals]
+
+
+# Runs ``module:function`` (argv[1]) with the arguments after it and prints the SIGTERM handler
+# in force when the first heavy import begins (rclpy, numpy, or a module of the entry point's
+# package but its ``executables``: the node's own), then ends the process there.
+FIRST_HEAVY_IMPORT = """
+import importlib, os, signal, sys
+module, function = sys.argv[1].split(':')
+package = module.split('.')[0]
+class FirstHeavyImport:
+    def find_spec(self, name, path=None, target=None):
+        if name in ('rclpy', 'numpy') or (name.startswith(package + '.')
+                                          and name != package + '.executables'):
+            handler = signal.getsignal(signal.SIGTERM)
+            print(name, getattr(handler, '__module__', ''), getattr(handler, '__name__', handler))
+            sys.stdout.flush()
+            os._exit(0)
+sys.argv = [function, *sys.argv[2:]]
+sys.meta_path.insert(0, FirstHeavyImport())
+getattr(importlib.import_module(module), function)()
+print('no heavy import')
+"""
+
+
+def handler_at_first_heavy_import(target: str, *arguments: str) -> str:
+    """Return ``<module> <handler's module> <handler>`` as ``target`` starts its heavy imports."""
+    return subprocess.run([sys.executable, '-c', FIRST_HEAVY_IMPORT, target, *arguments],
+                          capture_output=True, text=True, timeout=60.0).stdout.strip()
+
+
+@pytest.mark.linter
 @pytest.mark.parametrize('init', INITS, ids=[p.parent.name for p in INITS])
 def test_no_package_init_touches_the_signal_handlers(init):
     source = init.read_text(encoding='utf-8')
@@ -67,11 +106,10 @@ def test_a_package_init_that_holds_signals_is_found():
     assert signal_calls(source) == {'wirefish_common.startup_signals', HOLD}
 
 
+@pytest.mark.linter
 def test_every_node_executable_holds_its_stops_first():
     """Every executable a launcher holds the stops of (the registry's, compose) releases them."""
-    from wirefish_bringup.graph import NodeSpec
-    nodes = [e for e in wirefish_executables()
-             if NodeSpec(e.value.split('.')[0], e.name, e.name).releases_stop_signals]
+    nodes = held_executables()
     assert len(nodes) >= 11, [e.name for e in nodes]
     wrong = []
     for point in nodes:
@@ -88,3 +126,14 @@ def test_an_entry_point_that_imports_before_it_holds_is_found():
     early = late.replace('    from wirefish_cpg.cpg_node import main\n    hold_stop_signals()\n',
                          '    hold_stop_signals()\n    from wirefish_cpg.cpg_node import main\n')
     assert (holds_first(late, 'cpg_node'), holds_first(early, 'cpg_node')) == (False, True)
+
+
+@pytest.mark.parametrize('point', held_executables(), ids=lambda e: e.name)
+def test_the_stop_signals_are_held_before_the_heavy_imports(point):
+    seen = handler_at_first_heavy_import(point.value)
+    assert seen.split()[1:] == ['wirefish_common.startup_signals', '_keep'], seen
+
+
+def test_a_node_module_imported_without_its_entry_point_is_unheld():
+    seen = handler_at_first_heavy_import('wirefish_cpg.cpg_node:main')
+    assert seen.split()[0] == 'wirefish_cpg.cpg_node' and '_keep' not in seen, seen
