@@ -31,7 +31,7 @@ import threading
 import time
 from types import TracebackType
 
-from wirefish_common.startup_signals import received, release_stop_signals
+from wirefish_common.startup_signals import release_stop_signals
 from wirefish_launcher.errors import QemuBoardError
 
 QEMU = 'qemu-system-arm'
@@ -289,8 +289,6 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)
     release_stop_signals()  # held by `wirefish up` until here; QEMU inherits them unblocked
-    if received:  # a stop the ``qemu_board`` executable held while this module imported
-        return 0
     try:
         image = args.image if args.image is not None else build_image()
         board = QemuBoard(image, link=args.link)
