@@ -9,8 +9,10 @@ from wirefish_sim.radio_model import (Direction, preset, PRESETS, RadioLink, Rad
 TO_FISH, TO_HOST = Direction.TO_FISH, Direction.TO_HOST
 
 
-def run(link: RadioLink, until: float, step: float = 0.0005) -> list[tuple[float, Direction,
-                                                                          bytes]]:
+Delivery = tuple[float, Direction, bytes]
+
+
+def run(link: RadioLink, until: float, step: float = 0.0005) -> list[Delivery]:
     """Poll ``link`` every ``step`` s until ``until``; return (time, direction, bytes)."""
     got = []
     t = link.stats.started_s
