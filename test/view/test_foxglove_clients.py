@@ -143,3 +143,57 @@ def test_a_flood_of_refused_messages_reaches_neither_a_bystander_nor_its_stream(
     finally:
         flooder.close()
         bystander.close()
+
+
+class _ServiceClient(FoxgloveClient):
+    """The tests' client, also keeping each failed service call's message."""
+
+    def __init__(self, url: str) -> None:
+        self.failures: dict[int, str] = {}
+        super().__init__(url)
+
+    def _on_text(self, op: dict) -> None:
+        if op['op'] == 'serviceCallFailure':
+            with self.lock:
+                self.failures[op['callId']] = op['message']
+        super()._on_text(op)
+
+
+def _schema(service: dict, part: str) -> dict:
+    return json.loads(service[part]['schema'])
+
+
+def test_service_schemas_are_the_ros_types_and_a_malformed_request_fails(view_graph):
+    namespace = view_graph.graph.namespace
+    client = _ServiceClient(view_graph.ws_url)
+    try:
+        names = {f'{namespace}/{s}' for s in ('start', 'stop', 'follow_commands', 'retune_gait')}
+        assert client.wait(lambda: names <= set(client.services), 30.0)
+        retune = client.services[f'{namespace}/retune_gait']
+        assert retune['request']['schemaEncoding'] == 'jsonschema'
+        goal = _schema(retune, 'request')['properties']
+        assert set(goal) == {'wave', 'apply', 'seed', 'max_iterations', 'swarm_size', 'mode',
+                             'use_library'}
+        assert set(goal['wave']['properties']) == {'c1', 'c2', 'k', 'frequency_hz'}
+        assert goal['max_iterations'] == {'type': 'integer', 'minimum': 0,
+                                          'maximum': 2**32 - 1}
+        start = client.services[f'{namespace}/start']
+        assert _schema(start, 'request')['properties'] == {}
+        assert _schema(start, 'response')['properties'] == {
+            'success': {'type': 'boolean'}, 'message': {'type': 'string'}}
+        calls = {
+            client.call(f'{namespace}/start', b'{nope'): 'start: not JSON',
+            client.call(f'{namespace}/start', b'{"now": true}'): 'start: request: no field now',
+            client.call(f'{namespace}/retune_gait', b'{"wave": {"c1": "abc"}}'):
+                'retune_gait: wave.c1 must be a finite number, got "abc"',
+            client.call(f'{namespace}/retune_gait', b'{"max_iterations": -1}'):
+                'retune_gait: max_iterations must be a whole number'}
+        assert client.wait(lambda: set(calls) <= set(client.failures), 20.0), client.failures
+        for call, reason in calls.items():
+            assert reason in client.failures[call], client.failures[call]
+        assert not set(calls) & set(client.responses)
+        good = client.call(f'{namespace}/start', b'{}')
+        assert client.wait(lambda: good in client.responses, 20.0)
+        assert json.loads(client.responses[good])['success'] is True
+    finally:
+        client.close()

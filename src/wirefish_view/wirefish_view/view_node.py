@@ -20,7 +20,10 @@ Services (JSON)
     the planner rests the fish), ``follow_commands`` (cpg_node's: hands the gait back to the
     planner after a manual override such as an applied retune, as `wirefish hand-back` does),
     ``retune_gait`` (sends the tuner's action goal; its progress
-    and result go out on ``view/retune``).
+    and result go out on ``view/retune``). Their schemas are JSON Schemas generated from the
+    ROS types (``json_messages``: Trigger's request and response; RetuneGait's goal, answered
+    as a Trigger response); a request that is not JSON or not of the type fails the call
+    with the reason.
 The dashboard
     ``http://address:http_port/``: the bundled page (``share/wirefish_view/dashboard``, built by
     `make setup`) and ``/config.json`` (the WebSocket port and namespace); 0 serves none.
@@ -59,8 +62,9 @@ from wirefish_common.qos import RELIABLE, SENSOR_DATA, TF
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
 from wirefish_view.client_input import check_advertised, cmd_vel_from_client
-from wirefish_view.errors import UnknownType
+from wirefish_view.errors import RefusedInput, UnknownType
 from wirefish_view.front_door import FrontDoor
+from wirefish_view.json_messages import from_json, json_schema
 from wirefish_view.scene import fish_scene, tail_segments
 from wirefish_view.schemas import ros2msg_schema
 from wirefish_view.view_node_parameters import VIEW_PARAMETERS
@@ -153,8 +157,9 @@ class ViewNode(Node):
         services = [self._service('start', self._start_client),
                     self._service('stop', self._stop_client),
                     self._service('follow_commands', self._follow_client),
-                    foxglove.Service(f'{self._namespace}/retune_gait', schema=_json_schema(
-                        'wirefish_msgs/action/RetuneGait'), handler=self._on_retune)]
+                    foxglove.Service(f'{self._namespace}/retune_gait', schema=_service_schema(
+                        'wirefish_msgs/action/RetuneGait', RetuneGait.Goal, Trigger.Response),
+                        handler=self._on_retune)]
         # The sdk's server on a loopback port of its own; the view's port is the front door's,
         # which speaks either subprotocol name and answers client publishing per client.
         self._server = foxglove.start_server(
@@ -177,7 +182,8 @@ class ViewNode(Node):
 
     def _service(self, name: str, client: Any) -> foxglove.Service:
         return foxglove.Service(f'{self._namespace}/{name}',
-                                schema=_json_schema('std_srvs/srv/Trigger'),
+                                schema=_service_schema('std_srvs/srv/Trigger', Trigger.Request,
+                                                       Trigger.Response),
                                 handler=partial(self._on_trigger, name, client))
 
     def destroy_node(self) -> None:
@@ -256,6 +262,10 @@ class ViewNode(Node):
 
     # --- services (the server's threads) --------------------------------------------------
     def _on_trigger(self, name: str, client: Any, request: Any) -> bytes:
+        try:
+            from_json(Trigger.Request, request.payload)  # a Trigger request has no field
+        except RefusedInput as error:
+            raise RefusedInput(f'{name}: {error}') from None  # the caller's call fails
         if name == 'stop':
             self._cmd_pub.publish(Twist())  # the planner rests the fish at once
         if not client.wait_for_service(timeout_sec=SERVICE_WAIT_S):
@@ -270,9 +280,9 @@ class ViewNode(Node):
 
     def _on_retune(self, request: Any) -> bytes:
         try:
-            goal = _retune_goal(json.loads(request.payload or b'{}'))
-        except (ValueError, TypeError, AttributeError) as error:
-            return _answer(False, f'retune: {error}')
+            goal = from_json(RetuneGait.Goal, request.payload)
+        except RefusedInput as error:
+            raise RefusedInput(f'retune_gait: {error}') from None  # the caller's call fails
         if self._retune_busy.is_set():
             return _answer(False, 'retune: a fit is already running')
         if not self._retune.wait_for_server(timeout_sec=SERVICE_WAIT_S):
@@ -362,33 +372,18 @@ def _type_of(channel: foxglove.Channel) -> type:
     return getattr(importlib.import_module(f'{package}.{kind}'), name)
 
 
-def _json_schema(name: str) -> Any:
-    schema = foxglove.Schema(name=name, encoding='jsonschema', data=b'{"type": "object"}')
-    message = foxglove.MessageSchema(encoding='json', schema=schema)
-    return foxglove.ServiceSchema(name, request=message, response=message)
+def _service_schema(name: str, request: type, response: type) -> Any:
+    """Return a JSON service schema whose request and response are those ROS types' schemas."""
+    def message(cls: type, part: str) -> Any:
+        schema = foxglove.Schema(name=f'{name}_{part}', encoding='jsonschema',
+                                 data=json.dumps(json_schema(cls, f'{name}_{part}')).encode())
+        return foxglove.MessageSchema(encoding='json', schema=schema)
+    return foxglove.ServiceSchema(name, request=message(request, 'Request'),
+                                  response=message(response, 'Response'))
 
 
 def _answer(success: bool, message: str) -> bytes:
     return json.dumps({'success': success, 'message': message}).encode()
-
-
-def _retune_goal(fields: dict) -> Any:
-    """Return the RetuneGait goal of a JSON request; raise ValueError for a bad value."""
-    goal = RetuneGait.Goal()
-    wave = fields.get('wave', {})
-    for name in ('c1', 'c2', 'k', 'frequency_hz'):
-        if name in wave:
-            value = float(wave[name])
-            if not math.isfinite(value):
-                raise ValueError(f'wave.{name} must be finite')
-            setattr(goal.wave, name, value)
-    goal.apply = bool(fields.get('apply', False))
-    goal.max_iterations = int(fields.get('max_iterations', 0))
-    goal.swarm_size = int(fields.get('swarm_size', 0))
-    goal.use_library = bool(fields.get('use_library', True))
-    if not (0 <= goal.max_iterations < 2**32 and 0 <= goal.swarm_size < 2**32):
-        raise ValueError('max_iterations and swarm_size must fit a uint32')
-    return goal
 
 
 def main(args: list[str] | None = None) -> None:
