@@ -956,6 +956,25 @@ static void test_the_lone_cpg_follows_eq_1(void)
                                1.5f));
 }
 
+static void test_degenerate_couplings_keep_the_output_finite(void)
+{
+    /* GAIT allows any finite coupling: 1e30/s makes the phase rate overflow. The state stays
+     * finite (the phase restarts), the amplitude law is untouched. */
+    wf_cpg_params_t p = table1_gait();
+    p.w12 = 1e30f;
+    p.w21 = -3e38f;
+    p.phi12 = 1e30f;
+    wf_host_cpg_init(&p);
+    static float angles[2 * 2000];
+    wf_host_cpg_run(2000, angles, NULL);
+    for (int i = 0; i < 2 * 2000; i++) {
+        CHECK(isfinite(angles[i]) && fabsf(angles[i]) <= 0.47f + 0.1f + 1e-3f);
+    }
+    float state[10];
+    wf_host_cpg_state(state);
+    CHECK(fabsf(state[2] - 0.38f) < 1e-4f && fabsf(state[0]) <= 3.1416f);
+}
+
 int main(void)
 {
     test_crc_check_value();
@@ -994,6 +1013,7 @@ int main(void)
     test_health_once_after_boot_and_every_period();
     test_the_imu_lost_and_found_is_counted();
     test_the_lone_cpg_follows_eq_1();
-    printf("test_core: 36 tests, %d checks passed\n", checks);
+    test_degenerate_couplings_keep_the_output_finite();
+    printf("test_core: 37 tests, %d checks passed\n", checks);
     return 0;
 }
