@@ -32,8 +32,8 @@ extern "C" {
  * so the host's CPG node and the board integrate exactly the same steps from the same start
  * (their outputs then differ by binary32 rounding only, not by discretisation), and 1 ms is
  * the tick of wf_hal_millis, so one step per millisecond of the board's clock needs no
- * fractional bookkeeping. The RK4 error at 1 ms is ~(2 pi v h)^5 / 120 per step: 1e-11 rad at
- * 10 Hz, far below the binary32 rounding. */
+ * fractional bookkeeping. A step costs 1691 instructions on the Cortex-M4 build (make
+ * cpg-arm-count): about 15 us of each 1 ms at 168 MHz. */
 #define WF_CPG_STEP_MS 1u
 #define WF_CPG_STEP_S 1e-3f
 
