@@ -131,9 +131,9 @@ def test_an_entry_point_that_imports_before_it_holds_is_found():
 @pytest.mark.parametrize('point', held_executables(), ids=lambda e: e.name)
 def test_the_stop_signals_are_held_before_the_heavy_imports(point):
     seen = handler_at_first_heavy_import(point.value)
-    assert seen.split()[1:] == ['wirefish_common.startup_signals', '_keep'], seen
+    assert seen.split()[1:] == ['wirefish_common.startup_signals', '_end_at_once'], seen
 
 
 def test_a_node_module_imported_without_its_entry_point_is_unheld():
     seen = handler_at_first_heavy_import('wirefish_cpg.cpg_node:main')
-    assert seen.split()[0] == 'wirefish_cpg.cpg_node' and '_keep' not in seen, seen
+    assert seen.split()[0] == 'wirefish_cpg.cpg_node' and '_end_at_once' not in seen, seen

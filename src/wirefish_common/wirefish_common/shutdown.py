@@ -45,7 +45,7 @@ import sys
 import threading
 from typing import Any, NoReturn
 
-from wirefish_common.startup_signals import received, release_stop_signals, STOP_SIGNALS
+from wirefish_common.startup_signals import release_stop_signals, STOP_SIGNALS
 # Under the 6 s `wirefish up` gives a graph of 6 processes to stop; a stop takes < 2 s on the
 # loaded 2-core reference machine (load average 10).
 STOP_STACKS_AFTER_S = 4.0
@@ -96,8 +96,6 @@ class SignalShutdown:
         atexit.register(ignore_stop_signals)
         threading.Thread(target=self._watch, name='signals', daemon=True).start()
         release_stop_signals()  # one held since the process started arrives now, as any other
-        if received:  # a Ctrl-C while the process was importing: a stop request like any
-            sender.send(b'\0')
 
     def attach(self, node: Any) -> None:
         """Give ``node`` the guard condition that shuts rclpy down once a signal came."""

@@ -1,12 +1,12 @@
 """
-A Ctrl-C while a node's process is still importing is kept, not a KeyboardInterrupt trace.
+A Ctrl-C while a node's process is still importing ends it with exit 0, not with a trace.
 
 A node's process spends its first second or more importing (rclpy, numpy, the messages)
 before ``SignalShutdown`` is installed; Python's default SIGINT handler would raise
 KeyboardInterrupt in the middle of an import: a traceback and exit -2. Each executable's entry
 point (the function ``console_scripts`` names, in its package's ``executables`` module) calls
 ``hold_stop_signals`` before it imports its node's module: from then on SIGINT and SIGTERM end
-the process at once with exit code 0 (``_keep``) until ``SignalShutdown`` takes them over:
+the process at once with exit code 0 (``_end_at_once``) until ``SignalShutdown`` takes them over:
 nothing of the node exists yet (no DDS participant, no file), so that is the whole of a clean
 stop, without waiting for the rest of the imports (on a loaded machine they alone outlast
 `ros2 launch`'s 5 s before it escalates to SIGTERM). Importing a package changes no handler:
@@ -34,11 +34,8 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 # (in this order: coreutils 9.1 forgets the block when --default-signal follows it).
 _HELD_START = ('--default-signal=INT,TERM', '--block-signal=INT,TERM')
 
-received: list[int] = []  # the signals that arrived before SignalShutdown took over
 
-
-def _keep(signum: int, _frame: object) -> None:
-    received.append(signum)
+def _end_at_once(_signum: int, _frame: object) -> None:
     os._exit(0)  # still importing: nothing to stop but the process (see the docstring)
 
 
@@ -67,7 +64,7 @@ def hold_stop_signals() -> None:
     the process's own handler) is in place, a stop ends the process at once, exit code 0.
     """
     for signum in STOP_SIGNALS:
-        signal.signal(signum, _keep)
+        signal.signal(signum, _end_at_once)
     release_stop_signals()
 
 
