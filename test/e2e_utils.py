@@ -66,3 +66,89 @@ def descendants(pid: int) -> list[psutil.Process]:
         return psutil.Process(pid).children(recursive=True)
     except psutil.NoSuchProcess:
         return []
+
+
+class SimulatedTime:
+    """
+    The graph's simulated time (``<namespace>/clock``, owned by fish_sim) as a probe sees it.
+
+    ``now()`` is the latest clock received (s), None before the first. The probe itself runs on
+    the wall clock: it only reads the clock, so counting what arrives between two clock values
+    measures rates in simulated time, whatever the machine's load did to the wall clock.
+    """
+
+    def __init__(self, node, namespace: str) -> None:
+        """Subscribe to the clock of the graph in ``namespace`` (reliable: every step)."""
+        from rosgraph_msgs.msg import Clock
+        from wirefish_common.qos import reliable
+
+        self.latest: float | None = None
+        self.history: list[tuple[float, float]] = []  # (wall s, simulated s) of each /clock
+
+        def on_clock(msg: Clock) -> None:
+            self.latest = msg.clock.sec + 1e-9 * msg.clock.nanosec
+            self.history.append((time.monotonic(), self.latest))
+        node.create_subscription(Clock, f'{namespace.rstrip("/")}/clock', on_clock,
+                                 reliable(100))
+
+    def now(self) -> float | None:
+        """Return the latest simulated time received (s), None before the first /clock."""
+        return self.latest
+
+    def at_wall(self, wall_s: float) -> float | None:
+        """Return the simulated time that was current at ``wall_s`` (time.monotonic() s)."""
+        current = None
+        for wall, simulated in self.history:
+            if wall > wall_s:
+                break
+            current = simulated
+        return current
+
+
+def measure_simulated_rates(node, executor, namespace: str, window_s: float,
+                            clock: SimulatedTime, wall_timeout_s: float
+                            ) -> dict[str, tuple[str, float]]:
+    """
+    Return {topic: (type, messages per simulated second)} over ``window_s`` of /clock.
+
+    Each message counts at the simulated time current when the probe took it; the window is
+    the span of /clock between the first and the last message counted in. Raises
+    AssertionError naming what it waited for if /clock does not cover the window within
+    ``wall_timeout_s`` of wall time.
+    """
+    from wirefish_common.topics import graph_topics, matching_qos, message_class
+
+    topics = graph_topics(node, namespace)
+    counts = dict.fromkeys(topics, 0)
+    window: list[float] = []
+    subscriptions = []
+
+    def count(_data: bytes, topic: str) -> None:
+        now = clock.now()
+        if window and now is not None and window[0] <= now < window[1]:
+            counts[topic] += 1
+
+    for topic, type_name in topics.items():
+        try:
+            msg_class = message_class(type_name)
+        except (ImportError, AttributeError, ValueError):
+            continue
+        subscriptions.append(node.create_subscription(
+            msg_class, topic, lambda data, topic=topic: count(data, topic),
+            matching_qos(node, topic, 100), raw=True))
+    deadline = time.monotonic() + wall_timeout_s
+    # Let the subscriptions match their publishers before the window opens.
+    settle_until = time.monotonic() + 1.0
+    while time.monotonic() < settle_until or clock.now() is None:
+        assert time.monotonic() < deadline, 'no /clock from fish_sim: is the graph on sim time?'
+        executor.spin_once(timeout_sec=0.05)
+    start = clock.now() + 0.5  # half a second of simulated time to match, then count
+    window[:] = [start, start + window_s]
+    while clock.now() < window[1]:
+        assert time.monotonic() < deadline, (
+            f'/clock covered {max(0.0, clock.now() - start):.2f} of {window_s} s of simulated '
+            f'time in {wall_timeout_s} s of wall time')
+        executor.spin_once(timeout_sec=0.05)
+    for subscription in subscriptions:
+        node.destroy_subscription(subscription)
+    return {topic: (topics[topic], counts[topic] / window_s) for topic in sorted(topics)}

@@ -233,6 +233,7 @@ class NodeSpec:
     restart: RestartPolicy = NO_RESTART
     ros_nodes: tuple[str, ...] = ()
     links: tuple[Path, ...] = ()
+    remaps: Mapping[str, str] = field(default_factory=dict)
 
     def executable_path(self) -> Path:
         """Return the installed executable, where `ros2 run` finds it (lib/<package>/)."""
@@ -254,7 +255,7 @@ class NodeSpec:
         if self.namespace is None:
             return self.arguments
         return (*self.arguments, *ros_arguments(self.name, self.namespace, self.params_file,
-                                                self.parameters))
+                                                self.parameters, self.remaps))
 
     def typed_parameters(self) -> dict[str, bool | int | float | str]:
         """Return ``parameters`` typed as ``-p key:=value`` reads them: for launch_ros's dict."""
@@ -273,9 +274,12 @@ def parameter_value(text: str) -> bool | int | float | str:
 
 
 def ros_arguments(name: str, namespace: str, params_file: str | None,
-                  parameters: Mapping[str, str]) -> tuple[str, ...]:
-    """Return the ``--ros-args`` of one node: its name, namespace, parameter file and values."""
+                  parameters: Mapping[str, str],
+                  remaps: Mapping[str, str] | None = None) -> tuple[str, ...]:
+    """Return the ``--ros-args`` of one node: name, namespace, remaps, parameter file, values."""
     args = ['--ros-args', '-r', f'__node:={name}', '-r', f'__ns:={namespace}']
+    for source, target in (remaps or {}).items():
+        args += ['-r', f'{source}:={target}']
     if params_file is not None:
         args += ['--params-file', params_file]
     for key, value in parameters.items():
@@ -458,31 +462,42 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
     """
     Return a virtual-fish graph's processes with fish_sim owning the clock at ``speed``.
 
-    fish_sim gets ``--speed`` (it publishes /clock and steps in lockstep with the host's
+    fish_sim gets ``--speed`` (it publishes the clock and steps in lockstep with the host's
     SERVO_CMD, ``wirefish_sim.lockstep``); every other ROS node of the graph gets
     ``use_sim_time`` (the single-process host: ``--sim-time``), so its timers, stamps and
-    timeouts run on simulated time; the bridge's command rate limit is lifted to its most
+    timeouts run on simulated time. The clock is ``<fish_sim's namespace>/clock``
+    (``clock_topic``), which every node takes as its /clock (a remap): two graphs on one ROS
+    domain, in namespaces of their own, each keep their own time. The bridge's command rate
+    limit is lifted to its most
     (``SIM_TIME_COMMAND_RATE_HZ``). ``speed`` is ``--speed``'s text (``1``,
     ``4``, ``max``). A process that parses its own options (the recorder) keeps the wall clock
     for its receive times; the messages it records carry simulated stamps.
     """
     simulator = entry('fish_sim')
-    if not any(s.executable == simulator.executable and s.package == simulator.package
-               for s in specs):
+    owners = [s for s in specs
+              if (s.package, s.executable) == (simulator.package, simulator.executable)]
+    if not owners:
         raise ValueError("simulated time is the virtual fish's clock: this graph has none")
+    clock = clock_topic(owners[0].namespace or '/')
     timed = []
     for spec in specs:
-        if (spec.package, spec.executable) == (simulator.package, simulator.executable):
+        if spec in owners:
             spec = replace(spec, arguments=(*spec.arguments, '--speed', speed))
         elif spec.name == COMPOSED_NAME:
-            spec = replace(spec, arguments=(*spec.arguments, '--sim-time'))
+            spec = replace(spec, arguments=(*spec.arguments, '--sim-time', '--clock', clock))
         elif spec.namespace is not None:
             extra = {'use_sim_time': 'true'}
             if spec.executable == 'bridge_node':
                 extra['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
-            spec = replace(spec, parameters={**spec.parameters, **extra})
+            spec = replace(spec, parameters={**spec.parameters, **extra},
+                           remaps={**spec.remaps, '/clock': clock})
         timed.append(spec)
     return timed
+
+
+def clock_topic(namespace: str) -> str:
+    """Return the clock a virtual fish in ``namespace`` publishes (``<namespace>/clock``)."""
+    return f'{namespace.rstrip("/")}/clock'
 
 
 def _start_order(spec: NodeSpec, composed: list[NodeEntry]) -> int:

@@ -40,7 +40,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         'per node; the tuner always has its own')
     parser.add_argument('--sim-time', action='store_true',
                         help='every node on simulated time (use_sim_time: the clock fish_sim '
-                        'publishes on /clock, wirefish up --sim --speed)')
+                        'publishes, wirefish up --sim --speed)')
+    parser.add_argument('--clock', default='/clock',
+                        help='with --sim-time: the topic of that clock (fish_sim publishes '
+                        '<its namespace>/clock)')
 
 
 def node_class(path: str | None) -> type:
@@ -88,7 +91,8 @@ def run(args: argparse.Namespace) -> int:
                 parameters['use_sim_time'] = 'true'
                 if entry.name == 'bridge_node':
                     parameters['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
-            cli_args = list(ros_arguments(entry.name, namespace, params, parameters))
+            cli_args = list(ros_arguments(entry.name, namespace, params, parameters,
+                                          {'/clock': args.clock} if args.sim_time else None))
             node = node_class(entry.node_class)(cli_args=cli_args)
             nodes.append(node)
             (own_executor if entry.own_executor else executor).add_node(node)

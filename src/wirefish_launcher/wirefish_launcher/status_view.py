@@ -114,24 +114,24 @@ def clock_text(real_time_factor: float | None) -> str:
 
 class SimulatedClock:
     """
-    The real-time factor of /clock (the virtual fish's simulated time) over the last window.
+    The real-time factor of the virtual fish's clock (``<namespace>/clock``) over a window.
 
-    Simulated seconds per wall second between the first and the last /clock of ``WINDOW_S``;
-    None while no /clock moves (the wall-clock roads: a real fish, the emulated board, a radio).
+    Simulated seconds per wall second between the first and the last clock of ``WINDOW_S``;
+    None while no clock moves (the wall-clock roads: a real fish, the emulated board, a radio).
     """
 
-    def __init__(self, node, wall=time.monotonic) -> None:
-        """Subscribe to /clock from ``node`` (taken at each ``refresh``, as the topics are)."""
+    def __init__(self, node, topic: str, wall=time.monotonic) -> None:
+        """Subscribe to ``topic`` from ``node`` (taken at each ``refresh``, as the topics are)."""
         from rosgraph_msgs.msg import Clock
         from rclpy.qos import qos_profile_sensor_data
 
         self._node, self.wall = node, wall
         self._samples: deque[tuple[float, float]] = deque()  # (wall s, simulated s)
-        self._subscription = node.create_subscription(Clock, '/clock', _unused,
+        self._subscription = node.create_subscription(Clock, topic, _unused,
                                                       qos_profile_sensor_data)
 
     def refresh(self) -> None:
-        """Take the /clock messages that arrived; keep the window's (wall, simulated) pairs."""
+        """Take the clock messages that arrived; keep the window's (wall, simulated) pairs."""
         now = self.wall()
         while True:
             got = self._subscription.handle.take_message(self._subscription.msg_type, False)
@@ -143,7 +143,7 @@ class SimulatedClock:
             self._samples.popleft()
 
     def real_time_factor(self) -> float | None:
-        """Return simulated s per wall s over the window, or None without moving /clock."""
+        """Return simulated s per wall s over the window, or None without a moving clock."""
         if len(self._samples) < 2:
             return None
         (wall_0, sim_0), (wall_1, sim_1) = self._samples[0], self._samples[-1]
@@ -168,7 +168,7 @@ class LiveStatus:
         self._node, self._namespace = node, namespace.rstrip('/')
         self._watched: dict[str, _Watched] = {}
         self._diagnostics: dict[str, Any] = {}  # the last status of each name seen
-        self._clock = SimulatedClock(node, clock)
+        self._clock = SimulatedClock(node, f'{self._namespace}/clock', clock)
         self._scan()
 
     def _scan(self) -> None:

@@ -27,8 +27,9 @@ tick after it arrived (the servos' own PWM frame is 3 ms), however many fish sha
 With ``--speed X`` (the simulated-time road of `wirefish up --sim`) the process owns the graph's
 clock: it steps simulated time by ``1 / --step-hz`` (10 ms) at a time, in lockstep with the
 host's SERVO_CMD stream and paced at X times real time (``max``: as fast as the graph
-answers; see ``wirefish_sim.lockstep``), and with ``--ros`` publishes every step on ``/clock``
-(rosgraph_msgs/Clock), which every other node of the graph follows with ``use_sim_time``. Under
+answers; see ``wirefish_sim.lockstep``), and with ``--ros`` publishes every step on ``clock``
+(rosgraph_msgs/Clock, in its namespace: ``/wirefish/clock``), which every other node of the
+graph follows as its /clock (``use_sim_time`` and a remap, ``graph.on_simulated_time``). Under
 load simulated time slows down; it is never dropped. The faults' schedules run on the process's
 own clock (simulated time on that road).
 """
@@ -116,7 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument('--speed', type=_speed, default=None, metavar='X',
                    help="own the clock: simulated time in lockstep with the host's SERVO_CMD, "
                    'paced at X times real time (1 = real time when the machine keeps up; max = '
-                   'as fast as the host answers), published on /clock with --ros; absent: '
+                   'as fast as the host answers), published on <namespace>/clock with --ros; '
+                   'absent: '
                    'the wall clock')
     p.add_argument('--step-hz', type=float, default=100.0,
                    help='with --speed: steps of simulated time per second, the rate of the '
@@ -188,13 +190,15 @@ class GroundTruthPublisher:
         self._clock_publisher = None
 
     def publish_clock(self, time_ns: int) -> None:
-        """Publish ``time_ns`` on /clock (the publisher is made at the first call)."""
+        """Publish ``time_ns`` on the node's ``clock`` (made at the first call)."""
         from builtin_interfaces.msg import Time
         from rosgraph_msgs.msg import Clock
         from wirefish_common.qos import CLOCK
 
         if self._clock_publisher is None:
-            self._clock_publisher = self.node.create_publisher(Clock, '/clock', CLOCK)
+            # <namespace>/clock: the graph's nodes take it as their /clock (a remap), so
+            # virtual fish in namespaces of their own on one ROS domain keep their own time.
+            self._clock_publisher = self.node.create_publisher(Clock, 'clock', CLOCK)
         sec, nanosec = divmod(time_ns, 1_000_000_000)
         self._clock_publisher.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
 
