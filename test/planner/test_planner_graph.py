@@ -60,8 +60,8 @@ def test_drive_the_virtual_fish(driver):
         assert time.monotonic() < deadline, \
             'no ground truth / planner_state / servo_cmd from the graph'
         time.sleep(0.1)
-    # No cmd_vel ever received: the planner rests the fish (cpg_node starts with Table 1, and
-    # the planner's cpg_command reaches it only once discovery is done).
+    # No cmd_vel ever received: the fish starts still (cpg_node's autostart false in the
+    # graph's parameters) and the planner holds it there, saying so.
     rest_deadline = time.monotonic() + 20.0
     while True:
         time.sleep(1.0)
@@ -72,7 +72,7 @@ def test_drive_the_virtual_fish(driver):
             break
     print(f'rest before any cmd_vel: max |servo_cmd| over 1 s {rest_amplitude:.4f} rad')
     assert rest_amplitude < 0.02
-    assert rec.state[-1][1].mode == 'rest'
+    assert rec.state[-1][1].mode == 'still'
 
     results = {}
     for setpoint in (0.10, 0.20, 0.30):

@@ -75,7 +75,8 @@ def test_a_negative_speed_is_refused(planner):
     while time.monotonic() < deadline:
         publisher.publish(msg)
         executor.spin_once(timeout_sec=0.05)
-    assert states and all(s.mode == 'rest' and s.target_speed == 0.0 for s in states)
+    # A refused command is no first command: the fish stays still.
+    assert states and all(s.mode == 'still' and s.target_speed == 0.0 for s in states)
 
 
 def _imu(node, stamp_s: float, yaw_rate: float):
