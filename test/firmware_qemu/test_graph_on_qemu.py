@@ -144,6 +144,27 @@ def test_every_bridge_stream_at_its_rate_for_30_s(qemu_graph, graph_node):
         assert rates[_full(topic)][1] >= minimum, topic
 
 
+def test_the_board_holds_its_servos_at_neutral_until_the_first_command(qemu_graph, graph_node):
+    from geometry_msgs.msg import Twist
+
+    node, executor = graph_node
+    angles: list[float] = []  # what the board reports (the reference firmware echoes its command)
+    node.create_subscription(JointState, _full('servo_state'),
+                             lambda msg: angles.extend(msg.position), qos_profile_sensor_data)
+    assert spin_until(executor, lambda: len(angles) > 2 * 300, timeout_s=30.0)  # 3 s at 100 Hz
+    assert max(abs(a) for a in angles) < 1e-3, max(abs(a) for a in angles)
+    cmd_vel = node.create_publisher(Twist, _full('cmd_vel'), 10)
+    swim = Twist()
+    swim.linear.x = 0.2
+    since = len(angles)
+
+    def swims() -> bool:
+        cmd_vel.publish(swim)
+        return any(abs(a) > 0.05 for a in angles[since:])
+
+    assert spin_until(executor, swims, timeout_s=20.0)
+
+
 def test_qemu_restarted_under_the_running_graph_the_link_comes_back(qemu_graph, graph_node):
     node, executor = graph_node
     received: list[float] = []   # wall-clock times (psutil's process start times are too)
