@@ -152,3 +152,19 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     for subscription in subscriptions:
         node.destroy_subscription(subscription)
     return {topic: (topics[topic], counts[topic] / window_s) for topic in sorted(topics)}
+
+
+# Streams a node decimates on the wall clock, not its node clock: bridge_node's battery
+# (its Decimator is given time.monotonic()). At --speed 1 simulated time runs at most at real
+# time, so per simulated second such a stream comes at least at its nominal rate (more when
+# the machine slows the clock down).
+WALL_DECIMATED = frozenset({'battery'})
+
+
+def rate_problem(topic: str, measured: float, nominal: float, tolerance: float) -> str | None:
+    """Return why ``measured`` (Hz of simulated time) is not ``topic``'s rate, or None."""
+    if topic in WALL_DECIMATED:
+        ok = measured >= nominal * (1.0 - tolerance)
+    else:
+        ok = abs(measured - nominal) <= tolerance * nominal
+    return None if ok else f'{topic}: {measured:.1f} Hz of simulated time, promised {nominal:g}'
