@@ -2,12 +2,16 @@
 // WebSocket that offers the client's default subprotocol (FoxgloveClient.SUPPORTED_SUBPROTOCOL),
 // every advertised channel subscribed, each message decoded as a viewer does (CDR with
 // @foxglove/rosmsg2-serialization from the channel's ros2msg schema, JSON, protobuf's wire
-// format), counted over a window.
+// format), counted over a window of the messages' own time (their header stamps: simulated
+// time when the graph runs on it) and of wall time.
 //
-//   node --experimental-websocket ws_protocol_client.js URL WARMUP_S WINDOW_S OUT.json
+//   node --experimental-websocket ws_protocol_client.js URL WARMUP_S WINDOW_S WALL_LIMIT_S REF OUT
 //
-// Writes {subprotocol, channels: {topic: {encoding, schemaName, count, failures, firstError,
-// sample}}, statuses} to OUT.json; count is the messages received within the window.
+// After WARMUP_S of wall time the window opens at the latest stamp of topic REF; the client stops
+// once REF's stamps have advanced WINDOW_S + 1 past it (or after WALL_LIMIT_S). Writes {subprotocol,
+// start, windowS, wallS, channels: {topic: {encoding, schemaName, stamps, wallCount, received,
+// failures, firstError, sample}}, statuses} to OUT: stamps are those (s) of the messages
+// received after the warm-up, wallCount the messages received in the wall window.
 'use strict';
 const path = require('path');
 
@@ -17,7 +21,7 @@ const { parse } = require(path.join(web, '@foxglove/rosmsg'));
 const { MessageReader } = require(path.join(web, '@foxglove/rosmsg2-serialization'));
 const fs = require('fs');
 
-const [url, warmupS, windowS, out] = process.argv.slice(2);
+const [url, warmupS, windowS, wallLimitS, reference, out] = process.argv.slice(2);
 
 // A protobuf message's wire format, walked field by field to its end: a decode that checks
 // every tag, varint and length (the schema's FileDescriptorSet would need protobufjs).
@@ -64,15 +68,42 @@ const client = new FoxgloveClient({ ws });
 const channels = {}; // topic -> result
 const bySubscription = new Map();
 const statuses = [];
-let windowStart = null;
-let windowEnd = null;
+let warm = false;
+let latestStamp = -Infinity;
+let start = null;
+let wallStart = null;
+
+// A message's own time (s): its header's, a TF message's first transform's, a marker array's
+// first marker's; null for a message without one.
+function stampOf(m) {
+  const header = m && (m.header || (m.transforms && m.transforms[0] && m.transforms[0].header)
+    || (m.markers && m.markers[0] && m.markers[0].header));
+  if (!header || !header.stamp) return null;
+  return header.stamp.sec + header.stamp.nanosec * 1e-9;
+}
+
+// /diagnostics is shared by every graph of the ROS domain: a status array none of whose names
+// is in REF's namespace is another graph's (counted as foreign, not in stamps).
+const namespace = reference.slice(0, reference.lastIndexOf('/'));
+function foreign(m) {
+  return Array.isArray(m && m.status) && m.status.length > 0
+    && !m.status.some((s) => s.name.startsWith(`${namespace}/`));
+}
+
+function finish(code, extra) {
+  fs.writeFileSync(out, JSON.stringify({ subprotocol: ws.protocol, start, windowS: Number(windowS),
+    wallS: wallStart === null ? 0 : (Date.now() - wallStart) / 1000, channels, statuses,
+    ...extra }));
+  client.close();
+  process.exit(code);
+}
 
 client.on('advertise', (list) => {
   for (const channel of list) {
     if (channels[channel.topic]) continue;
     let decode;
-    const result = { encoding: channel.encoding, schemaName: channel.schemaName, count: 0,
-      received: 0, failures: 0, firstError: null, sample: null };
+    const result = { reference: channel.topic === reference, encoding: channel.encoding, schemaName: channel.schemaName, stamps: [],
+      wallCount: 0, foreign: 0, received: 0, failures: 0, firstError: null, sample: null };
     try { decode = decoderOf(channel); } catch (e) {
       result.failures += 1; result.firstError = `schema: ${e}`; decode = null;
     }
@@ -84,7 +115,6 @@ client.on('status', (s) => statuses.push(s.message));
 client.on('message', ({ subscriptionId, data }) => {
   const sub = bySubscription.get(subscriptionId);
   if (!sub) return;
-  const now = Date.now();
   sub.result.received += 1;
   let message;
   try {
@@ -94,7 +124,15 @@ client.on('message', ({ subscriptionId, data }) => {
     if (!sub.result.firstError) sub.result.firstError = String(e);
     return;
   }
-  if (windowStart !== null && now >= windowStart && now < windowEnd) sub.result.count += 1;
+  const stamp = stampOf(message);
+  if (sub.result.reference && stamp !== null && stamp > latestStamp) latestStamp = stamp;
+  if (warm && foreign(message)) {
+    sub.result.foreign += 1;
+  } else if (warm) {
+    sub.result.wallCount += 1;
+    if (stamp !== null) sub.result.stamps.push(stamp);
+    if (start !== null && latestStamp >= start + Number(windowS) + 1) finish(0, {});
+  }
   if (!sub.result.sample) {
     sub.result.sample = JSON.stringify(message, (_k, v) => (typeof v === 'bigint' ? String(v)
       : (ArrayBuffer.isView(v) ? Array.from(v) : v))).slice(0, 300);
@@ -102,19 +140,11 @@ client.on('message', ({ subscriptionId, data }) => {
 });
 client.on('error', (e) => statuses.push(`error: ${e && e.message ? e.message : e}`));
 client.on('open', () => {
-  windowStart = Date.now() + 1000 * Number(warmupS);
-  windowEnd = windowStart + 1000 * Number(windowS);
   setTimeout(() => {
-    fs.writeFileSync(out, JSON.stringify({ subprotocol: ws.protocol, windowS: Number(windowS),
-      channels, statuses }, null, 1));
-    client.close();
-    process.exit(0);
-  }, windowEnd - Date.now() + 200);
+    warm = true;
+    wallStart = Date.now();
+    start = latestStamp;
+  }, 1000 * Number(warmupS));
+  setTimeout(() => finish(4, { timedOut: true }), 1000 * Number(wallLimitS));
 });
-client.on('close', (event) => {
-  if (windowEnd === null || Date.now() < windowEnd) {
-    fs.writeFileSync(out, JSON.stringify({ subprotocol: ws.protocol, closed: String(
-      event && (event.reason || event.code)), channels, statuses }));
-    process.exit(3);
-  }
-});
+client.on('close', (event) => finish(3, { closed: String(event && (event.reason || event.code)) }));
