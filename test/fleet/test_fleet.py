@@ -38,8 +38,8 @@ def _frames(msg) -> tuple[str, ...]:
 def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_env,
                                                                    tmp_path):
     up = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fleet', '3',
-                '--start-swimming', '--namespace', BASE, '--duration', str(DURATION_S), '--no-status',
-                '--out', str(tmp_path)])
+                '--start-swimming', '--namespace', BASE, '--duration', str(DURATION_S),
+                '--no-status', '--out', str(tmp_path)])
     deadline = time.monotonic() + UP_TIMEOUT_S
     lines = []
     for line in up.stdout:

@@ -1,6 +1,8 @@
 """
-The fish starts still: with cpg_node's autostart false the planner holds the servos at neutral
-and says `still` until the first command, then starts the CPG (in-process, on its own domain).
+The fish starts still until its first command, then the planner starts the CPG.
+
+With cpg_node's autostart false the planner holds the servos at neutral and says `still` until
+the first command, then calls the CPG's start (in-process, on the test's own domain).
 
 The commands: a cmd_vel that asks to move, and a manual override (a retune applied: a set of
 the CPG's eq 1 parameters).
