@@ -91,7 +91,8 @@ def parameter_message(name: str, text: str, declared_type: int | None = None):
     if declared_type == DOUBLE and isinstance(value, int) and not isinstance(value, bool):
         value = float(value)
     message = Parameter(name, value=value).to_parameter_msg()
-    if declared_type not in (None, 0) and message.value.type != declared_type:
+    if declared_type is not None and declared_type != 0 and \
+            message.value.type != declared_type:
         raise ValueError(f'{name} is a {TYPE_WORDS[declared_type]}, {text!r} is a '
                          f'{TYPE_WORDS.get(message.value.type, "value")}: give '
                          f'{EXAMPLES.get(declared_type, "a value of that type")}')
