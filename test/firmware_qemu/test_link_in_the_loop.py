@@ -20,12 +20,14 @@ from cobs import cobs
 import pytest
 from qemu_loop import board_time_of, Console, Tap
 from wirefish_bridge.codec import encode_body, FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, Role, ServoCommand,
-                                      Status, Telemetry)
+from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, PROTOCOL_VERSION, Role,
+                                      ServoCommand, Status, Telemetry)
 from wirefish_bringup.graph import entry
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
+# A host of a version the board does not speak.
+OTHER_VERSION = PROTOCOL_VERSION + 1
 # The graph's servo_cmd rate (the CPG's stream, as the registry lists it).
 GRAPH_RATE_HZ = entry('cpg_node').rates_hz['servo_cmd']
 # PROTOCOL.md's firmware defaults.
@@ -33,6 +35,8 @@ COMMAND_TIMEOUT_MS = 500
 HEARTBEAT_TIMEOUT_MS = 1500
 TELEMETRY_PERIOD_MS = 10
 CLOCK_RESOLUTION_MS = 1
+# The stream failsafe's way to neutral (PROTOCOL.md's failsafe_slew_rad_s default).
+FAILSAFE_SLEW_RAD_S = 2.0
 # The firmware answers each kind of damage with at most one ERROR per this interval.
 ERROR_INTERVAL_MS = 20
 
@@ -50,7 +54,8 @@ def command_at(i: int) -> tuple[float, float]:
 
 def _connected(probe) -> bool:
     values = probe.last_diagnostics()
-    return values.get('link_state') == 'connected' and values.get('fish_protocol_version') == '1'
+    return (values.get('link_state') == 'connected'
+            and values.get('fish_protocol_version') == str(PROTOCOL_VERSION))
 
 
 def _telemetry(tap: Tap) -> list[Telemetry]:
@@ -73,27 +78,44 @@ def _servo_commands(tap: Tap, start: int = 0) -> list:
             and not c.dropped]
 
 
-def _align(wanted: list[float], seen: list[float], tolerance: float
-           ) -> tuple[int, list[tuple[int, float]], int]:
-    """
-    Return how many of ``wanted`` appear in ``seen`` in order, those that do not, and neutrals.
+def _toward_neutral(value: float, before: float | None, tolerance: float) -> bool:
+    """Return True when ``value`` lies between ``before`` and 0: a step of the failsafe slew."""
+    if before is None:
+        return abs(value) <= tolerance
+    return abs(value) <= abs(before) + tolerance and (value * before >= 0 or
+                                                      abs(value) <= tolerance)
 
-    A neutral write between two commands that is none of them is the board's command-timeout
-    failsafe (the emulator or the host stalled past the timeout): skipped and counted, and
-    the caller holds it against the FAILSAFE_COMMAND flag of the board's telemetry.
+
+def _align(wanted: list[float], seen: list[float], tolerance: float
+           ) -> tuple[int, list[tuple[int, float]], int, int]:
     """
-    matched, missed, neutrals, j = 0, [], 0, 0
+    Return how many of ``wanted`` were applied, those that were not, failsafe episodes, writes.
+
+    The last figure is how many of ``seen`` were accounted for (commands and failsafe steps).
+
+    Writes between two commands that are none of them and move towards neutral are the board's
+    command-timeout failsafe (the emulator or the host stalled past the timeout), which slews
+    to neutral at a bounded rate (PROTOCOL.md): skipped, each run of them counted once as an
+    episode, and the caller holds the count against the FAILSAFE_COMMAND flag of the board's
+    telemetry. A neutral command that the slew already reached writes nothing: it counts as
+    applied when the last write was neutral.
+    """
+    matched, missed, episodes, j = 0, [], 0, 0
     for i, angle in enumerate(wanted):
+        slewing = False
         while (j < len(seen) and abs(seen[j] - angle) > tolerance
-               and abs(seen[j]) <= tolerance):
-            neutrals += 1
+               and _toward_neutral(seen[j], seen[j - 1] if j else None, tolerance)):
+            episodes += 0 if slewing else 1
+            slewing = True
             j += 1
         if j < len(seen) and abs(seen[j] - angle) <= tolerance:
             matched += 1
             j += 1
+        elif abs(angle) <= tolerance and j > 0 and abs(seen[j - 1]) <= tolerance:
+            matched += 1   # the failsafe's slew was at neutral already
         else:
             missed.append((i, angle))
-    return matched, missed, neutrals
+    return matched, missed, episodes, j
 
 
 def _wait_board_time(tap: Tap, board_ms: int, timeout_s: float = 90.0) -> None:
@@ -129,12 +151,32 @@ def _first_after_deadline(telemetry: list[Telemetry], arrival: int, timeout_ms: 
     early = [t for t in after if t.board_time_ms < arrival + timeout_ms + CLOCK_RESOLUTION_MS]
     assert early and all(not t.status & flag for t in early)
     due = [t for t in after if t.board_time_ms >= taken + timeout_ms + CLOCK_RESOLUTION_MS]
-    assert due and all(t.status & flag and (t.servo_1, t.servo_2) == (0.0, 0.0)
-                       for t in due[:5]), due[:2]
+    assert due and all(t.status & flag for t in due[:5]), due[:2]
     first = next(t for t in after if t.status & flag)
+    _slews_to_neutral([t for t in after if t.board_time_ms >= first.board_time_ms])
     previous = after[after.index(first) - 1]
     stall = max(0, first.board_time_ms - previous.board_time_ms - TELEMETRY_PERIOD_MS)
     return first, first.board_time_ms - (taken + timeout_ms + CLOCK_RESOLUTION_MS) - stall
+
+
+def _slews_to_neutral(telemetry: list[Telemetry]) -> None:
+    """
+    Check the failsafe's way to neutral: never a step, and there in bounded time.
+
+    Between two frames no servo moves by more than the slew rate times their board time
+    apart (a float32's rounding allowed), no servo moves away from neutral, and both are at
+    neutral from |angle| / rate plus one telemetry period after the first flagged frame on.
+    """
+    first = telemetry[0]
+    for before, now in zip(telemetry, telemetry[1:]):
+        dt = (now.board_time_ms - before.board_time_ms) * 1e-3
+        for a, b in ((before.servo_1, now.servo_1), (before.servo_2, now.servo_2)):
+            assert abs(b - a) <= FAILSAFE_SLEW_RAD_S * dt + 1e-5 and abs(b) <= abs(a) + 1e-6, (
+                before, now)
+    reach_ms = max(abs(first.servo_1), abs(first.servo_2)) / FAILSAFE_SLEW_RAD_S * 1e3
+    settled = [t for t in telemetry
+               if t.board_time_ms >= first.board_time_ms + reach_ms + TELEMETRY_PERIOD_MS]
+    assert settled and all((t.servo_1, t.servo_2) == (0.0, 0.0) for t in settled), settled[:2]
 
 
 def _wait_console_caught_up(console: Console, tap: Tap, timeout_s: float = 90.0) -> None:
@@ -156,7 +198,8 @@ def test_hello_then_sixty_seconds_of_servo_cmd_every_command_applied(
         not t.status & (Status.FAILSAFE_HEARTBEAT | Status.VERSION_MISMATCH)
         for t in _telemetry(tap)[-5:]), 10.0)
     assert probe.spin_until(
-        lambda: 'fish says hello (protocol 1)' in (tmp_path / 'bridge.log').read_text(), 5.0)
+        lambda: f'fish says hello (protocol {PROTOCOL_VERSION})'
+        in (tmp_path / 'bridge.log').read_text(), 5.0)
     start = len(tap.record.to_board)
     telemetry_start = len(tap.record.to_host)
 
@@ -178,14 +221,15 @@ def test_hello_then_sixty_seconds_of_servo_cmd_every_command_applied(
         seen = [(t, console.angle(channel, ticks)) for t, ch, ticks in console.compares
                 if ch == channel and t >= since]
         tick = console.tick_rad(channel)
-        matched, missed, neutrals = _align(changes, [angle for _, angle in seen], tick + 1e-9)
+        matched, missed, neutrals, accounted = _align(changes, [angle for _, angle in seen],
+                                                      tick + 1e-9)
         failsafes = _failsafe_episodes([c.frame.message for c in
                                         tap.record.to_host[telemetry_start:]
                                         if isinstance(c.frame.message, Telemetry)])
         assert neutrals <= failsafes, (
-            f'channel {channel}: {neutrals} neutral writes between commands, '
+            f'channel {channel}: {neutrals} failsafe episodes between commands, '
             f'{failsafes} FAILSAFE_COMMAND episodes in the telemetry')
-        assert not missed and matched + neutrals == len(seen), (
+        assert not missed and accounted == len(seen), (
             f'channel {channel}: {len(changes)} commands, {len(seen)} compare writes, '
             f'{matched} matching; not applied (index, angle): {missed[:10]}; console '
             f'dropped {console.lines_dropped} lines, lost {console.rx_lost} bytes; board '
@@ -194,11 +238,12 @@ def test_hello_then_sixty_seconds_of_servo_cmd_every_command_applied(
         expected += len(changes)
         failsafe_writes += neutrals
     # The servo angles the board reports are the commands it was sent (a PWM servo reports
-    # what it is commanded), never anything else.
+    # what it is commanded), or the failsafe's way to neutral, never anything else.
     commanded = {(c.frame.message.servo_1, c.frame.message.servo_2) for c in sent}
-    reported = [(t.servo_1, t.servo_2) for t in (c.frame.message for c in
-                tap.record.to_host[telemetry_start:]) if isinstance(t, Telemetry)]
-    assert set(reported) <= commanded | {(0.0, 0.0)}
+    reported = [t for t in (c.frame.message for c in tap.record.to_host[telemetry_start:])
+                if isinstance(t, Telemetry)]
+    assert all((t.servo_1, t.servo_2) in commanded | {(0.0, 0.0)}
+               or t.status & Status.FAILSAFE_COMMAND for t in reported)
     errors = _errors(tap)
     diagnostics = probe.last_diagnostics()
     neutral = sum(1 for c in sent if (c.frame.message.servo_1, c.frame.message.servo_2)
@@ -207,7 +252,7 @@ def test_hello_then_sixty_seconds_of_servo_cmd_every_command_applied(
           f'{len(sent) - neutral} SERVO_CMD frames sent by the bridge (then {neutral} '
           f'neutral), {applied} compare writes, each the command it follows within one '
           f'timer tick (every command on both channels, then neutral once), '
-          f'{failsafe_writes} failsafe neutral writes between commands; '
+          f'{failsafe_writes} failsafe episodes between commands; '
           f'{len(reported)} telemetry frames; bridge: crc_errors {diagnostics["crc_errors"]}, '
           f'seq gaps {diagnostics["drops"]}; board side: ERROR frames {len(errors)}, '
           f'host stream crc errors {tap.host_decoder.stats.crc_errors} gaps '
@@ -229,7 +274,8 @@ def test_commands_stopped_on_the_wire_failsafe_command_and_neutral(
     probe.spin_for(0.5, lambda i: (0.4, -0.4), GRAPH_RATE_HZ)
     _wait_console_caught_up(console, tap)
     last_arrival = board_time_of(console, _servo_commands(tap)[-1])
-    while _telemetry(tap)[-1].board_time_ms <= last_arrival + COMMAND_TIMEOUT_MS + 100:
+    slew_ms = 0.4 / FAILSAFE_SLEW_RAD_S * 1e3   # the failsafe's way from 0.4 rad to neutral
+    while _telemetry(tap)[-1].board_time_ms <= last_arrival + COMMAND_TIMEOUT_MS + slew_ms + 100:
         probe.spin_for(0.2, lambda i: (0.4, -0.4), GRAPH_RATE_HZ)
     telemetry = _telemetry(tap)
     held = [t for t in telemetry if last_arrival < t.board_time_ms
@@ -290,7 +336,7 @@ def test_a_host_of_another_version_gets_error_5_and_the_servos_stay_neutral(boar
         while time.monotonic() < end:
             if time.monotonic() - last_heartbeat >= 0.2:
                 heartbeat_seqs.append(encoder.next_seq)
-                os.write(fd, encoder.encode(Heartbeat(version=2, role=Role.HOST)))
+                os.write(fd, encoder.encode(Heartbeat(version=OTHER_VERSION, role=Role.HOST)))
                 last_heartbeat = time.monotonic()
             os.write(fd, encoder.encode(ServoCommand(0.5, -0.5)))
             time.sleep(0.02)
@@ -315,7 +361,7 @@ def test_a_host_of_another_version_gets_error_5_and_the_servos_stay_neutral(boar
     errors = [f.message for f in frames if isinstance(f.message, ErrorReport)]
     telemetry = [f.message for f in frames if isinstance(f.message, Telemetry)]
     mismatched = [t for t in telemetry if t.status & Status.VERSION_MISMATCH]
-    print(f'\nversion 2 host: {len(heartbeat_seqs)} heartbeats, ERROR frames '
+    print(f'\nversion {OTHER_VERSION} host: {len(heartbeat_seqs)} heartbeats, ERROR frames '
           f'{[(e.code, e.ref_seq) for e in errors]}, {len(mismatched)} telemetry frames with '
           f'VERSION_MISMATCH, compare writes after boot {console.compares[2:]}')
     assert [e.code for e in errors] == [ErrorCode.VERSION_MISMATCH] * len(heartbeat_seqs)

@@ -112,11 +112,13 @@ static void pin_output(unsigned pin)
                              (GPIO_MODE_OUTPUT << (2u * pin));
 }
 
-static void recover(void)
+/* Counted when it was needed: a line held low, or BUSY stuck past the timeout (the analog
+ * filter's lock-up, both lines high). A recovery after a plain NACK (an absent sensor, probed
+ * every 100 ms) finds the bus idle and is not counted. */
+static void recover(bool busy_stuck)
 {
     static const wf_i2c_lines_t lines = {NULL, scl, sda, scl_high, sda_high, half_bit};
-    const bool held = (I2C_SR2(I2C1_BASE) & I2C_SR2_BUSY) || !pin_high(SDA_PIN) ||
-                      !pin_high(SCL_PIN);
+    const bool held = busy_stuck || !pin_high(SDA_PIN) || !pin_high(SCL_PIN);
     I2C_CR1(I2C1_BASE) = 0u;   /* PE off: the pins are the GPIO's */
     pin_level(SCL_PIN, true);
     pin_level(SDA_PIN, true);
@@ -136,7 +138,7 @@ void board_i2c_init(void)
     RCC_APB1ENR |= RCC_APB1ENR_I2C1;
     gpio_alternate(GPIOB_BASE, SCL_PIN, 4u, 1);
     gpio_alternate(GPIOB_BASE, SDA_PIN, 4u, 1);
-    recover();   /* a reset in the middle of a read leaves the sensor holding SDA */
+    recover(false);   /* a reset in the middle of a read leaves the sensor holding SDA */
 }
 
 /* --- transfers -------------------------------------------------------------------------- */
@@ -260,7 +262,7 @@ bool wf_hal_i2c_transfer(uint8_t address7, const uint8_t *tx, size_t tx_len, uin
 {
     uint32_t started = wf_hal_millis();
     if (!bus_idle(started)) {
-        recover();
+        recover(true);
         started = wf_hal_millis();
         if (!bus_idle(started)) {
             return false;
@@ -277,7 +279,7 @@ bool wf_hal_i2c_transfer(uint8_t address7, const uint8_t *tx, size_t tx_len, uin
     }
     if (!ok) {
         I2C_CR1(I2C1_BASE) |= I2C_CR1_STOP;
-        recover();
+        recover(false);
     }
     return ok;
 }

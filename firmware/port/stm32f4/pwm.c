@@ -25,7 +25,11 @@ void board_pwm_set_failsafe(const uint32_t compare[2])
 }
 
 /* The fault path's write: only registers, nothing that could itself fault on a broken state.
- * Preloaded: the pulse under way finishes, the next one is neutral. */
+ * The compares are preloaded: the pulse under way finishes and the next one is neutral. The
+ * reset that follows stops the timer and leaves the pins without pulses until the next boot
+ * writes neutral again, so one neutral pulse is let out first: the wait for the next update
+ * and for that pulse's end is at most two frames (40 ms at 50 Hz), inside the watchdog's
+ * shortest 102 ms, and counted in microseconds of SysTick (interrupts are masked here). */
 void board_pwm_failsafe(void)
 {
     if (period_ticks == 0u) {
@@ -33,6 +37,17 @@ void board_pwm_failsafe(void)
     }
     TIM_CCR1(TIM3_BASE) = failsafe_compare[0];
     TIM_CCR2(TIM3_BASE) = failsafe_compare[1];
+    const uint32_t longest = failsafe_compare[0] > failsafe_compare[1] ? failsafe_compare[0]
+                                                                       : failsafe_compare[1];
+    enum { STEP_US = 10 };
+    uint32_t steps = 2u * period_ticks / STEP_US + 1u;   /* 1 tick = 1 us */
+    TIM_SR(TIM3_BASE) = ~TIM_SR_UIF;   /* rc_w0: writing 0 clears the update flag */
+    for (; steps > 0u && !(TIM_SR(TIM3_BASE) & TIM_SR_UIF); steps--) {
+        board_delay_us(STEP_US);
+    }
+    for (; steps > 0u && TIM_CNT(TIM3_BASE) <= longest; steps--) {
+        board_delay_us(STEP_US);
+    }
 }
 
 uint32_t board_pwm_period(void)

@@ -133,6 +133,7 @@
 #define TIM2_BASE 0x40000000u
 #define TIM3_BASE 0x40000400u
 #define TIM_CR1(base) WF_REG((base) + 0x00u)
+#define TIM_SR(base) WF_REG((base) + 0x10u)
 #define TIM_EGR(base) WF_REG((base) + 0x14u)
 #define TIM_CCMR1(base) WF_REG((base) + 0x18u)
 #define TIM_CCER(base) WF_REG((base) + 0x20u)
@@ -141,6 +142,7 @@
 #define TIM_CCR1(base) WF_REG((base) + 0x34u)
 #define TIM_CCR2(base) WF_REG((base) + 0x38u)
 #define TIM_CNT(base) WF_REG((base) + 0x24u)
+#define TIM_SR_UIF (1u << 0)
 #define TIM_CR1_CEN (1u << 0)
 #define TIM_CR1_ARPE (1u << 7)
 #define TIM_EGR_UG (1u << 0)
