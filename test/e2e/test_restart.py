@@ -9,10 +9,11 @@ longer than MAX_PAUSE_S. Checks that belong to one victim (the bridge holding th
 while the CPG is gone, the tuner answering again, the recorder writing on into the same bag)
 are in VICTIM_CHECKS. After the kills the graph is stopped and its one bag is read: it opens
 with rosbags, and no publisher sequence number of any topic is missing except while the
-recorder itself was down (from at most KILL_MARGIN_S before its kill). The crash-loop
-test gives the tuner a parameter it refuses at start-up, so it exits at once every time: the
-launcher backs off, gives up on it and keeps the rest running. (A required node that spends its
-budget stops the graph: test/bringup/test_supervisor.py, without the cost of a whole graph.)
+recorder itself was down (from at most KILL_MARGIN_S before its kill). The refusal test gives
+the tuner a parameter it refuses at start-up: a configuration error, which the launcher says on
+the terminal and does not restart, keeping the rest running. (A crash loop's back-off, and a
+required node that spends its budget stopping the graph: test/bringup/test_supervisor.py,
+without the cost of a whole graph.)
 """
 
 from collections.abc import Callable, Iterator
