@@ -6,7 +6,8 @@ import pytest
 from wirefish_bridge.codec import DecoderStats
 from wirefish_bridge.link_health import (DECODER_KEYS, identifies_fish, Level, LINK_KEYS,
                                          LinkHealth, RateMeter)
-from wirefish_bridge.protocol import ErrorReport, Heartbeat, Role, ServoCommand, Telemetry
+from wirefish_bridge.protocol import (ErrorReport, Heartbeat, Role, ServoCommand, Status,
+                                      Telemetry, TelemetryCompact)
 from wirefish_bridge.transport import LinkState, LinkStats
 
 PORT = '/dev/fish'
@@ -82,3 +83,15 @@ def test_rate_meter_counts_per_second_between_readings():
     meter = RateMeter(now=0.0)
     assert meter.rate(2.0, 100) == 50.0
     assert meter.rate(3.0, 100) == 0.0
+
+
+def test_compact_telemetry_is_judged_and_taken_as_the_full_form(health):
+    coasting = TelemetryCompact.from_telemetry(Telemetry(
+        1, 0.0, 0.0, 3.14159, (0.0, 0.0, 0.0), (0.0, 0.0, 9.8), 0.4, -0.4, 8.0,
+        int(Status.GAIT_MODE | Status.COASTING), 7))
+    assert health.on_telemetry(coasting, now=11.0) is None
+    assert health.fish_status == Status.GAIT_MODE | Status.COASTING
+    impossible = TelemetryCompact.from_telemetry(TELEMETRY)  # gait id 0 yet coasting
+    assert 'gait mode' in health.on_telemetry(
+        TelemetryCompact(**{**impossible.__dict__, 'status': int(Status.COASTING)}), now=12.0)
+    assert health.telemetry_rejected == 1
