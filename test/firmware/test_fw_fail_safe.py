@@ -21,8 +21,8 @@ from mpu6050_model import (ACCEL_CONFIG, GYRO_CONFIG, Mpu6050Model, PWR_MGMT_1, 
                            WHO_AM_I)
 import pytest
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import (Health, HealthFlags, Heartbeat, PROTOCOL_VERSION,
-                                      ResetCause, Role, ServoCommand, Status)
+from wirefish_bridge.protocol import (ClockSource, Health, HealthFlags, Heartbeat,
+                                      PROTOCOL_VERSION, ResetCause, Role, ServoCommand, Status)
 
 IMU_PERIOD_MS = 5
 STUCK_SAMPLES = 20
@@ -49,6 +49,7 @@ class Port:
             'wf_host_watchdog_reset': [],
             'wf_host_set_reset_flags': [ctypes.c_uint32],
             'wf_hal_health_port': [ctypes.POINTER(HealthRecord)],
+            'wf_host_set_clock_source': [ctypes.c_uint8],
         }.items():
             getattr(lib, name).argtypes = argtypes
             getattr(lib, name).restype = None
@@ -162,6 +163,18 @@ def test_the_record_is_read_once_and_a_power_loss_voids_it(port: Port):
     port.board.lib.wf_host_set_reset_flags(POR | BOR | PIN)
     port.boot()   # power went while the record was pending: RAM is not to be trusted
     assert port.health().reset_cause == ResetCause.POWER_ON
+
+
+@pytest.mark.parametrize('source, fallback', [
+    (ClockSource.HSE_PLL, False), (ClockSource.HSI_PLL, True), (ClockSource.HSI, True),
+])
+def test_a_clock_fallback_is_flagged_in_status_and_health(port: Port, source: ClockSource,
+                                                          fallback: bool):
+    port.board.lib.wf_host_reset()
+    port.board.lib.wf_host_set_clock_source(source)
+    output = port.boot() + port.run(1, 20)
+    assert bool(port.board.snapshot().status & Status.CLOCK_FALLBACK) is fallback
+    assert healths(output)[0].clock_source == source
 
 
 # --- servo limits ------------------------------------------------------------------------

@@ -31,6 +31,7 @@ static struct {
     wf_health_t health; /* the port's fields only */
     wf_host_i2c_lines_fn lines;
     void *lines_context;
+    uint8_t clock_source; /* what the next boot's clock set-up reaches */
 } port;
 
 void wf_host_reset(void)
@@ -41,7 +42,10 @@ void wf_host_reset(void)
     memset(&port, 0, sizeof port);
     /* A power cycle: RAM holds nothing valid; power-on sets POR, BOR and PIN (RM0090 7.3.21). */
     port.reset_flags = WF_RESET_FLAG_POR | WF_RESET_FLAG_BOR | WF_RESET_FLAG_PIN;
+    port.clock_source = WF_CLOCK_EMULATED;
 }
+
+void wf_host_set_clock_source(uint8_t source) { port.clock_source = source; }
 
 /* --- the reset path ------------------------------------------------------------------- */
 static void recover_bus(void);
@@ -53,7 +57,7 @@ void wf_host_boot(void)
     port.health.i2c_bus_recoveries = recoveries;
     wf_reset_cause_decide(port.reset_flags, &port.record, &port.health);
     port.reset_flags = 0u; /* RMVF */
-    port.health.clock_source = WF_CLOCK_EMULATED;
+    port.health.clock_source = port.clock_source;
     recover_bus(); /* the stm32f4 port's I2C init runs the recovery too */
 }
 

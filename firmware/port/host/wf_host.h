@@ -70,6 +70,9 @@ void wf_host_watchdog_reset(void);
 void wf_host_set_reset_flags(uint32_t flags);
 void wf_host_set_failsafe_compares(const uint32_t compare[WF_SERVO_COUNT]);
 void wf_host_set_uart_overruns(uint32_t count);
+/* The clock source the next boot reaches (wf_clock_source_t; EMULATED after wf_host_reset):
+ * HSI_PLL or HSI model the stm32f4 port's fallback from a dead crystal. */
+void wf_host_set_clock_source(uint8_t source);
 
 /* A flat view of a board for tests. */
 typedef struct {
