@@ -45,9 +45,27 @@ def test_same_named_processes_are_all_stopped_with_exit_code_0(tmp_path, ros_env
 
 
 def _failing_cpg(policy: RestartPolicy) -> NodeSpec:
-    # A rate the CPG refuses: it exits 1 at once at every start.
+    # A crash at every start: rcl cannot open the parameter file (a traceback, exit 1).
     return NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node',
-                    ('--ros-args', '-p', 'publish_rate_hz:=-1.0'), restart=policy)
+                    ('--ros-args', '--params-file', '/nonexistent/wirefish.yaml'),
+                    restart=policy)
+
+
+def test_a_node_refusing_its_parameters_is_given_up_at_once_with_its_reason(tmp_path, ros_env):
+    supervisor = Supervisor(tmp_path, env=ros_env)
+    # A rate the CPG refuses: one FATAL line and exit 1, at every start alike.
+    supervisor.start(NodeSpec('wirefish_cpg', 'cpg_node', 'cpg_node',
+                              ('--ros-args', '-p', 'publish_rate_hz:=-1.0'),
+                              restart=RestartPolicy(delay_s=0.1)))
+    try:
+        lines = _supervise_until(supervisor, lambda: 'cpg_node' in supervisor.given_up)
+    finally:
+        supervisor.stop()
+    assert len(lines) == 1, lines
+    assert lines[0].startswith('cpg_node refused its start-up parameters and is not restarted'), \
+        lines
+    assert 'publish_rate_hz' in lines[0] and lines[0].endswith('the rest keeps running'), lines
+    assert supervisor.budgets['cpg_node'].total == 0
 
 
 def _supervise_until(supervisor: Supervisor, done, timeout_s: float = 60.0) -> list[str]:
