@@ -97,7 +97,7 @@ SCENARIOS = [
     Scenario('gait_version_mismatch', duration_ms=1600, commands_until_ms=50,
              heartbeats_until_ms=1600, resume_at_ms=1600, version=1,
              events={100: (TABLE_1,), 500: (Heartbeat(1, Role.HOST, 500),),
-                     600: (replace(TABLE_1, gait_id=2),), 800: (Heartbeat(),),
+                     600: (replace(TABLE_1, gait_id=2), LinkConfig(50)), 800: (Heartbeat(),),
                      900: (replace(TABLE_1, gait_id=3),)}),
 ]
 
@@ -219,6 +219,9 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
         worst.see(tuple(state.target), fish.target, k + 1)
         statuses.add(state.status)
     print(f'{scenario.name}: servo angles within {worst.rad:.2e} rad (at {worst.at_ms} ms)')
+    assert board.gait().acks_dropped == fish.acks_dropped
+    if len(scenario.events.get(900, ())) == 6 and not scenario.damage:
+        assert fish.acks_dropped == 2   # a burst of six GAITs against a queue of four
     assert fish_frames.stats.resyncs == board_frames.stats.resyncs == 0
     assert {'Telemetry', 'Heartbeat', 'Health'} <= seen
     if scenario.version != PROTOCOL_VERSION or scenario.damage:
