@@ -4,7 +4,7 @@ The firmware's host build from Python: the make step and ctypes bindings of wf_h
 ``build_firmware`` runs ``make -C firmware`` once per process under a file lock (pytest-xdist
 workers share the tree); ``FirmwareHost`` wraps ``build/host/libwirefish_fw.so``: the process's
 one board (init, step at a time, snapshots of its state, its gait mode and its health, I2C
-device model, ADC), a lone CPG and the batch codec; ``random_messages`` draws valid messages of
+device model, ADC) and the batch codec; ``random_messages`` draws valid messages of
 every type as flat records, ``to_python`` makes the wirefish_bridge message of one and
 ``to_record`` the record of a message.
 """
