@@ -19,5 +19,5 @@ def test_a_view_port_in_use_is_one_line_naming_the_flag(tmp_path, ros_env):
     lines = result.stderr.strip().splitlines()
     assert lines == [f'wirefish up: the live view cannot bind 127.0.0.1:{port} (Address already '
                      'in use; another `wirefish view` or `wirefish up --view`?): give '
-                     '--view-port another port'], result.stderr
+                     '--view-port another port (0: any free one)'], result.stderr
     assert not (tmp_path / 'out').exists()  # nothing started, nothing written

@@ -293,6 +293,8 @@ def _view_ports_problem(params: dict, namespace: str) -> str | None:
     for key, block in params.items():  # later keys of the file win, as rcl reads them
         if matched_nodes(key, [view_node]):
             values.update((k, v) for k, v in block['ros__parameters'].items() if k in values)
+    taken: list[tuple[str, str]] = []  # (address:port, the option that changes it)
+    why = ''
     for name, flag in (('port', '--view-port'), ('http_port', '--view-http-port')):
         if int(values[name]) <= 0:  # 0: any free port; -1: no dashboard
             continue
@@ -301,10 +303,14 @@ def _view_ports_problem(params: dict, namespace: str) -> str | None:
             try:
                 probe.bind((str(values['address']), int(values[name])))
             except OSError as error:
-                return (f'the live view cannot bind {values["address"]}:{values[name]} '
-                        f'({error.strerror}; another `wirefish view` or `wirefish up --view`?): '
-                        f'give {flag} another port')
-    return None
+                taken.append((f'{values["address"]}:{values[name]}', flag))
+                why = error.strerror or str(error)
+    if not taken:
+        return None
+    return (f'the live view cannot bind {" and ".join(where for where, _ in taken)} ({why}; '
+            'another `wirefish view` or `wirefish up --view`?): give '
+            f'{" and ".join(flag for _, flag in taken)} '
+            f'{"another port" if len(taken) == 1 else "other ports"} (0: any free one)')
 
 
 def _report(lines: list[str]) -> None:
