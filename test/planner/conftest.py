@@ -39,16 +39,49 @@ class PlannerGraph:
     domain_id: int
     namespace: str
     link: Path
+    simulated: bool = False  # on fish_sim's clock (<namespace>/clock), as `wirefish up --sim`
 
 
-def _ros_args(namespace: str, *extra: str) -> list[str]:
-    params = Path(get_package_share_directory('wirefish_bringup'), 'config', 'wirefish.yaml')
-    return ['--ros-args', '-r', f'__ns:={namespace}', '--params-file', str(params), *extra]
+def _default_params() -> Path:
+    return Path(get_package_share_directory('wirefish_bringup'), 'config', 'wirefish.yaml')
+
+
+def _ros_args(namespace: str, *extra: str, params: Path | None = None) -> list[str]:
+    return ['--ros-args', '-r', f'__ns:={namespace}', '--params-file',
+            str(params or _default_params()), *extra]
+
+
+def _simulated_params(directory: Path) -> Path:
+    """Return the graph's parameters with what `wirefish up` sets on simulated time."""
+    import yaml
+    from wirefish_bringup.graph import SIM_TIME_COMMAND_RATE_HZ
+
+    values = yaml.safe_load(_default_params().read_text())
+    values['/**/bridge_node']['ros__parameters']['max_command_rate_hz'] = float(
+        SIM_TIME_COMMAND_RATE_HZ)
+    path = directory / 'wirefish_simulated.yaml'
+    path.write_text(yaml.safe_dump(values))
+    return path
 
 
 def start_planner_graph(domain_id: int, namespace: str = NAMESPACE,
-                        fish_flags: tuple[str, ...] = ()) -> PlannerGraph:
-    """Start fish_sim, bridge_node, cpg_node and planner_node; return once the fish is up."""
+                        fish_flags: tuple[str, ...] = (), speed: str | None = None,
+                        directory: Path | None = None) -> PlannerGraph:
+    """
+    Start fish_sim, bridge_node, cpg_node and planner_node; return once the fish is up.
+
+    ``speed``: on the virtual fish's clock at that pace (fish_sim --speed, every node on
+    ``<namespace>/clock`` with use_sim_time, as `wirefish up --sim` starts them); the run's
+    parameter file goes to ``directory``. None: the wall clock.
+    """
+    if speed is not None:
+        from wirefish_bringup.graph import clock_topic
+        assert directory is not None, 'a graph on simulated time needs a directory'
+        params = _simulated_params(directory)
+        timed = ('-p', 'use_sim_time:=true', '-r', f'/clock:={clock_topic(namespace)}')
+        fish_flags = (*fish_flags, '--speed', speed)
+    else:
+        params, timed = None, ()
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1',
                RCUTILS_COLORIZED_OUTPUT='0')
@@ -62,15 +95,16 @@ def start_planner_graph(domain_id: int, namespace: str = NAMESPACE,
         return procs[name]
 
     fish = start('fish_sim', [executable('wirefish_sim', 'fish_sim'), '--link', str(link),
-                              '--ros', *fish_flags, *_ros_args(namespace)])
+                              '--ros', *fish_flags, *_ros_args(namespace, params=params)])
     if not fish.stdout.readline():
         raise RuntimeError('fish_sim did not start: ' + fish.stdout.read())
     start('bridge_node', [executable('wirefish_bridge', 'bridge_node'),
-                          *_ros_args(namespace, '-p', f'port:={link}')])
-    start('cpg_node', [executable('wirefish_cpg', 'cpg_node'), *_ros_args(namespace)])
+                          *_ros_args(namespace, '-p', f'port:={link}', *timed, params=params)])
+    start('cpg_node', [executable('wirefish_cpg', 'cpg_node'),
+                       *_ros_args(namespace, *timed, params=params)])
     start('planner_node', [executable('wirefish_planner', 'planner_node'),
-                           *_ros_args(namespace)])
-    return PlannerGraph(procs, env, domain_id, namespace, link)
+                           *_ros_args(namespace, *timed, params=params)])
+    return PlannerGraph(procs, env, domain_id, namespace, link, simulated=speed is not None)
 
 
 def stop_planner_graph(graph: PlannerGraph) -> dict[str, int | None]:
@@ -97,8 +131,13 @@ class Recording:
 class Driver:
     """A node in the test process: publishes cmd_vel at 20 Hz, records the graph."""
 
-    def __init__(self, context, namespace: str) -> None:
-        """Create the node, its subscriptions and the cmd_vel timer; spin on a thread."""
+    def __init__(self, context, namespace: str, simulated: bool = False) -> None:
+        """
+        Create the node, its subscriptions and the cmd_vel sender; spin on a thread.
+
+        ``simulated``: the probe's clock is the graph's simulated time (``now``, ``sleep``
+        and the 20 Hz of cmd_vel are simulated seconds), else the wall clock.
+        """
         from diagnostic_msgs.msg import DiagnosticArray
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
@@ -108,7 +147,15 @@ class Driver:
         from wirefish_msgs.msg import PlannerState
 
         self._twist = Twist
-        self.node = rclpy.create_node('h8_driver', namespace=namespace, context=context)
+        from rclpy.parameter import Parameter
+        from wirefish_bringup.graph import clock_topic
+
+        self.simulated = simulated
+        timed = {'cli_args': ['--ros-args', '-r', f'/clock:={clock_topic(namespace)}'],
+                 'parameter_overrides': [Parameter('use_sim_time', value=True)]
+                 } if simulated else {}
+        self.node = rclpy.create_node('h8_driver', namespace=namespace, context=context,
+                                      **timed)
         self.recording = Recording()
         self.command: tuple[float, float] | None = None  # None: publish nothing
         self._lock = threading.Lock()
@@ -134,20 +181,36 @@ class Driver:
         self._sender.start()
 
     def now(self) -> float:
-        """Return the probe's clock (s)."""
+        """Return the probe's clock (s): simulated time on a simulated graph."""
         return self.node.get_clock().now().nanoseconds * 1e-9
+
+    def sleep(self, seconds: float, wall_timeout_s: float | None = None) -> None:
+        """Wait ``seconds`` of the probe's clock (on a simulated graph: of simulated time)."""
+        if not self.simulated:
+            time.sleep(seconds)
+            return
+        start = self.now()
+        # The clock may run slower than the wall clock on a loaded machine; it never stops
+        # for long (fish_sim waits out a silent host), so a deadline of many times the span.
+        deadline = time.monotonic() + (wall_timeout_s or 30.0 + 10.0 * seconds)
+        while self.now() < start + seconds:
+            assert time.monotonic() < deadline, (
+                f'simulated time moved {self.now() - start:.2f} of {seconds} s')
+            time.sleep(0.005)
 
     def _send_commands(self) -> None:
         period = 1.0 / CMD_RATE_HZ
-        due = time.monotonic()
+        clock = self.now if self.simulated else time.monotonic
+        due = clock()
         while not self._stopping:
             command = self.command
             if command is not None:
                 msg = self._twist()
                 msg.linear.x, msg.angular.z = command
                 self._pub.publish(msg)
-            due = max(due + period, time.monotonic())
-            time.sleep(max(0.0, due - time.monotonic()))
+            due = max(due + period, clock())
+            while clock() < due and not self._stopping:  # 20 Hz of the graph's clock
+                time.sleep(0.002 if self.simulated else max(0.0, due - clock()))
 
     def _on_truth(self, msg) -> None:
         import math
@@ -215,16 +278,32 @@ def planner_graph(planner_domain_id: int) -> Iterator[PlannerGraph]:
         print('exit codes:', codes)
 
 
+@pytest.fixture(scope='module')
+def simulated_planner_graph(planner_domain_id: int, tmp_path_factory) -> Iterator[PlannerGraph]:
+    """Yield the module's graph on fish_sim's clock at --speed 1; stop it afterwards."""
+    graph = start_planner_graph(planner_domain_id, fish_flags=(
+        '--yaw-disturbance', str(YAW_DISTURBANCE_RAD_S)), speed='1',
+        directory=tmp_path_factory.mktemp('simulated_planner'))
+    try:
+        yield graph
+    finally:
+        codes = stop_planner_graph(graph)
+        assert not graph.link.exists(), 'fish_sim left its pty link behind'
+        print('exit codes:', codes)
+
+
 @pytest.fixture
-def driver(planner_graph: PlannerGraph, monkeypatch: pytest.MonkeyPatch) -> Iterator[Driver]:
-    """Yield a driver node on the graph's domain, in a context of its own."""
+def driver(simulated_planner_graph: PlannerGraph,
+           monkeypatch: pytest.MonkeyPatch) -> Iterator[Driver]:
+    """Yield a driver node on the simulated graph's domain and clock, in a context of its own."""
     import rclpy
     from rclpy.context import Context
 
+    planner_graph = simulated_planner_graph
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     context = Context()
     rclpy.init(context=context, domain_id=planner_graph.domain_id)
-    probe = Driver(context, planner_graph.namespace)
+    probe = Driver(context, planner_graph.namespace, simulated=planner_graph.simulated)
     try:
         yield probe
     finally:

@@ -1,8 +1,10 @@
 """
 The planner's acceptance on the virtual fish, across processes, measured on sim/ground_truth.
 
-One graph (fish_sim with a constant yaw disturbance, bridge, CPG, planner) and one drive in
-phases, because each phase needs many seconds of swimming: rest before any cmd_vel; speed
+One graph (fish_sim with a constant yaw disturbance, bridge, CPG, planner) on the virtual
+fish's clock (lockstep, --speed 1: every time below is simulated time, so a loaded machine
+slows the drive down and changes nothing in it) and one drive in phases, because each phase
+needs many seconds of swimming: rest before any cmd_vel; speed
 setpoints 0.10 / 0.20 / 0.30 m/s; 0.6 m/s clamped (planner_state, /diagnostics); yaw rate
 +-0.2 rad/s at 0.2 m/s; heading hold against the current, then the same straight run with the
 hold off (rate loop only) and with the yaw loop off (open loop), printed; cmd_vel stops. The
@@ -46,7 +48,7 @@ def _rate(servo: list, start: float, end: float) -> float:
 def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, float]:
     driver.command = command
     start = driver.now()
-    time.sleep(seconds)
+    driver.sleep(seconds)  # of simulated time: the graph runs on fish_sim's clock
     return start, driver.now()
 
 
@@ -64,7 +66,7 @@ def test_drive_the_virtual_fish(driver):
     # graph's parameters) and the planner holds it there, saying so.
     rest_deadline = time.monotonic() + 20.0
     while True:
-        time.sleep(1.0)
+        driver.sleep(1.0)
         t0 = driver.now()
         resting = _window(rec.servo, t0 - 1.0, t0)  # servo stamps: the CPG node's clock
         rest_amplitude = np.abs(resting[:, 1:3]).max()
@@ -123,7 +125,7 @@ def test_drive_the_virtual_fish(driver):
 
     driver.command = None  # cmd_vel stops
     stopped = driver.now()
-    time.sleep(STOP_WITHIN_S + 1.0)
+    driver.sleep(STOP_WITHIN_S + 1.0)
     after = np.array([r for r in rec.truth if r[0] >= stopped])
     slow = after[after[:, 4] < 0.02]
     stop_time = slow[0, 0] - stopped if len(slow) else math.inf
