@@ -93,3 +93,33 @@ def test_a_retune_applied_starts_the_cpg(graph):
     assert result.successful, result.reason
     assert spin_until(executor, lambda: _moves(servo, since), timeout_s=15.0)
     assert spin_until(executor, lambda: modes[-1] == 'manual', timeout_s=5.0), modes[-1]
+
+
+@pytest.mark.ros
+def test_a_cpg_restarted_mid_drive_is_started_again(graph, ros_context):
+    from wirefish_cpg.cpg_node import CpgNode
+
+    cpg, executor, servo, modes, cmd_vel = graph
+    swim = Twist()
+    swim.linear.x = 0.2
+    since = len(servo)
+
+    def swims_since(start: int):
+        def check() -> bool:
+            cmd_vel.publish(swim)
+            return _moves(servo, start)
+        return check
+
+    assert spin_until(executor, swims_since(since), timeout_s=15.0)
+    executor.remove_node(cpg)
+    cpg.destroy_node()  # the CPG is gone: its start service too
+    spin_until(executor, swims_since(len(servo)), timeout_s=1.0)
+    again = CpgNode(context=ros_context, namespace=NAMESPACE,
+                    parameter_overrides=[Parameter('autostart', value=False)])
+    executor.add_node(again)
+    try:
+        since = len(servo)
+        assert spin_until(executor, swims_since(since), timeout_s=15.0)
+    finally:
+        executor.remove_node(again)
+        again.destroy_node()

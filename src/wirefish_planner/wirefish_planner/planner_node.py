@@ -25,8 +25,9 @@ Drives
 Starts
     the CPG (its ``start`` service, std_srvs/Trigger) once, at the first command since start-up:
     the first cmd_vel that asks to move, or the first manual override it hears (a retune
-    applied). Until then planner_state says ``still`` (the graph's cpg_node starts with
-    ``autostart`` false: the servos at neutral), or ``own_gait`` with ``rest_at_start`` false.
+    applied); and again a CPG restarted after that (its start service gone, then back). Until
+    then planner_state says ``still`` (the graph's cpg_node starts with ``autostart`` false: the
+    servos at neutral), or ``own_gait`` with ``rest_at_start`` false.
     Hears ``cpg_params`` (what the CPG runs: planner_state's cpg_* fields) and ``cpg_status``.
     One owner of the gait: while the CPG is under a manual override (its parameters were set,
     e.g. a retune applied) the planner sends nothing and says so (mode ``manual``); a refused
@@ -84,6 +85,7 @@ class PlannerNode(Node):
         # No command since start-up: the tail is still (or swims the CPG's own start-up gait).
         self._commanded = False
         self._start_pending = False  # the CPG's start is due, its service not yet seen
+        self._cpg_was_ready: bool | None = None  # the CPG's start service at the last tick
         self._wire_cpg()
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
         self._imu_intake: BatchIntake | None = None
@@ -150,8 +152,17 @@ class PlannerNode(Node):
             self._start_cpg()
 
     def _start_cpg(self) -> None:
-        """Call the CPG's start once its service is there (the next tick retries until then)."""
-        if self._start_pending and self._start_client.service_is_ready():
+        """
+        Call the CPG's start once its service is there (the next tick retries until then).
+
+        A CPG that comes back after it was gone (restarted, its start service seen again)
+        starts still like any: once commanded, the planner starts it again.
+        """
+        ready = self._start_client.service_is_ready()
+        if self._commanded and self._cpg_was_ready is False and ready:
+            self._start_pending = True
+        self._cpg_was_ready = ready
+        if self._start_pending and ready:
             self._start_pending = False
             self._start_client.call_async(Trigger.Request())
 
