@@ -469,8 +469,7 @@ class TelemetryCompact(ProtocolMessage, kind=MsgType.TELEMETRY_COMPACT,
         return cls(board_time_ms=t.board_time_ms,
                    roll=quantize(t.roll, ANGLE_LSB_RAD), pitch=quantize(t.pitch, ANGLE_LSB_RAD),
                    yaw=quantize(t.yaw, ANGLE_LSB_RAD),
-                   gyro=tuple(quantize(v, RATE_LSB_RAD_S) for v in t.gyro),
-                   accel=tuple(quantize(v, ACCEL_LSB_M_S2) for v in t.accel),
+                   gyro=_counts(t.gyro, RATE_LSB_RAD_S), accel=_counts(t.accel, ACCEL_LSB_M_S2),
                    servo_1=quantize(t.servo_1, ANGLE_LSB_RAD),
                    servo_2=quantize(t.servo_2, ANGLE_LSB_RAD),
                    battery_mv=quantize(t.battery_v, BATTERY_LSB_V, _U16),
@@ -480,12 +479,20 @@ class TelemetryCompact(ProtocolMessage, kind=MsgType.TELEMETRY_COMPACT,
         """Return the same fields as a Telemetry in SI units (rad, rad/s, m/s^2, V)."""
         return Telemetry(board_time_ms=self.board_time_ms, roll=self.roll * ANGLE_LSB_RAD,
                          pitch=self.pitch * ANGLE_LSB_RAD, yaw=self.yaw * ANGLE_LSB_RAD,
-                         gyro=tuple(v * RATE_LSB_RAD_S for v in self.gyro),
-                         accel=tuple(v * ACCEL_LSB_M_S2 for v in self.accel),
+                         gyro=_scaled(self.gyro, RATE_LSB_RAD_S),
+                         accel=_scaled(self.accel, ACCEL_LSB_M_S2),
                          servo_1=self.servo_1 * ANGLE_LSB_RAD,
                          servo_2=self.servo_2 * ANGLE_LSB_RAD,
                          battery_v=self.battery_mv * BATTERY_LSB_V, status=self.status,
                          gait_id=self.gait_id)
+
+
+def _counts(xyz: tuple[float, float, float], lsb: float) -> tuple[int, int, int]:
+    return quantize(xyz[0], lsb), quantize(xyz[1], lsb), quantize(xyz[2], lsb)
+
+
+def _scaled(xyz: tuple[int, int, int], lsb: float) -> tuple[float, float, float]:
+    return xyz[0] * lsb, xyz[1] * lsb, xyz[2] * lsb
 
 
 def telemetry_of(message: ProtocolMessage) -> Telemetry | None:

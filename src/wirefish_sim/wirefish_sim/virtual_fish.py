@@ -355,7 +355,8 @@ class VirtualFish:
                 elapsed_ms = now_ms - (self._last_output_ms if self._last_output_ms is not None
                                        else now_ms)
                 step = c.failsafe_slew_rad_s * min(elapsed_ms, 1000) * 1e-3
-                wanted = tuple(t - min(max(t, -step), step) for t in self.target)
+                t1, t2 = self.target
+                wanted = (t1 - min(max(t1, -step), step), t2 - min(max(t2, -step), step))
             else:
                 wanted = self._commanded
         if abs(wanted[0]) > limit or abs(wanted[1]) > limit:
