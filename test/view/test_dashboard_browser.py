@@ -4,9 +4,14 @@ The dashboard in a real browser: headless chromium (Debian's) driven by Selenium
 The page is that of a running `wirefish up --sim --view`.
 
 One graph and one browser for the module. The claims: the plots update (values read back from
-the page); a drive key raises planner_state's target speed; a retune from the form shows its
-progress and applies, and the page then offers the hand-back that gives the drive keys their
-effect again; the stop button brings cmd_vel to zero and the fish to rest. The retune
+the page), their legends show values, the battery shows no NaN percentage, the top view has a
+distance scale and /favicon.ico is served; a drive key raises planner_state's target speed; a
+retune from the form shows its progress and applies, and the page then offers the hand-back
+(named as `wirefish hand-back`) that gives the drive keys their effect again; the form refuses
+what is not a number before sending, and shows the tuner's refusal of an unreachable wave at
+once; the stop button brings cmd_vel to zero and the fish to rest; after it, the speed plot
+shows no estimate newer than the last one published, and the body-wave axis stays the tail's
+after a retune. The retune
 test saves its screenshot to out/dashboard.png; with WIREFISH_UPDATE_DOCS=1 it also replaces
 docs/dashboard.png, the picture the README shows (a plain run leaves the tree clean).
 """
@@ -16,6 +21,7 @@ import os
 from pathlib import Path
 import shutil
 import time
+import urllib.request
 
 from geometry_msgs.msg import Twist
 import pytest
@@ -27,7 +33,7 @@ from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 from sensor_msgs.msg import JointState
 from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
-from wirefish_msgs.msg import CpgParams, PlannerState
+from wirefish_msgs.msg import CpgParams, PlannerState, SpeedEstimate
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
@@ -99,7 +105,16 @@ def test_the_plots_update_with_the_graphs_values(browser):
     assert _wait_page(browser, 'window.wirefish.plots.speed.data[0].length > 10', 10.0)
     assert _wait_page(browser, 'window.wirefish.latest.odom !== undefined', 10.0)  # from /tf
     assert _wait_page(browser, "document.getElementById('v-mode').textContent !== '-'", 10.0)
-    assert 'V' in browser.find_element(By.ID, 'v-battery').text
+    battery = browser.find_element(By.ID, 'v-battery').text
+    assert 'V' in battery and 'NaN' not in battery and '-' not in battery, battery
+    # Legends show values (uPlot's own legend shows '--' without a cursor over the plot).
+    legends = _live(browser, "Array.from(document.querySelectorAll('#plot-servo .u-legend "
+                    ".u-value, #plot-heading .u-legend .u-value')).map(e => e.textContent)")
+    assert legends and '--' not in legends, legends
+    scale = _live(browser, 'window.wirefish.topdown')
+    assert scale['bar_m'] > 0 and scale['bar_px'] > 20, scale
+    with urllib.request.urlopen(browser.current_url + 'favicon.ico', timeout=10) as icon:
+        assert icon.status == 200 and icon.headers['Content-Type'] == 'image/svg+xml'
 
 
 def test_a_drive_key_raises_the_planners_target_speed(browser, probe):
@@ -143,6 +158,7 @@ def test_after_an_applied_retune_the_page_hands_the_gait_back_to_the_planner(bro
     assert spin_until(executor, lambda: bool(heard['planner_state']) and (
         heard['planner_state'][-1].mode == 'manual'), timeout_s=20.0)
     assert _wait_page(browser, "!document.getElementById('hand-back').hidden", 10.0)
+    assert 'wirefish hand-back' in browser.find_element(By.ID, 'v-note').text
     browser.find_element(By.ID, 'hand-back').click()
     assert spin_until(executor, lambda: heard['planner_state'][-1].mode != 'manual',
                       timeout_s=20.0)
@@ -165,3 +181,59 @@ def test_the_stop_button_zeroes_cmd_vel_and_rests_the_fish(browser, probe):
 
     assert spin_until(executor, at_rest, timeout_s=30.0)
     assert _live(browser, 'window.wirefish.drive.speed') == 0.0
+
+
+def _retune_from_form(browser, **fields: str) -> None:
+    form = browser.find_element(By.ID, 'retune-form')
+    for name, value in fields.items():
+        form.find_element(By.NAME, name).clear()
+        form.find_element(By.NAME, name).send_keys(value)
+    browser.find_element(By.ID, 'retune-submit').click()
+
+
+def test_the_retune_form_refuses_what_the_tuner_would_at_once(browser):
+    _retune_from_form(browser, c1='abc', max_iterations='0')
+    assert _live(browser, "window.wirefish.retune.state") == 'invalid'  # nothing was sent
+    assert "c1 must be a number, got 'abc'" in browser.find_element(By.ID, 'v-retune').text
+    # An amplitude the servos cannot reach: the tuner's refusal, shown as such, no full bar.
+    sent = time.monotonic()
+    _retune_from_form(browser, c1='5', max_iterations='0')
+    assert _wait_page(browser, "window.wirefish.retune && window.wirefish.retune.state === "
+                      "'done' && !window.wirefish.retune.success", 30.0), (
+        _live(browser, 'window.wirefish.retune'), browser.find_element(By.ID, 'v-retune').text)
+    print(f'c1 = 5 refused in {time.monotonic() - sent:.2f} s: '
+          f'{browser.find_element(By.ID, "v-retune").text}')
+    assert browser.find_element(By.ID, 'v-retune').text.startswith('refused: rejected:')
+    assert _live(browser, "document.getElementById('retune-progress').value") == 0
+    _retune_from_form(browser, c1='0.15')
+
+
+def test_after_stop_the_speed_plot_shows_no_estimate_newer_than_the_last_published(
+        browser, probe, view_graph):
+    heard, executor = probe
+    browser.find_element(By.ID, 'stop').click()
+    node = executor.get_nodes()[0]
+    published: list[float] = []
+    node.create_subscription(
+        SpeedEstimate, f'{view_graph.graph.namespace}/speed_estimate',
+        lambda m: published.append(m.header.stamp.sec + m.header.stamp.nanosec * 1e-9),
+        RELIABLE)
+    spin_until(executor, lambda: False, timeout_s=8.0)  # the fish comes to rest, then on
+    assert published, 'no speed estimate was published'
+    data = _live(browser, 'window.wirefish.plots.speed.data')
+    plotted = [t for t, v in zip(data[0], data[1]) if v is not None and t >= published[0]]
+    truths = [t for t, v in zip(data[0], data[2]) if v is not None]
+    print(f'estimates published {len(published)}, last at {published[-1]:.3f}; plotted '
+          f'since the first: {len(plotted)}, last at {max(plotted, default=0):.3f}; ground '
+          f'truth up to {max(truths):.3f}')
+    assert max(plotted, default=-math.inf) <= published[-1] + 1e-6
+    assert all(min(abs(t - p) for p in published) < 1e-6 for t in plotted)  # at their stamps
+
+
+def test_after_stop_and_a_retune_the_body_wave_axis_is_the_tails(browser):
+    _retune_from_form(browser, c1='0.15', k='8.0', max_iterations='5')
+    assert _wait_page(browser, "window.wirefish.retune && window.wirefish.retune.state === "
+                      "'done'", 120.0)
+    time.sleep(2.0)
+    scale = _live(browser, 'window.wirefish.plots.wave.scales.x')
+    assert scale['min'] == 0 and 0.1 < scale['max'] < 1.0, scale  # the tail: 0.24 m

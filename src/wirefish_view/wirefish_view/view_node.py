@@ -80,9 +80,9 @@ RETUNE_PROGRESS_SCHEMA = json.dumps({
         'iteration': {'type': 'integer'}, 'max_iterations': {'type': 'integer'},
         'best_loss': {'type': 'number'}, 'success': {'type': 'boolean'},
         'message': {'type': 'string'}, 'applied': {'type': 'boolean'},
-        'loss': {'type': 'number'}, 'iterations': {'type': 'integer'},
+        'loss': {'type': ['number', 'null']}, 'iterations': {'type': 'integer'},
         'from_library': {'type': 'boolean'},
-        'rmse_theta_deg': {'type': 'array', 'items': {'type': 'number'}}}}).encode()
+        'rmse_theta_deg': {'type': 'array', 'items': {'type': ['number', 'null']}}}}).encode()
 
 
 def is_loopback(address: str) -> bool:
@@ -294,7 +294,10 @@ class ViewNode(Node):
         return _answer(True, 'goal sent: progress on view/retune')
 
     def _report_retune(self, report: dict) -> None:
-        self._retune_channel.log(json.dumps(report).encode(), log_time=time.time_ns())
+        # JSON has no NaN (Python's json writes it, a browser's JSON.parse refuses it): a
+        # refused wave's loss and RMSE, never computed, go out as null.
+        self._retune_channel.log(json.dumps(_json_safe(report), allow_nan=False).encode(),
+                                 log_time=time.time_ns())
 
     def _on_retune_feedback(self, message: Any) -> None:
         f = message.feedback
@@ -380,6 +383,17 @@ def _service_schema(name: str, request: type, response: type) -> Any:
         return foxglove.MessageSchema(encoding='json', schema=schema)
     return foxglove.ServiceSchema(name, request=message(request, 'Request'),
                                   response=message(response, 'Response'))
+
+
+def _json_safe(value: Any) -> Any:
+    """Return ``value`` with every non-finite float (NaN, inf) replaced by None."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    return value
 
 
 def _answer(success: bool, message: str) -> bytes:

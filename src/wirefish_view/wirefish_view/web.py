@@ -2,7 +2,8 @@
 The dashboard's web server: the page bundled at setup time, and its configuration.
 
 Serves ``share/wirefish_view/dashboard/`` (index.html and the esbuild bundle `make setup`
-builds from web/) and ``/config.json`` (the WebSocket port, namespace, drive limits, frames).
+builds from web/), ``/config.json`` (the WebSocket port, namespace, drive limits, frames) and
+``/favicon.ico`` (a fish, as SVG: browsers ask for it whatever the page says).
 Nothing is fetched from elsewhere: the page works offline.
 """
 
@@ -14,6 +15,10 @@ import json
 from pathlib import Path
 import threading
 
+FAVICON = (b'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 32 32">'
+           b'<ellipse cx="13" cy="16" rx="11" ry="7" fill="#1565c0"/>'
+           b'<path d="M22 16 L31 8 L31 24 Z" fill="#ef6c00"/>'
+           b'<circle cx="7" cy="14" r="1.6" fill="#fff"/></svg>')
 MISSING = (b'<!doctype html><title>wirefish view</title><p>The dashboard is not built: run '
            b'<code>make setup</code> (npm ci and the bundle of src/wirefish_view/web).')
 
@@ -31,6 +36,8 @@ class _Handler(SimpleHTTPRequestHandler):
         """Answer /config.json, a missing page's hint, or a file of the bundle."""
         if self.path == '/config.json':
             self._send(200, 'application/json', self.config)
+        elif self.path == '/favicon.ico':
+            self._send(200, 'image/svg+xml', FAVICON)
         elif self.path in ('/', '/index.html') and not Path(self.directory,
                                                             'index.html').exists():
             self._send(503, 'text/html', MISSING)

@@ -7,7 +7,9 @@ import { parse } from '@foxglove/rosmsg';
 import { MessageReader } from '@foxglove/rosmsg2-serialization';
 import uPlot from 'uplot';
 
-const SUBPROTOCOL = 'foxglove.sdk.v1';
+// Either name of the protocol: the view accepts both.
+const SUBPROTOCOLS = ['foxglove.sdk.v1', 'foxglove.websocket.v1'];
+const KEPT = 100; // refusals, errors and retune reports kept (the newest)
 const WINDOW_S = 15; // seconds of history in the time plots
 const DRIVE_HZ = 10; // cmd_vel rate while driving (the planner's timeout is 0.5 s)
 const SPEED_STEP = 0.05; // m/s, as `wirefish drive`
@@ -17,8 +19,13 @@ const WANTED = ['servo_cmd', 'servo_state', 'body_wave', 'planner_state', 'speed
 
 const live = {
   connected: false, counts: {}, latest: {}, plots: {}, drive: { speed: 0, turn: 0 },
-  retune: null, retuneLog: [], refusals: [], errors: [],
+  retune: null, retuneLog: [], refusals: [], errors: [], estimates: [], topdown: null,
 };
+// A bounded log: the newest KEPT entries (a flood of statuses or errors cannot grow the page).
+function keep(list, entry) {
+  list.push(entry);
+  if (list.length > KEPT) list.splice(0, list.length - KEPT);
+}
 window.wirefish = live;
 
 const $ = (id) => document.getElementById(id);
@@ -36,11 +43,19 @@ class Series {
   data() { return [this.t, ...this.v]; }
 }
 
-function timePlot(id, title, labels, colours, unit) {
+// Two series sampled at their own times as one table with a shared x (null where a series has
+// no sample): what uPlot draws.
+function merged(a, b) {
+  const t = [...new Set([...a.t, ...b.t])].sort((x, y) => x - y);
+  const at = (s) => { const m = new Map(s.t.map((x, i) => [x, s.v[0][i]])); return t.map((x) => (m.has(x) ? m.get(x) : null)); };
+  return [t, at(a), at(b)];
+}
+
+function timePlot(id, title, labels, colours, unit, extra = []) {
   const opts = {
     title, width: 420, height: 220,
     scales: { x: { time: true } },
-    series: [{}, ...labels.map((label, i) => ({ label, stroke: colours[i], width: 1.5 }))],
+    series: [{}, ...labels.map((label, i) => ({ label, stroke: colours[i], width: 1.5, ...(extra[i] || {}) }))],
     axes: [{}, { label: unit }],
   };
   const plot = new uPlot(opts, [[], ...labels.map(() => [])], $(id));
@@ -49,7 +64,10 @@ function timePlot(id, title, labels, colours, unit) {
 
 const servo = new Series(['cmd 1', 'state 1', 'cmd 2', 'state 2']);
 const heading = new Series(['target', 'measured']);
-const speed = new Series(['estimate', 'ground truth']);
+// The speed estimate comes once per tail beat: it is plotted at its own stamps (steps and
+// points), never repeated at the ground truth's rate as if it were live.
+const estimate = new Series(['estimate']);
+const truth = new Series(['ground truth']);
 let plots = null;
 let wave = { q: [], y: [], yd: [] };
 
@@ -59,9 +77,16 @@ function makePlots() {
       ['#1565c0', '#90caf9', '#c62828', '#ef9a9a'], 'rad'),
     heading: timePlot('plot-heading', '', ['target', 'measured'], ['#6a1b9a', '#26a69a'], 'rad'),
     speed: timePlot('plot-speed', '', ['estimate', 'ground truth'], ['#ef6c00', '#2e7d32'],
-      'm/s'),
+      'm/s', [{ paths: uPlot.paths.stepped({ align: 1 }), spanGaps: true,
+        points: { show: true, size: 6 } }, {}]),
+    // The tail from plate I (q = 0) to the tip, whatever the samples (none after a stop):
+    // an axis that auto-ranged on nothing jumped to 0-100 m.
     wave: new uPlot({
-      width: 420, height: 220, scales: { x: { time: false } },
+      width: 420, height: 220,
+      scales: {
+        x: { time: false, range: (_u, _min, max) => [0, Number.isFinite(max) && max > 0 ? max : 0.24] },
+        y: { range: (_u, min, max) => { const r = Math.max(Math.abs(min) || 0, Math.abs(max) || 0, 0.02) * 1.1; return [-r, r]; } },
+      },
       series: [{ label: 'q (m)' }, { label: 'y', stroke: '#1565c0', width: 2 },
         { label: 'desired', stroke: '#2e7d32', width: 1, dash: [4, 4] }],
       axes: [{ label: 'q (m)' }, { label: 'm' }],
@@ -95,6 +120,13 @@ function drawTopdown() {
   for (let gy = Math.floor(cy - span); gy <= cy + span; gy += 0.5) {
     const [, b] = px(0, gy); g.beginPath(); g.moveTo(0, b); g.lineTo(canvas.width, b); g.stroke();
   }
+  // A distance scale: a bar of a round length near a quarter of the view, labelled.
+  const bar = [0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50].find((m) => m * scale >= canvas.width / 5) || 100;
+  g.strokeStyle = '#333'; g.fillStyle = '#333'; g.lineWidth = 2; g.beginPath();
+  g.moveTo(10, canvas.height - 12); g.lineTo(10 + bar * scale, canvas.height - 12); g.stroke();
+  g.font = '12px sans-serif';
+  g.fillText(`${bar} m (grid 0.5 m)`, 10, canvas.height - 18);
+  live.topdown = { bar_m: bar, bar_px: bar * scale };
   g.strokeStyle = '#2e7d32'; g.lineWidth = 1.5; g.beginPath();
   pts.forEach(([x, y], i) => { const [a, b] = px(x, y); if (i) g.lineTo(a, b); else g.moveTo(a, b); });
   g.stroke();
@@ -145,9 +177,18 @@ function onMessage(topic, m) {
       $('hand-back').hidden = m.mode !== 'manual';
       $('v-target-speed').textContent = fixed(m.target_speed);
       $('v-predicted-speed').textContent = fixed(m.predicted_speed);
-      $('v-note').textContent = m.note || m.clamp_reason || '';
+      // A manual override (an applied retune, a parameter set): the way back, in the words
+      // of the command line and of the button below.
+      $('v-note').textContent = m.mode === 'manual'
+        ? 'manual override: the drive keys act again once the gait is handed back '
+          + "(the 'hand the gait back' button, or wirefish hand-back)"
+        : (m.note || m.clamp_reason || '');
       break;
-    case 'speed_estimate': live.latest.speed_estimate = m.speed; break;
+    case 'speed_estimate':
+      live.latest.speed_estimate = m.speed;
+      estimate.push(stampS(m.header.stamp), [m.speed]);
+      keep(live.estimates, { t: stampS(m.header.stamp), speed: m.speed });
+      break;
     case '/tf':
       // This fish's odom -> base_link: the virtual fish's ground truth or the real fish's
       // dead reckoning (tf_node), so the top view works on both.
@@ -165,13 +206,15 @@ function onMessage(topic, m) {
       break;
     case 'sim/ground_truth': {
       const p = m.pose.pose.position;
-      speed.push(stampS(m.header.stamp), [live.latest.speed_estimate ?? NaN, m.twist.twist.linear.x]);
+      truth.push(stampS(m.header.stamp), [m.twist.twist.linear.x]);
       live.latest.ground_truth = { x: p.x, y: p.y, speed: m.twist.twist.linear.x };
       break;
     }
     case 'battery':
       live.latest.battery = { voltage: m.voltage, percentage: m.percentage };
-      $('v-battery').textContent = `${fixed(m.voltage)} V ${fixed(100 * m.percentage, 0)} %`;
+      // The percentage is NaN when the battery does not say (sensor_msgs/BatteryState): blank.
+      $('v-battery').textContent = `${fixed(m.voltage)} V`
+        + (Number.isFinite(m.percentage) ? ` ${(100 * m.percentage).toFixed(0)} %` : '');
       break;
     case 'cmd_vel': live.latest.cmd_vel = { speed: m.linear.x, turn: m.angular.z }; break;
     case '/diagnostics': {
@@ -193,14 +236,28 @@ function onMessage(topic, m) {
   }
 }
 
+// Legends show the latest values while the pointer is not over a plot (uPlot's own legend
+// shows '--' without a cursor).
+function latestInLegend(plot) {
+  const n = plot.data[0].length;
+  if (n && (plot.cursor.left == null || plot.cursor.left < 0)) {
+    const last = plot.series.map((_s, i) => {
+      for (let k = n - 1; k >= 0; k -= 1) if (plot.data[i][k] != null) return k;
+      return n - 1;
+    });
+    plot.setLegend({ idx: n - 1, idxs: last });
+  }
+}
+
 function refresh() {
   if (!plots) return;
   plots.servo.setData(servo.data());
   plots.heading.setData(heading.data());
-  plots.speed.setData(speed.data());
-  if (wave.q.length) {
+  plots.speed.setData(merged(estimate, truth));
+  if (wave.q.length && wave.q.every(Number.isFinite)) {
     plots.wave.setData([wave.q, wave.y, wave.yd.length ? wave.yd : wave.q.map(() => null)]);
   }
+  Object.values(plots).forEach(latestInLegend);
   drawTopdown();
 }
 
@@ -243,7 +300,7 @@ async function drive(key) {
   if (key === ' ') { stop(); return; }
   if (stopped) {
     stopped = false;
-    try { $('v-drive-status').textContent = (await callService('start', {})).message; } catch (e) { live.errors.push(String(e)); }
+    try { $('v-drive-status').textContent = (await callService('start', {})).message; } catch (e) { keep(live.errors, String(e)); }
   }
   if (key === 'w') d.speed = Math.min(lim.max_speed, +(d.speed + SPEED_STEP).toFixed(3));
   if (key === 's') d.speed = Math.max(0, +(d.speed - SPEED_STEP).toFixed(3));
@@ -288,27 +345,49 @@ function wireControls() {
   $('retune-form').addEventListener('submit', (e) => {
     e.preventDefault();
     const f = new FormData(e.target);
-    const num = (k) => Number(f.get(k));
-    const request = { wave: { c1: num('c1'), c2: num('c2'), k: num('k'), frequency_hz: num('frequency_hz') },
-      apply: f.get('apply') === 'on', max_iterations: num('max_iterations'), use_library: false };
+    // Each field checked before anything is sent: 'abc' is not a number (Number('abc') is
+    // NaN, which JSON sends as null).
+    const problems = [];
+    const num = (k, label, whole = false) => {
+      const text = String(f.get(k)).trim();
+      const v = Number(text);
+      if (text === '' || !Number.isFinite(v)) problems.push(`${label} must be a number, got '${text}'`);
+      else if (whole && !(Number.isInteger(v) && v >= 0)) problems.push(`${label} must be a whole number >= 0, got '${text}'`);
+      return v;
+    };
+    const request = { wave: { c1: num('c1', 'c1'), c2: num('c2', 'c2'), k: num('k', 'k'),
+      frequency_hz: num('frequency_hz', 'f (Hz)') },
+    apply: f.get('apply') === 'on', max_iterations: num('max_iterations', 'iterations', true), use_library: false };
+    if (problems.length) {
+      live.retune = { state: 'invalid', message: problems.join('; ') };
+      $('v-retune').textContent = problems.join('; ');
+      return;
+    }
     live.retune = { state: 'asked' };
     $('v-retune').textContent = 'asked';
+    $('retune-progress').value = 0;
     callService('retune_gait', request).then((r) => {
       if (!r.success) { live.retune = { state: 'refused', message: r.message }; $('v-retune').textContent = r.message; }
-    }).catch((err) => { $('v-retune').textContent = String(err); });
+    }).catch((err) => {
+      live.retune = { state: 'refused', message: String(err.message || err) };
+      $('v-retune').textContent = String(err.message || err);
+    });
   });
 }
 
 function onRetune(m) {
   live.retune = m;
-  live.retuneLog.push(m);
+  keep(live.retuneLog, m);
   if (m.state === 'running') {
     $('retune-progress').max = Math.max(m.max_iterations, 1);
     $('retune-progress').value = m.iteration;
     $('v-retune').textContent = `iteration ${m.iteration}/${m.max_iterations}, best loss ${fixed(m.best_loss, 4)}`;
   } else if (m.state === 'done') {
-    $('retune-progress').value = $('retune-progress').max;
-    $('v-retune').textContent = `${m.success ? 'done' : 'failed'}: ${m.message}; applied ${m.applied}; loss ${fixed(m.loss, 4)}`;
+    // A refused wave is answered at once with no iteration: no full bar for it.
+    $('retune-progress').value = m.success ? $('retune-progress').max : 0;
+    $('v-retune').textContent = m.success
+      ? `done: ${m.message}; applied ${m.applied}; loss ${fixed(m.loss, 4)}`
+      : `refused: ${m.message}`;
   } else {
     $('v-retune').textContent = m.state;
   }
@@ -316,7 +395,7 @@ function onRetune(m) {
 
 // --- connection -------------------------------------------------------------------------------
 function connect() {
-  const ws = new WebSocket(`ws://${location.hostname}:${live.config.websocket_port}`, [SUBPROTOCOL]);
+  const ws = new WebSocket(`ws://${location.hostname}:${live.config.websocket_port}`, SUBPROTOCOLS);
   client = new FoxgloveClient({ ws });
   client.on('open', () => { live.connected = true; $('connection').textContent = 'connected'; $('connection').className = 'ok'; });
   client.on('close', () => {
@@ -324,18 +403,18 @@ function connect() {
     readers.clear(); topicOf.clear(); services.clear(); cmdChannel = null;
     setTimeout(connect, 1000);
   });
-  client.on('error', (e) => live.errors.push(String(e)));
+  client.on('error', (e) => keep(live.errors, String(e)));
   client.on('serverInfo', () => {
     cmdChannel = client.advertise({ topic: `${ns}/cmd_vel`, encoding: 'json', schemaName: 'geometry_msgs/msg/Twist' });
   });
-  client.on('status', (s) => { if (/refused/.test(s.message)) live.refusals.push(s.message); });
+  client.on('status', (s) => { if (/refused/.test(s.message)) keep(live.refusals, s.message); });
   client.on('advertise', (channels) => {
     for (const ch of channels) {
       const topic = rel(ch.topic);
       if (!WANTED.includes(topic)) continue;
       try {
         readers.set(ch.id, ch.encoding === 'json' ? 'json' : new MessageReader(parse(ch.schema, { ros2: true })));
-      } catch (e) { live.errors.push(`${topic}: ${e}`); continue; }
+      } catch (e) { keep(live.errors, `${topic}: ${e}`); continue; }
       topicOf.set(client.subscribe(ch.id), { topic, channel: ch.id });
     }
   });
@@ -346,7 +425,7 @@ function connect() {
     const reader = readers.get(sub.channel);
     try {
       onMessage(sub.topic, reader === 'json' ? JSON.parse(new TextDecoder().decode(data)) : reader.readMessage(data));
-    } catch (e) { live.errors.push(`${sub.topic}: ${e}`); }
+    } catch (e) { keep(live.errors, `${sub.topic}: ${e}`); }
   });
   client.on('serviceCallResponse', ({ callId, data }) => {
     const call = calls.get(callId);
