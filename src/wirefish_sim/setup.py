@@ -20,6 +20,7 @@ setup(
     entry_points={
         'console_scripts': [
             'fish_sim = wirefish_sim.executables:fish_sim',
+            'radio_relay = wirefish_sim.executables:radio_relay',
         ],
     },
 )

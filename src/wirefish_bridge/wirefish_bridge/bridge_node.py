@@ -1,10 +1,20 @@
 """
 bridge_node: the serial link to the fish's board (STM32F407, §2.1), see PROTOCOL.md.
 
+Drive modes (``drive_mode``, see ``bridge_node_parameters.DriveMode``): ``stream`` forwards
+servo_cmd; ``gait`` sends the CPG node's parameters and the board integrates eq 1 itself.
 Subscribes
     ``servo_cmd`` (sensor_msgs/JointState ``servo_1``, ``servo_2``, rad; sensor-data QoS, as the
-    CPG publishes it): forwarded as SERVO_CMD frames, at most ``max_command_rate_hz``; when it
-    stops for ``command_timeout_s`` (or before the first one) the bridge commands neutral.
+    CPG publishes it): stream mode forwards it as SERVO_CMD frames, at most
+    ``max_command_rate_hz``; when it stops for ``command_timeout_s`` (or before the first one)
+    the bridge commands neutral. Gait mode compares it with the board's servo angles
+    (``gait_link.OscillatorWatch``: a divergence beyond ``divergence_bound_rad`` warns).
+    ``cpg_params`` (wirefish_msgs/CpgParams, latched): gait mode sends each change as a GAIT
+    with the next gait id, again every ``gait_resend_s`` until an ACK or the telemetry's gait id
+    acknowledges it (``gait_link.GaitLink``).
+LINK_CONFIG (telemetry period and form, HEALTH period, link timeout, coast time: the
+parameters of the same names) goes out when the fish identifies itself, again until an ACK
+accepts it, in gait mode or whenever it differs from the fish's boot defaults.
 Publishes (sensor-data QoS, stamped on receipt with the node clock)
     ``imu/data`` (sensor_msgs/Imu, frame ``imu_frame_id``), ``attitude``
     (geometry_msgs/Vector3Stamped: roll, pitch, yaw rad), ``servo_state`` (sensor_msgs/JointState,
@@ -32,6 +42,7 @@ transport with backoff; the node keeps running.
 from __future__ import annotations
 
 from collections import deque
+import math
 import os
 import threading
 import time
@@ -44,16 +55,19 @@ from rclpy.parameter import Parameter
 from rclpy.timer import Timer
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
-from wirefish_bridge.bridge_node_parameters import (check_combination, LINK_PARAMETERS,
+from wirefish_bridge.bridge_node_parameters import (check_combination, DriveMode, link_config,
+                                                    LINK_CONFIG_PARAMETERS, LINK_PARAMETERS,
                                                     PARAMETERS, SPECS)
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.decimator import Decimator
+from wirefish_bridge.gait_link import ConfigLink, GaitLink, GaitParameters, OscillatorWatch
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
 from wirefish_bridge.link_owner import open_refusal
-from wirefish_bridge.protocol import (ErrorReport, Heartbeat,
+from wirefish_bridge.protocol import (Ack, ErrorReport, Health, Heartbeat, LinkConfig,
                                       PROTOCOL_VERSION, ProtocolMessage, Role, ServoCommand,
-                                      Status, Telemetry)
+                                      Status, Telemetry, telemetry_of,
+                                      TelemetryCompact)
 from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, servo_state_message)
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
@@ -62,8 +76,9 @@ from wirefish_common.cdr_views import CdrError, read_joint_state
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update
-from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_angles
+from wirefish_msgs.msg import CpgParams
 
 
 # Rate of the command tick (Hz): the failsafe and held commands (see _make_timers).
@@ -90,6 +105,13 @@ class BridgeNode(Node):
         self._drain_scheduled = False  # a drain task is pending on the executor (inbox lock)
         self._health = LinkHealth(self._values['heartbeat_timeout_s'], time.monotonic())
         self._battery_rate = Decimator(self._values['battery_rate_hz'])
+        # Gait mode's state: the executor sets and sends, the reader thread reports what the
+        # board runs; one lock between them.
+        self._gait_lock = threading.Lock()
+        self._gait = GaitLink(self._values['gait_resend_s'])
+        self._config = ConfigLink(link_config(self._values), self._values['gait_resend_s'])
+        self._watch = OscillatorWatch(self._values['divergence_window_s'],
+                                      self._values['divergence_bound_rad'])
 
         self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
         self._attitude_pub = self.create_publisher(Vector3Stamped, 'attitude',
@@ -102,6 +124,7 @@ class BridgeNode(Node):
         # Raw: the pair is read from the bytes (cdr_views), no Python message is built.
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA, raw=True)
+        self.create_subscription(CpgParams, 'cpg_params', self._on_cpg_params, LATCHED)
         self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
         self.add_on_set_parameters_callback(self._validate)
@@ -122,6 +145,16 @@ class BridgeNode(Node):
         self._gate.limit_rad = self._values['servo_limit_rad']
         self._health.heartbeat_timeout_s = self._values['heartbeat_timeout_s']
         self._battery_rate.rate_hz = self._values['battery_rate_hz']
+        with self._gait_lock:
+            self._gait.resend_s = self._values['gait_resend_s']
+            self._config.resend_s = self._values['gait_resend_s']
+            self._watch.window_s = self._values['divergence_window_s']
+            self._watch.bound_rad = self._values['divergence_bound_rad']
+            if names & LINK_CONFIG_PARAMETERS:
+                self._config.set_config(link_config(self._values), time.monotonic())
+        if 'drive_mode' in names:
+            self.get_logger().info(f'drive mode {self._values["drive_mode"]}')
+            self._on_command_tick()   # gait mode: the current gait goes out now
         if names & {'heartbeat_rate_hz', 'diagnostics_rate_hz'}:
             self._make_timers()
         if names & LINK_PARAMETERS:
@@ -159,7 +192,7 @@ class BridgeNode(Node):
             if identifies_fish(frame.message):
                 # Here, on the reader thread: the heartbeat came from the device now open.
                 self._link.identify_peer()
-            if isinstance(frame.message, Telemetry):
+            if isinstance(frame.message, (Telemetry, TelemetryCompact)):
                 self._publish_from_reader(frame.message)
             else:
                 others.append(frame)
@@ -168,12 +201,19 @@ class BridgeNode(Node):
                 self._inbox.extend(others)
             self._hand_over()
 
-    def _publish_from_reader(self, telemetry: Telemetry) -> None:
-        problem = self._health.on_telemetry(telemetry, time.monotonic())
+    def _publish_from_reader(self, message: Telemetry | TelemetryCompact) -> None:
+        problem = self._health.on_telemetry(message, time.monotonic())
         if problem is not None:
             self.get_logger().warn(f'impossible telemetry dropped: {problem}',
                                    throttle_duration_sec=2.0)
             return
+        telemetry = telemetry_of(message)   # either form, in SI units
+        assert telemetry is not None
+        now = time.monotonic()
+        with self._gait_lock:
+            self._gait.on_telemetry(telemetry.gait_id, now)
+            if telemetry.status & Status.GAIT_MODE:
+                self._watch.add_board(now, (telemetry.servo_1, telemetry.servo_2))
         try:
             self._publish_telemetry(telemetry)
         except Exception as error:  # noqa: B902 (the reader thread must survive; say why)
@@ -209,12 +249,25 @@ class BridgeNode(Node):
                 state, detail = item
                 if state is LinkState.CONNECTED:
                     self.get_logger().info(f'link {state.value}: {detail}')
+                    self._reconfigure_fish()   # another board, or the same one reset
                 else:
                     self.get_logger().warn(f'link {state.value}: {detail}')
                 continue
             message = item.message
             if identifies_fish(message):
+                restarts = self._health.fish_restarts
                 self._log(self._health.on_heartbeat(message, time.monotonic()))
+                if self._health.fish_restarts != restarts:   # its uptime went back
+                    self.get_logger().warn('the fish restarted: configuring it again')
+                    self._reconfigure_fish()
+            elif isinstance(message, Ack):
+                with self._gait_lock:
+                    self._gait.on_ack(message, time.monotonic())
+                    self._config.on_ack(message)
+            elif isinstance(message, Health):
+                line = self._health.on_health(message)
+                if line is not None:
+                    self.get_logger().error(line)
             elif isinstance(message, ErrorReport):
                 self.get_logger().warn(self._health.on_error_report(message),
                                        throttle_duration_sec=2.0)
@@ -240,6 +293,10 @@ class BridgeNode(Node):
             self._battery_pub.publish(battery_message(
                 telemetry, stamp, low_battery, prefixed(self._frame_prefix, 'base_link')))
 
+    @property
+    def _gait_mode(self) -> bool:
+        return self._values['drive_mode'] == DriveMode.GAIT
+
     def _on_servo_cmd(self, data: bytes) -> None:
         try:
             angles = servo_angles(read_joint_state(data))
@@ -249,11 +306,80 @@ class BridgeNode(Node):
             self.get_logger().warn(f'servo_cmd ignored: {angles.message}',
                                    throttle_duration_sec=2.0)
             return
+        if self._gait_mode:   # the board runs the gait itself: compare, never forward
+            with self._gait_lock:
+                self._watch.add_host(time.monotonic(), angles)
+            return
         to_send = self._gate.on_command(angles, time.monotonic())
         if to_send is not None:
             self._send(ServoCommand(*to_send))
 
+    def _on_cpg_params(self, msg: CpgParams) -> None:
+        parameters = GaitParameters(
+            float(msg.frequency_hz), (float(msg.amplitude[0]), float(msg.amplitude[1])),
+            (float(msg.offset[0]), float(msg.offset[1])), float(msg.w12), float(msg.w21),
+            float(msg.phi12), float(msg.phi21), float(msg.alpha))
+        with self._gait_lock:
+            new = self._gait.set_gait(parameters, time.monotonic())
+        if new:
+            self._send_gait_mode_frames()
+
+    def _reconfigure_fish(self) -> None:
+        """Make LINK_CONFIG and the current gait due: the fish may not have them."""
+        with self._gait_lock:
+            self._config.link_up(time.monotonic())
+            self._gait.on_fish_restart()
+        self._send_gait_mode_frames()
+
+    def _send_gait_mode_frames(self) -> None:
+        """Send a LINK_CONFIG and a GAIT that are due (the gait in gait mode only)."""
+        now = time.monotonic()
+        with self._gait_lock:
+            config = self._config.due(now) if self._configures_fish() else None
+            gait = self._gait.due(now) if self._gait_mode else None
+        if config is not None:
+            seq = self._send(config)
+            if seq is not None:
+                with self._gait_lock:
+                    self._config.sent(seq, now)
+        if gait is not None:
+            seq = self._send(gait)
+            if seq is not None:
+                with self._gait_lock:
+                    self._gait.sent(seq, now)
+
+    def _configures_fish(self) -> bool:
+        """Return True when LINK_CONFIG must go out: gait mode, or not the boot defaults."""
+        return self._gait_mode or self._config.config != LinkConfig()
+
+    def _gait_problem(self, now: float) -> str | None:
+        """Return what gait mode finds wrong for /diagnostics, or None (the gait lock held)."""
+        gait = self._gait
+        if gait.parameters is None:
+            return 'gait mode: no cpg_params yet'
+        if gait.refusal is not None:
+            return f'the fish refused gait {gait.gait_id} (error {gait.refusal})'
+        if not gait.acknowledged:
+            return f'gait {gait.gait_id} not acknowledged yet'
+        if self._config.refusal is not None:
+            return f'the fish refused LINK_CONFIG (error {self._config.refusal})'
+        return self._watch.problem(now)
+
+    def _mode_values(self) -> dict[str, object]:
+        """Return the /diagnostics values of the drive mode (the gait lock held)."""
+        values: dict[str, object] = {'drive_mode': self._values['drive_mode'],
+                                     'link_config_acknowledged': self._config.acknowledged}
+        if self._gait_mode:
+            values.update(self._gait.values())
+            divergence = self._watch.divergence(time.monotonic())
+            values['oscillator_divergence_rad'] = (math.nan if divergence is None
+                                                   else divergence)
+        return values
+
     def _on_command_tick(self) -> None:
+        self._send_gait_mode_frames()
+        if self._gait_mode:
+            return   # no SERVO_CMD: one would put the board back in stream mode
         was_failsafe = self._gate.failsafe
         to_send = self._gate.on_tick(time.monotonic())
         if self._gate.failsafe and not was_failsafe:
@@ -266,24 +392,33 @@ class BridgeNode(Node):
         uptime_ms = int((time.monotonic() - self._started) * 1000.0)
         self._send(Heartbeat(PROTOCOL_VERSION, Role.HOST, uptime_ms))
 
-    def _send(self, message: ProtocolMessage) -> None:
+    def _send(self, message: ProtocolMessage) -> int | None:
+        """Send ``message``; return its sequence number, or None when it did not go out."""
+        seq = self._encoder.next_seq
         frame = self._encoder.encode(message)
         try:
             self._link.write(frame)
         except PeerNotIdentified:
-            return   # not a fish (yet): counted by the link as withheld
+            return None   # not a fish (yet): counted by the link as withheld
         except (LinkDown, LinkWriteError):
             self._health.out.dropped += 1  # the link's state is in /diagnostics
-            return
+            return None
         self._health.out.sent += 1
+        return seq
 
     def _publish_diagnostics(self) -> None:
         self._drain_inbox()  # heartbeats first, so the status is up to date
         now = time.monotonic()
         port, state, stats = self._values['port'], self._link.state, self._link.stats
-        level, message = self._health.level(now, state, port, stats, self._gate.failsafe)
+        with self._gait_lock:
+            problem = self._gait_problem(now) if self._gait_mode else None
+            mode_values = self._mode_values()
+        level, message = self._health.level(now, state, port, stats,
+                                            self._gate.failsafe and not self._gait_mode,
+                                            problem)
         values = self._health.values(now, state, port, self._decoder.stats, stats,
                                      self._gate.counters())
+        values.update(mode_values)
         node = self.get_fully_qualified_name()
         device = os.path.realpath(port)
         hardware_id = f'{node} on {port}' + (f' ({device})' if device != port else '')
@@ -295,8 +430,15 @@ class BridgeNode(Node):
 
     def destroy_node(self) -> None:
         """Command neutral, stop the serial link (joins its thread, closes the port), the node."""
-        # The fish would otherwise hold the last angle until its own command timeout.
-        self._send(ServoCommand(*NEUTRAL))
+        if self._gait_mode:
+            # Rest through the oscillator (amplitudes and offsets to 0 at alpha): no step.
+            with self._gait_lock:
+                rest = self._gait.resting_gait()
+            if rest is not None:
+                self._send(rest)
+        else:
+            # The fish would otherwise hold the last angle until its own command timeout.
+            self._send(ServoCommand(*NEUTRAL))
         self._link.stop()
         super().destroy_node()
 

@@ -188,6 +188,20 @@ class GaitLink:
         elif self._state.acknowledged:
             self._state.again()   # the board no longer runs it (reset, stream mode)
 
+    def resting_gait(self) -> Gait | None:
+        """
+        Return a GAIT that brings the tail to rest through the oscillator, or None.
+
+        The current gait with amplitudes and offsets 0 and the next id: the board converges to
+        rest at alpha, as after its coast (what the bridge sends when it stops in gait mode).
+        """
+        if self.parameters is None:
+            return None
+        p = self.parameters
+        rest = GaitParameters(p.frequency_hz, (0.0, 0.0), (0.0, 0.0), p.w12, p.w21, p.phi12,
+                              p.phi21, p.alpha)
+        return rest.message(next_gait_id(self.gait_id))
+
     def on_fish_restart(self) -> None:
         """Take a board restart: it runs no gait until the current one reaches it again."""
         if self.parameters is not None:
@@ -217,6 +231,15 @@ class ConfigLink:
         """Hold ``config``; nothing is due before the fish identifies itself."""
         self.config = config
         self._state = _Acknowledged(MsgType.LINK_CONFIG, resend_s)
+
+    @property
+    def resend_s(self) -> float:
+        """Return the resend period (s)."""
+        return self._state.resend_s
+
+    @resend_s.setter
+    def resend_s(self, value: float) -> None:
+        self._state.resend_s = value
 
     @property
     def acknowledged(self) -> bool:

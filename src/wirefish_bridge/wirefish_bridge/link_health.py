@@ -17,8 +17,10 @@ import enum
 import math
 
 from wirefish_bridge.codec import DecoderStats
-from wirefish_bridge.protocol import (ErrorCode, ErrorReport, Heartbeat, PROTOCOL_VERSION,
-                                      ProtocolMessage, Role, Status, Telemetry)
+from wirefish_bridge.protocol import (ClockSource, ErrorCode, ErrorReport, Health, HealthFlags,
+                                      Heartbeat, PROTOCOL_VERSION, ProtocolMessage, ResetCause,
+                                      Role, Status, Telemetry,
+                                      TelemetryCompact)
 from wirefish_bridge.telemetry_limits import telemetry_problem
 from wirefish_bridge.transport import LinkState, LinkStats
 
@@ -48,6 +50,37 @@ def error_name(code: int) -> str:
         return ErrorCode(code).name
     except ValueError:
         return f'code {code}'
+
+
+def _name(kind: type[enum.IntEnum], value: int) -> str:
+    try:
+        return kind(value).name
+    except ValueError:
+        return f'unknown {value}'
+
+
+def health_values(health: Health | None) -> dict[str, object]:
+    """Return the /diagnostics values of the fish's last HEALTH ('none yet' before one)."""
+    if health is None:
+        return {'fish_reset_cause': 'none yet'}
+    values: dict[str, object] = {
+        'fish_reset_cause': _name(ResetCause, health.reset_cause),
+        'fish_clock': _name(ClockSource, health.clock_source),
+        'fish_health_flags': ', '.join(str(f.name) for f in HealthFlags
+                                       if f and health.flags & f) or 'none',
+        'fish_uptime_s': health.uptime_ms / 1000.0,
+        'fish_stack_free_min': f'{health.stack_free_min} of {health.stack_size} bytes',
+    }
+    if health.flags & HealthFlags.FAULT_RECORD:
+        values.update({'fish_fault_pc': f'0x{health.fault_pc:08x}',
+                       'fish_fault_lr': f'0x{health.fault_lr:08x}',
+                       'fish_fault_cfsr': f'0x{health.fault_cfsr:08x}',
+                       'fish_fault_hfsr': f'0x{health.fault_hfsr:08x}'})
+    for name in ('uart_rx_overruns', 'tx_bytes_dropped', 'rx_crc', 'rx_frame',
+                 'rx_unknown_type', 'rx_length', 'rx_invalid', 'imu_faults', 'imu_recoveries',
+                 'i2c_bus_recoveries'):
+        values[f'fish_{name}'] = getattr(health, name)
+    return values
 
 
 def status_names(status: int) -> str:
@@ -93,6 +126,9 @@ class LinkHealth:
         self.last_telemetry_rejected = ''
         self.last_heartbeat: float | None = None
         self.last_telemetry: float | None = None
+        self.last_health: Health | None = None
+        self.fish_restarts = 0
+        self._fish_uptime_ms: int | None = None
         self._rx_rate = RateMeter(now)
         self._tx_rate = RateMeter(now)
 
@@ -104,6 +140,7 @@ class LinkHealth:
     def on_heartbeat(self, heartbeat: Heartbeat, now: float) -> tuple[Level, str] | None:
         """Take a fish heartbeat; return what to log when the fish's version is new."""
         self.last_heartbeat = now
+        self._take_uptime(heartbeat.uptime_ms)
         if heartbeat.version == self.fish_version:
             return None
         self.fish_version = heartbeat.version
@@ -112,7 +149,26 @@ class LinkHealth:
                                  f'bridge {PROTOCOL_VERSION}')
         return Level.OK, f'fish says hello (protocol {heartbeat.version})'
 
-    def on_telemetry(self, telemetry: Telemetry, now: float) -> str | None:
+    def _take_uptime(self, uptime_ms: int) -> bool:
+        """Take the fish's uptime; return True when it went back (the board restarted)."""
+        restarted = self._fish_uptime_ms is not None and uptime_ms < self._fish_uptime_ms
+        self._fish_uptime_ms = uptime_ms
+        if restarted:
+            self.fish_restarts += 1
+        return restarted
+
+    def on_health(self, health: Health) -> str | None:
+        """Take a HEALTH report; return a line to log when it tells of a fault reset."""
+        first = self.last_health is None
+        self.last_health = health
+        if health.reset_cause in (ResetCause.FAULT, ResetCause.IWDG, ResetCause.BROWN_OUT) \
+                and (first or health.uptime_ms < 5000):
+            return (f'fish reset by {_name(ResetCause, health.reset_cause)}'
+                    + (f' (fault pc 0x{health.fault_pc:08x})'
+                       if health.flags & HealthFlags.FAULT_RECORD else ''))
+        return None
+
+    def on_telemetry(self, telemetry: Telemetry | TelemetryCompact, now: float) -> str | None:
         """Take a telemetry frame; return why it is impossible (then drop it), or None."""
         problem = telemetry_problem(telemetry)
         if problem is not None:
@@ -133,8 +189,13 @@ class LinkHealth:
         return math.inf if self.last_heartbeat is None else now - self.last_heartbeat
 
     def level(self, now: float, state: LinkState, port: str, link: LinkStats,
-              failsafe: bool) -> tuple[Level, str]:
-        """Return the diagnostic level and message; the first rule that applies wins."""
+              failsafe: bool, gait_problem: str | None = None) -> tuple[Level, str]:
+        """
+        Return the diagnostic level and message; the first rule that applies wins.
+
+        ``failsafe``: stream mode's gate commands neutral; ``gait_problem``: what gait mode
+        finds wrong (not acknowledged, refused, diverging), None in stream mode or when fine.
+        """
         if state is LinkState.IDENTIFYING:
             return Level.ERROR, (f'{port} is open but sent no fish heartbeat yet: writing '
                                  'nothing to it')
@@ -149,6 +210,12 @@ class LinkHealth:
             return Level.ERROR, f'protocol version mismatch ({self.fish_version})'
         if self.heartbeat_age(now) > self.heartbeat_timeout_s:
             return Level.WARN, 'connected, fish heartbeat stale'
+        if self.fish_status & Status.RESTING:
+            return Level.WARN, 'connected, fish RESTING: it lost the link past its coast time'
+        if self.fish_status & Status.COASTING:
+            return Level.WARN, 'connected, fish COASTING: it lost the link, swims its last gait'
+        if gait_problem is not None:
+            return Level.WARN, f'connected, {gait_problem}'
         if failsafe:
             return Level.WARN, 'connected, no servo_cmd: commanding neutral'
         return Level.OK, 'connected'
@@ -174,7 +241,9 @@ class LinkHealth:
             'fish_errors': self.fish_errors,
             'telemetry_rejected': self.telemetry_rejected,
             'last_telemetry_rejected': self.last_telemetry_rejected,
+            'fish_restarts': self.fish_restarts,
         })
+        values.update(health_values(self.last_health))
         values.update(gate)
         return values
 

@@ -27,6 +27,7 @@ from wirefish_cli.api import duration_s
 from wirefish_common.input_checks import params_file_problem, parse_speed, serial_port_problem
 from wirefish_common.progress import duration_text, Progress
 from wirefish_launcher.errors import QemuBoardError
+from wirefish_launcher.radio_road import bridge_settings, DriveMode, Radio, with_radio
 from wirefish_launcher.status_view import LiveStatus, TerminalBlock
 from wirefish_launcher.stop_flag import stop_on_signals, StopFlag
 from wirefish_launcher.supervisor import Supervisor, wait_for_path
@@ -77,6 +78,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         'up, max as fast as the graph answers; the live status shows the '
                         'real-time factor. Only with the virtual fish on one host: a real '
                         'fish, the emulated board and a radio run on the wall clock')
+    parser.add_argument('--radio', choices=[radio.value for radio in Radio], default=None,
+                        help='a radio model between the bridge and the virtual fish or the '
+                        'emulated board (wired, bluetooth, rf433: docs/REFERENCE.md gives their '
+                        'numbers); the radio runs on the wall clock, so the virtual fish does '
+                        'too (no --speed). Its counters go to <run>/radio.json; "cut SECONDS" '
+                        'written to <run>/radio-control cuts it')
+    parser.add_argument('--drive-mode', choices=[mode.value for mode in DriveMode],
+                        default=None,
+                        help="bridge_node's drive_mode: stream forwards servo_cmd, gait sends "
+                        'the CPG parameters and the board integrates eq 1 (default: stream '
+                        "with --sim and --fish qemu, gait with --port, the preset's with "
+                        '--radio: gait on bluetooth and rf433)')
     parser.add_argument('--namespace', default=DEFAULT_NAMESPACE,
                         help='ROS namespace (of a fleet: its base, fish in <ns>/fish_<i>)')
     parser.add_argument('--role', choices=[role.value for role in Role],
@@ -149,7 +162,8 @@ DEFAULT_SPEED = '1'
 
 def on_simulated_time_road(args: argparse.Namespace) -> bool:
     """Return whether the graph runs on the virtual fish's clock: the virtual fish, one host."""
-    return args.port is None and args.fish != Fish.QEMU and args.role == Role.ALL
+    return (args.port is None and args.fish != Fish.QEMU and args.role == Role.ALL
+            and args.radio is None)   # a radio's timing is the wall clock's
 
 
 def fleet_size(text: str) -> int:
@@ -266,6 +280,14 @@ def _effective_params(args: argparse.Namespace, run_dir: Path
         put('/**/view_node', 'http_port', args.view_http_port)
     if args.baud is not None:
         put('/**/bridge_node', 'baudrate', args.baud)
+    # The road's drive mode (radio_road), unless the user's file or --drive-mode chose one.
+    chose = args.drive_mode is not None or 'drive_mode:' in yaml.safe_dump(user)
+    for name, value in bridge_settings(port=args.port is not None,
+                                       radio=Radio(args.radio) if args.radio else None,
+                                       drive_mode=DriveMode(args.drive_mode)
+                                       if args.drive_mode else None).items():
+        if name != 'drive_mode' or args.drive_mode is not None or not chose:
+            put('/**/bridge_node', name, value)
     if on_simulated_time_road(args):  # see graph.SIM_TIME_COMMAND_RATE_HZ; a -p loses to the
         # file's /**/bridge_node section, so the value goes here
         from wirefish_bringup.graph import SIM_TIME_COMMAND_RATE_HZ
@@ -374,6 +396,8 @@ def _run(args: argparse.Namespace) -> int:
         qemu = args.fish == Fish.QEMU
         sim = args.port is None and not qemu
         if args.fleet is not None:
+            if args.radio is not None:
+                raise ValueError('--radio puts one radio in front of one fish: not with --fleet')
             if args.port is not None or qemu or args.single_process or args.frame_prefix:
                 raise ValueError('--fleet starts virtual fish, one process per node, each '
                                  'with frames fish_<i>/...: no --port, --single-process or '
@@ -389,13 +413,16 @@ def _run(args: argparse.Namespace) -> int:
             if qemu:
                 from wirefish_launcher.qemu_board import build_image
                 build_image()
+            if args.radio is not None:
+                specs = with_radio(specs, Radio(args.radio), stats=run_dir / 'radio.json',
+                                   control=run_dir / 'radio-control')
         if on_simulated_time_road(args):
             from wirefish_bringup.graph import on_simulated_time
             specs = on_simulated_time(specs, args.speed or DEFAULT_SPEED)
         elif args.speed is not None:
             raise ValueError("--speed sets the virtual fish's simulated time: a real fish "
-                             '(--port), the emulated board (--fish qemu) and two hosts (--role) '
-                             'run on the wall clock')
+                             '(--port), the emulated board (--fish qemu), two hosts (--role) '
+                             'and a radio (--radio) run on the wall clock')
     except ValueError as error:
         print(f'wirefish up: {error}', file=sys.stderr)
         return 2
