@@ -137,18 +137,23 @@ def least_squares_drag(geometry: FishGeometry = FishGeometry(),
 def virtual_fish_speeds(geometry: FishGeometry,
                         points: tuple[PaperPoint, ...] = PAPER_POINTS,
                         progress: Progress | None = None) -> list[float]:
-    """Return the virtual fish's steady mean speeds (m/s) at ``points`` (its servo model)."""
-    from wirefish_analysis.fig11 import run_steady
+    """
+    Return the virtual fish's steady mean speeds (m/s) at ``points`` (its servo model).
 
-    speeds = []
+    The points' fish swim as one school (``fig11.run_steady_school``): each speed is the one
+    its fish alone gives (``run_steady``).
+    """
+    from wirefish_analysis.fig11 import run_steady_school
+
+    gaits = []
     for point in points:
         scale = (1.0 if point.tip_amplitude is None
                  else amplitude_scale_for(point.tip_amplitude, point.frequency_hz, geometry))
-        params = table1_locked_at(point.frequency_hz, scale)
-        speeds.append(run_steady(params, point.frequency_hz, geometry).speed)
-        if progress is not None:
-            progress.step(text=f'virtual fish at {point.frequency_hz:g} Hz')
-    return speeds
+        gaits.append((table1_locked_at(point.frequency_hz, scale), point.frequency_hz))
+    runs = run_steady_school(gaits, geometry)
+    for point in points if progress is not None else ():
+        progress.step(text=f'virtual fish at {point.frequency_hz:g} Hz')
+    return [run.speed for run in runs]
 
 
 def least_squares_report(geometry: FishGeometry, with_virtual_fish: bool = True,

@@ -15,6 +15,7 @@ The servo's slew limit is calibrated on the paper's 3 Hz cap, not on this figure
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from dataclasses import dataclass
 import json
 from pathlib import Path
@@ -26,6 +27,7 @@ from wirefish_cpg.table1_gait import amplitude_scale_for, locked_speed_estimate,
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.virtual_fish import SimConfig, VirtualFish
+from wirefish_sim.virtual_fleet import VirtualFleet
 
 SCALE_FREQUENCY_HZ = 3.0  # amplitudes are scaled once, with ideal servos, at this frequency
 COMMAND_RATE_HZ = 200.0
@@ -67,6 +69,42 @@ def run_steady(params: CpgParameters, frequency_hz: float, geometry: FishGeometr
             tips.append(fish.state.tail_tip_offset)
     ideal = locked_speed_estimate(params, geometry).speed
     return SteadyRun(frequency_hz, float(np.mean(speeds)), 0.5 * float(np.ptp(tips)), ideal)
+
+
+def run_steady_school(gaits: Sequence[tuple[CpgParameters, float]], geometry: FishGeometry,
+                      config: SimConfig | None = None, settle_s: float = 5.0,
+                      average_s: float = 2.0) -> list[SteadyRun]:
+    """
+    Return ``run_steady`` of every (gait, frequency) of ``gaits``, swum as one school.
+
+    One ``VirtualFleet`` (one physics vectorised over the fish) swims every gait at once, each
+    fish with its own commands: a fish of a school swims as it would alone (to float rounding),
+    so each result is ``run_steady``'s. Every fish runs as long as the longest run; a fish's
+    mean and amplitude are over its own window, after which it swims on unobserved.
+    """
+    config = config or SimConfig(command_timeout_s=None, heartbeat_timeout_s=None)
+    school = VirtualFleet([np.random.default_rng(0) for _ in gaits], config, geometry)
+    dt = 1.0 / COMMAND_RATE_HZ
+    steps_settle = round(settle_s / dt)
+    windows = [round(max(1, round(average_s * f)) / f / dt) for _, f in gaits]
+    total = steps_settle + max(windows)
+    times = np.arange(total) * dt
+    commands = np.stack([steady_state_servo_angles(params, times)[0] for params, _ in gaits])
+    speeds = np.empty((len(gaits), total))
+    tips = np.empty((len(gaits), total))
+    for i in range(total):
+        for fish, command in zip(school.fish, commands[:, i].tolist()):
+            fish.command(*command)
+        school.step(dt)
+        speeds[:, i] = [fish.state.speed for fish in school.fish]
+        tips[:, i] = [fish.state.tail_tip_offset for fish in school.fish]
+    runs = []
+    for f, ((params, frequency), window) in enumerate(zip(gaits, windows)):
+        observed = slice(steps_settle, steps_settle + window)
+        runs.append(SteadyRun(frequency, float(np.mean(speeds[f, observed])),
+                              0.5 * float(np.ptp(tips[f, observed])),
+                              locked_speed_estimate(params, geometry).speed))
+    return runs
 
 
 def speed_sweep(frequencies_hz: np.ndarray | None = None, tip_amplitude_m: float = 0.05,

@@ -72,16 +72,38 @@ def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) ->
     return SweepPoint(frequency_hz, tip_amplitude_m, float(model), fish, geometry.body_length)
 
 
+# Grid points swum together as one school (fig11.run_steady_school): the physics is one
+# vectorised evaluation per step for the whole school, and the progress is told per school.
+SCHOOL_SIZE = 14
+
+
 def run_sweep(with_fish: bool = True,
               progress: Progress | None = None) -> tuple[list[SweepPoint], list[SweepPoint]]:
-    """Return (the Fig 9/10 grid, the Fig 11 line); ``progress`` is told after each point."""
+    """
+    Return (the Fig 9/10 grid, the Fig 11 line); ``progress`` is told after each point.
+
+    The virtual fish of ``SCHOOL_SIZE`` points at a time swim as one school: each point's
+    speed is the one its fish alone gives (``sweep_point``), a fraction of the time.
+    """
+    from wirefish_analysis.fig11 import run_steady_school
+    from wirefish_cpg.table1_gait import locked_speed_estimate, table1_at_tip_amplitude
+    from wirefish_kinematics.geometry import FishGeometry
+
+    geometry = FishGeometry()
     wanted = [*((f, a) for a in PAPER_GRID_AMPLITUDES_M for f in PAPER_GRID_FREQUENCIES_HZ),
               *((f, FIG11_AMPLITUDE_M) for f in FIG11_FREQUENCIES_HZ)]
     points = []
-    for frequency, amplitude in wanted:
-        points.append(sweep_point(frequency, amplitude, with_fish))
-        if progress is not None:
-            progress.step(text=f'{frequency:g} Hz, {amplitude * 100:g} cm')
+    for first in range(0, len(wanted), SCHOOL_SIZE):
+        school = wanted[first:first + SCHOOL_SIZE]
+        gaits = [(table1_at_tip_amplitude(a, f, geometry), f) for f, a in school]
+        fish = (run_steady_school(gaits, geometry) if with_fish else [None] * len(school))
+        for (frequency, amplitude), (params, _), run in zip(school, gaits, fish):
+            model = locked_speed_estimate(params, geometry).speed
+            points.append(SweepPoint(frequency, amplitude, float(model),
+                                     None if run is None else run.speed,
+                                     geometry.body_length))
+            if progress is not None:
+                progress.step(text=f'{frequency:g} Hz, {amplitude * 100:g} cm')
     split = len(PAPER_GRID_AMPLITUDES_M) * len(PAPER_GRID_FREQUENCIES_HZ)
     return points[:split], points[split:]
 
