@@ -42,6 +42,7 @@ ROOT = Path(__file__).resolve().parents[2]
 SCREENSHOT = ROOT / 'out' / 'dashboard.png'
 DOCS_SCREENSHOT = ROOT / 'docs' / 'dashboard.png'
 REST_RAD = 0.05  # servo commands within this of neutral: the fish at rest
+DONE = "window.wirefish.retune && window.wirefish.retune.state === 'done'"
 
 
 @pytest.fixture(scope='module')
@@ -193,13 +194,12 @@ def _retune_from_form(browser, **fields: str) -> None:
 
 def test_the_retune_form_refuses_what_the_tuner_would_at_once(browser):
     _retune_from_form(browser, c1='abc', max_iterations='0')
-    assert _live(browser, "window.wirefish.retune.state") == 'invalid'  # nothing was sent
+    assert _live(browser, 'window.wirefish.retune.state') == 'invalid'  # nothing was sent
     assert "c1 must be a number, got 'abc'" in browser.find_element(By.ID, 'v-retune').text
     # An amplitude the servos cannot reach: the tuner's refusal, shown as such, no full bar.
     sent = time.monotonic()
     _retune_from_form(browser, c1='5', max_iterations='0')
-    assert _wait_page(browser, "window.wirefish.retune && window.wirefish.retune.state === "
-                      "'done' && !window.wirefish.retune.success", 30.0), (
+    assert _wait_page(browser, DONE + ' && !window.wirefish.retune.success', 30.0), (
         _live(browser, 'window.wirefish.retune'), browser.find_element(By.ID, 'v-retune').text)
     print(f'c1 = 5 refused in {time.monotonic() - sent:.2f} s: '
           f'{browser.find_element(By.ID, "v-retune").text}')
@@ -232,8 +232,7 @@ def test_after_stop_the_speed_plot_shows_no_estimate_newer_than_the_last_publish
 
 def test_after_stop_and_a_retune_the_body_wave_axis_is_the_tails(browser):
     _retune_from_form(browser, c1='0.15', k='8.0', max_iterations='5')
-    assert _wait_page(browser, "window.wirefish.retune && window.wirefish.retune.state === "
-                      "'done'", 120.0)
+    assert _wait_page(browser, DONE, 120.0)
     time.sleep(2.0)
     scale = _live(browser, 'window.wirefish.plots.wave.scales.x')
     assert scale['min'] == 0 and 0.1 < scale['max'] < 1.0, scale  # the tail: 0.24 m
