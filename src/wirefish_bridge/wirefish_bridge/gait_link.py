@@ -219,7 +219,9 @@ class GaitLink:
             'gait_acknowledged': self.acknowledged, 'gait_changes': self.changes,
             'gait_frames_sent': self.sends,
             'gait_refused': 'no' if self.refusal is None else f'error {self.refusal}',
+            'gait_acks': len(latencies),
             'gait_ack_median_s': percentile(latencies, 0.5),
+            'gait_ack_p99_s': percentile(latencies, 0.99),
             'gait_ack_last_s': self.ack_latencies_s[-1] if self.ack_latencies_s else math.nan,
         }
 

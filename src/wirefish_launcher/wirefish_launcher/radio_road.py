@@ -80,13 +80,14 @@ def bridge_settings(*, port: bool, radio: Radio | None,
 
 
 def with_radio(specs: list[NodeSpec], radio: Radio, *, seed: int = 0,
-               stats: Path | None = None, control: Path | None = None) -> list[NodeSpec]:
+               stats: Path | None = None, control: Path | None = None,
+               tap: Path | None = None) -> list[NodeSpec]:
     """
     Return ``specs`` with the radio relay between the fish's process and the bridge.
 
     The process that creates the bridge's device link (the virtual fish or the emulated
     board) creates ``<link>-fish`` instead; the relay, started right after it, opens that
-    and creates the bridge's link. ``stats``/``control``: the relay's --stats and --control.
+    and creates the bridge's link. ``stats``/``control``/``tap``: the relay's options.
     Raises ValueError when no process of ``specs`` creates a link (a real fish's port).
     """
     fish = [k for k, spec in enumerate(specs) if spec.links]
@@ -106,6 +107,8 @@ def with_radio(specs: list[NodeSpec], radio: Radio, *, seed: int = 0,
         arguments += ['--stats', str(stats)]
     if control is not None:
         arguments += ['--control', str(control)]
+    if tap is not None:
+        arguments += ['--tap', str(tap)]
     relay = NodeSpec('wirefish_sim', RELAY_NAME, RELAY_NAME, arguments=tuple(arguments),
                      restart=RestartPolicy(required=True), links=(link,))
     return [*specs[:index], moved, relay, *specs[index + 1:]]

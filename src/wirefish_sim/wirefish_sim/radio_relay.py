@@ -33,6 +33,7 @@ import os
 from pathlib import Path
 import random
 import select
+import struct
 import sys
 import time
 import tty
@@ -49,6 +50,22 @@ LATE_S = 0.0005         # an event due within this is handled now
 # Bytes kept for a side that does not read (no bridge on the pty, a stalled board); beyond
 # this the oldest go, as a module's buffer overflows.
 MAX_PENDING = 65536
+# One record of --tap: the monotonic time the bytes were read (s, float64), their count (u32),
+# then the bytes (little-endian).
+TAP_RECORD = struct.Struct('<dI')
+
+
+def read_tap(path: Path) -> list[tuple[float, bytes]]:
+    """Return the (time, bytes) records of a ``--tap`` file."""
+    data = path.read_bytes()
+    records = []
+    offset = 0
+    while offset + TAP_RECORD.size <= len(data):
+        t, size = TAP_RECORD.unpack_from(data, offset)
+        offset += TAP_RECORD.size
+        records.append((t, data[offset:offset + size]))
+        offset += size
+    return records
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -69,6 +86,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument('--stats', type=Path, default=None,
                    help='write the link counters here as JSON (every --stats-every s)')
     p.add_argument('--stats-every', type=float, default=1.0, help='(s)')
+    p.add_argument('--tap', type=Path, default=None,
+                   help="record what the fish sends, before the radio (TAP_RECORD records: "
+                   'monotonic time, length, bytes)')
     return p
 
 
@@ -183,6 +203,7 @@ def run(args: argparse.Namespace) -> int:
     device = _Device(args.device)
     host_pending = bytearray()
     next_stats = start
+    tap = open(args.tap, 'ab') if args.tap is not None else None
     try:
         print(host.open_pair(), flush=True)
         print(f'radio_relay: {params.name} between {args.link} and {args.device}',
@@ -199,6 +220,9 @@ def run(args: argparse.Namespace) -> int:
             from_fish = device.read()
             if from_fish:
                 link.send(Direction.TO_HOST, from_fish, now)
+                if tap is not None:
+                    tap.write(TAP_RECORD.pack(now, len(from_fish)) + from_fish)
+                    tap.flush()
             for direction, data in link.poll(now + LATE_S):
                 if direction is Direction.TO_FISH:
                     device.write(data)
@@ -223,6 +247,8 @@ def run(args: argparse.Namespace) -> int:
         if args.stats is not None:
             now = time.monotonic()
             _write_stats(args.stats, stats_document(link.stats, params.name, now, cuts))
+        if tap is not None:
+            tap.close()
         device.close()
         host.close()
         host.remove_link()
