@@ -119,8 +119,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         '(wirefish view; view_node parameters port, http_port)')
     parser.add_argument('--start-swimming', action='store_true',
                         help="swim the parameter file's gait from start-up (default: the fish "
-                        'starts still, the servos at neutral until the first cmd_vel, retune '
-                        'applied or start service)')
+                        'starts still, the servos at neutral until the first cmd_vel that '
+                        'asks to move or retune applied)')
     parser.add_argument('--view-port', type=port_number, default=None, metavar='PORT',
                         help="with --view: the Foxglove WebSocket port (view_node's port, "
                         'default 8765; 0: any free one)')
