@@ -123,3 +123,36 @@ def test_a_cpg_restarted_mid_drive_is_started_again(graph, ros_context):
     finally:
         executor.remove_node(again)
         again.destroy_node()
+
+
+@pytest.mark.ros
+def test_start_swimming_says_the_cpg_swims_its_own_gait(ros_context):
+    # What `wirefish up --start-swimming` sets: cpg_node's autostart, no rest at start.
+    import rclpy
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from wirefish_cpg.cpg_node import CpgNode
+    from wirefish_msgs.msg import PlannerState
+    from wirefish_planner.planner_node import PlannerNode
+
+    cpg = CpgNode(context=ros_context, namespace=NAMESPACE,
+                  parameter_overrides=[Parameter('autostart', value=True)])
+    planner = PlannerNode(context=ros_context, namespace=NAMESPACE,
+                          parameter_overrides=[Parameter('rest_at_start', value=False)])
+    peer = rclpy.create_node('peer', namespace=NAMESPACE, context=ros_context)
+    servo: list[tuple[float, float]] = []
+    modes: list[str] = []
+    peer.create_subscription(JointState, 'servo_cmd', lambda m: servo.append(tuple(m.position)),
+                             qos_profile_sensor_data)
+    peer.create_subscription(PlannerState, 'planner_state', lambda m: modes.append(m.mode), 10)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for node in (cpg, planner, peer):
+        executor.add_node(node)
+    try:
+        assert spin_until(executor, lambda: _moves(servo, 0) and len(modes) > 10,
+                          timeout_s=30.0)
+        assert set(modes) == {'own_gait'}, set(modes)
+    finally:
+        executor.shutdown()
+        for node in (peer, planner, cpg):
+            node.destroy_node()
