@@ -177,6 +177,9 @@ def test_the_recorders_account_is_summed_into_custom_data(killed_bag, write_bag)
 @pytest.mark.parametrize('custom, line', [
     ({'missing:/a': '0', 'missing:/b': '0'}, 'recording: 0 lost on 2 topics'),
     (None, 'recording: no account of loss (the recorder was killed before it closed the bag)'),
+    # A bag of /diagnostics alone (several publishers): accounted for, nothing was killed.
+    ({'missing:/diagnostics': 'unchecked', 'lag_max_s:/diagnostics': '0.01'},
+     'recording: loss not counted (every topic has several publishers)'),
 ])
 def test_a_run_says_what_it_lost(custom, line):
     assert loss_line(custom) == line

@@ -145,10 +145,8 @@ def recording_summary(bag_path: Path, accounts: dict[str, TopicAccount],
                                          for t in accounts):
         lines.append(f'recording: no topic under {namespace} (only '
                      f'{", ".join(sorted(accounts)) or "nothing"}): is the namespace right?')
-    elif checked:
+    else:
         lines.append(loss_line(recording_account(accounts)))
-    else:  # nothing with one publisher's sequence to count (nothing was killed either)
-        lines.append('recording: loss not counted (every topic has several publishers)')
     return '\n'.join(lines)
 
 

@@ -112,6 +112,10 @@ def recording_losses(custom_data: dict | None) -> dict[str, int]:
 def loss_line(custom_data: dict | None) -> str:
     """Return 'recording: 0 lost ...' or 'recording: LOST n messages: <topic> <count>, ...'."""
     losses = recording_losses(custom_data)
+    if not losses and any(str(key).startswith(f'{AccountKey.MISSING}:')
+                          for key in (custom_data or {})):
+        # An account was written, but of topics with several publishers only: nothing killed.
+        return 'recording: loss not counted (every topic has several publishers)'
     if not losses:
         return 'recording: no account of loss (the recorder was killed before it closed the bag)'
     lost = {t: n for t, n in sorted(losses.items()) if n}
