@@ -10,7 +10,9 @@ feed) takes the same path with the cause IWDG; RCC_CSR is not modelled either, s
 board's cause is the record's alone (UNKNOWN at its first boot). Those parts are tested on the
 host port (test/firmware/test_fw_fail_safe.py).
 
-The last test shows with nm that the hardware image holds none of the console.
+bridge_node, on the board's link, shows the fault and its PC in /diagnostics (its
+fish_reset_cause and fish_fault_pc). The last test shows with nm that the hardware image holds
+none of the console.
 """
 
 from collections.abc import Iterator
@@ -61,10 +63,10 @@ class Report:
 class Board:
     """The board's console (read, and commands written) and its link (read, frames written)."""
 
-    def __init__(self, qemu: QemuBoard) -> None:
+    def __init__(self, qemu: QemuBoard, link: bool = True) -> None:
         assert qemu.ports is not None and qemu.ports.console is not None
         self.console = _open_raw(qemu.ports.console)
-        self.link = _open_raw(qemu.ports.link)
+        self.link = _open_raw(qemu.ports.link) if link else -1
         self.lines: list[str] = []
         self.frames: list = []
         self._decoder = StreamDecoder()
@@ -77,7 +79,8 @@ class Board:
     def _run(self) -> None:
         pending = b''
         while not self._stop.is_set():
-            ready = select.select([self.console, self.link], [], [], 0.05)[0]
+            ready = select.select([fd for fd in (self.console, self.link) if fd >= 0], [], [],
+                                  0.05)[0]
             for fd in ready:
                 try:
                     chunk = os.read(fd, 65536)
@@ -122,7 +125,8 @@ class Board:
         self._stop.set()
         self._thread.join(2.0)
         os.close(self.console)
-        os.close(self.link)
+        if self.link >= 0:
+            os.close(self.link)
 
 
 def _open_raw(path: str) -> int:
@@ -209,6 +213,33 @@ def test_a_stack_overflow_faults_resets_and_the_board_runs_on_unharmed(emulated:
     telemetry = emulated.wait(lambda: [m for m in emulated.frames[frames:]
                                        if isinstance(m, Telemetry)])
     assert (telemetry[-1].servo_1, telemetry[-1].servo_2) == (0.0, 0.0)
+
+
+def _diagnosed(probe, key: str, value: str) -> dict[str, str] | None:
+    """Return the newest /diagnostics status whose ``key`` is ``value``, if any."""
+    for array in reversed(probe.diagnostics):
+        for status in array.status:
+            values = {kv.key: kv.value for kv in status.values}
+            if values.get(key) == value:
+                return values
+    return None
+
+
+@pytest.mark.ros
+def test_the_bridge_shows_the_fault_and_its_pc_in_diagnostics(board: QemuBoard, start_bridge,
+                                                              probe):
+    console = Board(board, link=False)
+    try:
+        console.wait(lambda: console.reports())
+        start_bridge(board.link)
+        assert probe.spin_until(lambda: _diagnosed(probe, 'link_state', 'connected'), 30.0)
+        lines = len(console.lines)
+        console.command('H')
+        pc = console.wait(lambda: console.tagged('F', lines))[0][1]
+        assert probe.spin_until(lambda: (_diagnosed(probe, 'fish_reset_cause', 'FAULT') or {}).get(
+            'fish_fault_pc') == f'0x{pc:08x}', 30.0), probe.diagnostics[-1:]
+    finally:
+        console.close()
 
 
 def test_the_hardware_image_holds_no_test_console(qemu_image: Path):
