@@ -12,7 +12,9 @@ The virtual fish's clock, measured: the sweep old against new, and simulated tim
   second.
 
 ``python -m wirefish_bench.bench_sim_clock [--repeats N] [--window S]`` prints JSON and the
-rows BENCHMARKS.md keeps. Nothing here asserts: these are measurements.
+rows BENCHMARKS.md keeps; ``--lockstep S`` only counts one graph's streams over S simulated
+seconds at --speed 1 (``lockstep_counts``; pinned to a core beside two CPU hogs it shows a
+starved graph computing the same experiment). Nothing here asserts: these are measurements.
 """
 
 from __future__ import annotations
@@ -123,6 +125,65 @@ def graph_clock(speed: str | None, window_s: float, domain_id: int = DOMAIN) -> 
             'cpu_s_per_simulated_s': cpu / simulated, 'processes': len(procs)}
 
 
+def lockstep_counts(simulated_s: float, speed: str = '1', domain_id: int = DOMAIN) -> dict:
+    """
+    One fish's graph on simulated time for ``simulated_s``: what came per simulated second.
+
+    servo_cmd and imu/data are counted by their header stamps over ``simulated_s`` of the
+    graph's clock, against their registry rates times that span; the clock's own steps are
+    checked for gaps (a dropped step of simulated time). Run it pinned to a core beside CPU
+    hogs to see that a starved graph runs slower, not differently.
+    """
+    import yaml
+    from wirefish_bench.bench_graph import processes, ros_session, spin_for
+    from wirefish_bringup.graph import (clock_topic, default_params_file, expected_rates,
+                                        fish_graph, on_simulated_time,
+                                        SIM_TIME_COMMAND_RATE_HZ)
+    from rclpy.qos import qos_profile_sensor_data
+    from rosgraph_msgs.msg import Clock
+    from sensor_msgs.msg import Imu, JointState
+    from wirefish_common.qos import reliable
+
+    directory = Path(tempfile.mkdtemp(prefix='wirefish_bench_lockstep_'))
+    values = yaml.safe_load(default_params_file().read_text())
+    values['/**/bridge_node']['ros__parameters']['max_command_rate_hz'] = float(
+        SIM_TIME_COMMAND_RATE_HZ)
+    params = directory / 'params.yaml'
+    params.write_text(yaml.safe_dump(values))
+    specs = [replace(s, params_file=str(params))
+             for s in on_simulated_time(fish_graph(NAMESPACE, sim=True), speed)]
+    stamps: dict[str, list[float]] = {'servo_cmd': [], 'imu/data': []}
+    steps: list[float] = []
+    with processes(specs, domain_id, log_dir=directory), \
+            ros_session(domain_id) as (node, spinner):
+        for topic, msg_type in (('servo_cmd', JointState), ('imu/data', Imu)):
+            node.create_subscription(
+                msg_type, f'{NAMESPACE}/{topic}', lambda m, t=topic: stamps[t].append(
+                    m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec), qos_profile_sensor_data)
+        node.create_subscription(Clock, clock_topic(NAMESPACE), lambda m: steps.append(
+            m.clock.sec + 1e-9 * m.clock.nanosec), reliable(1000))
+        launched = time.monotonic()
+        while time.monotonic() - launched < READY_TIMEOUT_S and len(stamps['servo_cmd']) < 200:
+            spin_for(spinner, 0.5)
+        start = steps[-1] + 1.0
+        wall_start = time.monotonic()
+        while not steps or steps[-1] < start + simulated_s + 1.0:
+            spin_for(spinner, 0.5)
+        wall = time.monotonic() - wall_start
+    nominal = expected_rates(sim=True)[0]
+    window = [t for t in sorted(set(steps)) if start <= t <= start + simulated_s]
+    gaps = [round(b - a, 4) for a, b in zip(window, window[1:]) if b - a > 0.0101]
+    counts = {topic: sum(start <= t < start + simulated_s for t in values)
+              for topic, values in stamps.items()}
+    return {'speed': speed, 'simulated_s': simulated_s, 'wall_s': wall,
+            'real_time_factor': simulated_s / wall,
+            'clock_gaps': gaps, 'clock_steps': len(window),
+            **{f'{topic}_count': count for topic, count in counts.items()},
+            **{f'{topic}_expected': nominal[topic] * simulated_s for topic in counts},
+            **{f'{topic}_error_percent': 100.0 * (count / (nominal[topic] * simulated_s) - 1.0)
+               for topic, count in counts.items()}}
+
+
 def markdown(sweep: dict, wall: dict, fast: dict) -> str:
     """Return the rows BENCHMARKS.md keeps of one run."""
     old, new = sweep['old'], sweep['new']
@@ -133,6 +194,9 @@ def markdown(sweep: dict, wall: dict, fast: dict) -> str:
         f"{len(old['wall_s'])} alternated | {old['median_wall_s']:.1f} | "
         f"{new['median_wall_s']:.1f} ({new['median_wall_s'] / old['median_wall_s']:.2f} of old; "
         f"largest speed difference {sweep['largest_speed_difference_m_s']:.1e} m/s) |",
+        f"| `wirefish sweep`, CPU s of the computation | "
+        f"{', '.join(f'{c:.1f}' for c in old['cpu_s'])} | "
+        f"{', '.join(f'{c:.1f}' for c in new['cpu_s'])} |",
         f"| one fish's graph: simulated s per wall s | {wall['real_time_factor']:.2f} (wall "
         f"clock) | {fast['real_time_factor']:.2f} (--speed max) |",
         f"| one fish's graph: CPU s per simulated s ({wall['processes']} processes) | "
@@ -145,7 +209,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--repeats', type=int, default=2, help='alternations of the sweep')
     parser.add_argument('--window', type=float, default=20.0, help='wall s per graph figure')
+    parser.add_argument('--lockstep', type=float, default=None, metavar='S',
+                        help='only this: one graph at --speed 1 for S simulated seconds, '
+                        'servo_cmd and imu/data counted by their stamps (lockstep_counts)')
     args = parser.parse_args(argv)
+    if args.lockstep is not None:
+        print(json.dumps(lockstep_counts(args.lockstep), indent=1))
+        return 0
     load = os.getloadavg()[0]
     sweep = sweep_old_new(args.repeats)
     wall = graph_clock(None, args.window)

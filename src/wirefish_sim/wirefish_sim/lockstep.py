@@ -33,8 +33,9 @@ import math
 ENGAGE_STEPS = 2
 # How long (wall s) an engaged fish may keep the clock waiting for its command: far above a
 # round trip through the CPG and the bridge on a loaded machine (tens of ms beside two CPU
-# hogs on one core), far below the start-up of a restarted node.
-DEFAULT_GRACE_S = 2.0
+# hogs on one core). At 2 s a CPG starved while other nodes restarted (load ~10 on 2 cores)
+# released the clock, and the streams it feeds paused 1-3 s of simulated time.
+DEFAULT_GRACE_S = 5.0
 
 
 @dataclass
