@@ -194,7 +194,7 @@ def markdown(sweep: dict, wall: dict, fast: dict) -> str:
         f"{len(old['wall_s'])} alternated | {old['median_wall_s']:.1f} | "
         f"{new['median_wall_s']:.1f} ({new['median_wall_s'] / old['median_wall_s']:.2f} of old; "
         f"largest speed difference {sweep['largest_speed_difference_m_s']:.1e} m/s) |",
-        f"| `wirefish sweep`, CPU s of the computation | "
+        f'| `wirefish sweep`, CPU s of the computation | '
         f"{', '.join(f'{c:.1f}' for c in old['cpu_s'])} | "
         f"{', '.join(f'{c:.1f}' for c in new['cpu_s'])} |",
         f"| one fish's graph: simulated s per wall s | {wall['real_time_factor']:.2f} (wall "
