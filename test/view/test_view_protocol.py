@@ -109,6 +109,7 @@ def test_a_fast_stream_arrives_whole_and_decodes_to_what_was_published(
     print(f'{topic}: graph {len(graph_stamps) / WINDOW_S:.1f} Hz, '
           f'view {len(view_stamps) / WINDOW_S:.1f} Hz')
     assert len(view_stamps) >= 0.95 * len(graph_stamps) > 0
+
     def values(m) -> tuple:
         if kind.endswith('JointState'):
             return tuple(m.name), tuple(m.position)
