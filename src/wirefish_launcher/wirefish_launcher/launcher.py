@@ -441,7 +441,6 @@ def _run(args: argparse.Namespace) -> int:
                                                 for name in _node_names(spec, namespace)]):
         print(f'wirefish up: warning: --params-file {args.params_file}: {warning}',
               file=sys.stderr)
-    _write_params(params_file, merged_params)
     if args.port is not None and not Path(args.port).exists():
         print(f'wirefish up: {args.port} does not exist (yet): the bridge keeps retrying until '
               'it appears; /diagnostics and its log say why it cannot open it', file=sys.stderr)
@@ -471,6 +470,7 @@ def _run(args: argparse.Namespace) -> int:
                 if stop.requested:
                     return 0
             write_profile(env, own_profile)
+            _write_params(params_file, merged_params)  # nothing written before this point
             for spec in specs:
                 proc = supervisor.start(spec)
                 for link in spec.links:
