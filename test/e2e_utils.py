@@ -1,6 +1,8 @@
 """Helpers of the end-to-end tests: the whole graph started exactly as `make run` starts it."""
 
+import bisect
 from dataclasses import dataclass
+import math
 import os
 from pathlib import Path
 import subprocess
@@ -97,12 +99,8 @@ class SimulatedTime:
 
     def at_wall(self, wall_s: float) -> float | None:
         """Return the simulated time that was current at ``wall_s`` (time.monotonic() s)."""
-        current = None
-        for wall, simulated in self.history:
-            if wall > wall_s:
-                break
-            current = simulated
-        return current
+        index = bisect.bisect_right(self.history, (wall_s, math.inf))
+        return self.history[index - 1][1] if index else None
 
 
 def measure_simulated_rates(node, executor, namespace: str, window_s: float,

@@ -3,21 +3,25 @@ Under `wirefish up` a node killed with SIGKILL is back and streaming, and the re
 
 One graph for the module's kill tests, recording the whole run (`--duration`: the recorder is
 one of the victims); each test kills one process of the registry and checks that it is
-restarted (a new PID, on the ROS graph again) and every stream runs at its rate again; that
-every other process kept its PID; and that no stream the killed node does not feed paused
-longer than MAX_PAUSE_S. Checks that belong to one victim (the bridge holding the fish neutral
-while the CPG is gone, the tuner answering again, the recorder writing on into the same bag)
-are in VICTIM_CHECKS. After the kills the graph is stopped and its one bag is read: it opens
-with rosbags, and no publisher sequence number of any topic is missing except while the
-recorder itself was down (from at most KILL_MARGIN_S before its kill). The refusal test gives
+restarted (a new PID, on the ROS graph again, within the restart policy's wall-clock delay) and
+every stream runs at its rate again; that every other process kept its PID; and that no
+stream the killed node does not feed paused longer than MAX_PAUSE_S. Rates and pauses are in
+the graph's simulated time (fish_sim's clock: every node runs on it, so fish_sim feeds all).
+Checks that belong to one victim (the bridge holding the fish neutral while the CPG is gone,
+the tuner answering again, the recorder writing on into the same bag) are in VICTIM_CHECKS.
+After the kills the graph is stopped and its one bag is read: it opens with rosbags, and no
+publisher sequence number of any topic is missing except while the recorder itself was down
+(from at most KILL_MARGIN_S before its kill). The refusal test gives
 the tuner a parameter it refuses at start-up: a configuration error, which the launcher says on
 the terminal and does not restart, keeping the rest running. (A crash loop's back-off, and a
 required node that spends its budget stopping the graph: test/bringup/test_supervisor.py,
 without the cost of a whole graph.)
 """
 
+import bisect
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+import math
 import os
 from pathlib import Path
 import signal
@@ -27,7 +31,7 @@ import threading
 import time
 
 from bag_utils import assert_bag_readable, flushed_topics, sequence_gaps
-from e2e_utils import descendants, RunningGraph, start_graph
+from e2e_utils import descendants, RunningGraph, SimulatedTime, start_graph
 import numpy as np
 import psutil
 import pytest
@@ -61,6 +65,7 @@ RESUMED_FRACTION = 0.75  # of the nominal rate, over RATE_WINDOW_S
 # killed subscriber stalled its publishers for 1 s: the graph runs over UDP, dds_profile.)
 MAX_PAUSE_S = 1.5
 NEUTRAL_RAD = 0.05
+CLOCK_OWNER = 'fish_sim'  # the graph's simulated time (wirefish up --sim: lockstep, --speed 1)
 COMMAND_TIMEOUT_S = 0.5  # the bridge's default command_timeout_s (config/wirefish.yaml)
 KILL_MARGIN_S = 1.0  # the recorder flushes every 0.5 s: a kill loses at most about 1 s
 # The restarted recorder records again once it is up and has found the topics (it rescans the
@@ -82,7 +87,35 @@ class WatchedGraph:
     node: Node
     log: StreamLog
     bag: Path
+    clock: SimulatedTime
     kills: dict[str, 'Kill'] = field(default_factory=dict)
+
+    def simulated(self, wall_s: float) -> float:
+        """Return the graph's simulated time at ``wall_s`` (monotonic s); -inf before any."""
+        value = self.clock.at_wall(wall_s)
+        return -math.inf if value is None else value
+
+    def rate(self, topic: str, window_s: float) -> float:
+        """Return ``topic``'s messages per simulated second over the last ``window_s`` of it."""
+        now = self.clock.now()
+        if now is None:
+            return 0.0
+        arrivals = self.log.arrivals[topic]
+        first = bisect.bisect_left(arrivals, self._wall_of(now - window_s))
+        return (len(arrivals) - first) / window_s
+
+    def longest_pause(self, topic: str, since_wall: float, until_wall: float) -> float:
+        """Return ``topic``'s longest gap in simulated time between two walls (monotonic s)."""
+        times = [self.simulated(t) for t in self.log.arrivals[topic]
+                 if since_wall <= t <= until_wall]
+        edges = [self.simulated(since_wall), *times, self.simulated(until_wall)]
+        return max(b - a for a, b in zip(edges, edges[1:]))
+
+    def _wall_of(self, simulated_s: float) -> float:
+        """Return the wall time (monotonic s) the graph's clock first reached ``simulated_s``."""
+        history = self.clock.history  # in order of arrival; a restarted fish_sim jumps ahead
+        index = bisect.bisect_left(history, simulated_s, key=lambda entry: entry[1])
+        return history[index][0] if index < len(history) else math.inf
 
     def pids(self) -> dict[str, int]:
         """Return {registry name: PID} of the graph's live processes."""
@@ -137,6 +170,8 @@ def _wait(predicate: Callable[[], bool], timeout_s: float) -> bool:
 
 def _fed_by(victim: str) -> set[str]:
     """Return the victim and every node whose streams are computed (transitively) from it."""
+    if victim == CLOCK_OWNER:  # every node of the graph runs on its clock
+        return {e.name for e in GRAPH}
     fed = {victim}
     while True:
         more = {e.name for e in GRAPH if set(e.fed_by) & fed} - fed
@@ -166,9 +201,10 @@ def watched(e2e_domain_id: int, tmp_path_factory) -> Iterator[WatchedGraph]:
         types = {n: message_class(t[0]) for n, t in node.get_topic_names_and_types()
                  if n in wanted}
         log = StreamLog(node, types, keep=(_full('servo_state'),))
+        clock = SimulatedTime(node, NAMESPACE)
         spinner.start()
         (bag,) = out.glob('run_*/bag')
-        yield WatchedGraph(graph, node, log, bag)
+        yield WatchedGraph(graph, node, log, bag, clock)
     finally:
         executor.shutdown()
         if spinner.is_alive():
@@ -182,22 +218,36 @@ def watched(e2e_domain_id: int, tmp_path_factory) -> Iterator[WatchedGraph]:
         graph.launcher.stdout.close()
 
 
-def _all_streaming(log: StreamLog) -> bool:
-    now = time.monotonic()
-    return all(log.rate(_full(t), now - RATE_WINDOW_S, now) >= RESUMED_FRACTION * hz
+def _all_streaming(watched: WatchedGraph) -> bool:
+    """Return whether every stream came at its rate over the last RATE_WINDOW_S of sim time."""
+    return all(watched.rate(_full(t), RATE_WINDOW_S) >= RESUMED_FRACTION * hz
                for t, hz in NOMINAL_HZ.items())
 
 
 def _fish_held_neutral(watched: WatchedGraph, kill: Kill) -> None:
-    """While the CPG is gone, the bridge commands neutral: the measured angles go to 0."""
+    """
+    While the CPG is gone, simulated time stands still, or the bridge commands neutral.
+
+    The fish holds the clock for the CPG's command (lockstep) until it waits out its grace
+    (``wirefish_sim.lockstep``): a CPG back within it finds the clock where it left it, and
+    nothing swam without it. Past the grace the clock runs on without it, and the bridge's
+    failsafe holds the fish neutral: the measured angles go to 0.
+    """
+    span = watched.simulated(kill.restarted_at + 0.3) - watched.simulated(kill.killed_at)
+    if span < COMMAND_TIMEOUT_S + 0.3:
+        print(f'CPG gone for {span:.2f} s of simulated time: the clock waited for it')
+        return
     # From when the watchdog has fired (COMMAND_TIMEOUT_S after the last command) and the
     # servos got there (slew limit, lag), until the new CPG could send its first command: a
     # fresh Python process needs well over 0.3 s to import rclpy and create its node.
-    since = kill.killed_at + COMMAND_TIMEOUT_S + 0.3
-    until = kill.restarted_at + 0.3
+    # In simulated time: the fish holds the clock for the CPG's command until it waits out the
+    # grace (wall time in which no simulated time passes), so the bridge's neutral comes within
+    # a command tick of the kill's simulated time.
+    since = watched.simulated(kill.killed_at) + COMMAND_TIMEOUT_S + 0.3
+    until = watched.simulated(kill.restarted_at) + 0.3
     angles = np.array([deserialize_message(data, JointState).position
                        for t, data in watched.log.kept[_full('servo_state')]
-                       if since <= t < until])
+                       if since <= watched.simulated(t) < until])
     assert len(angles) >= 10, f'{len(angles)} servo_state samples while the CPG was gone'
     assert np.abs(angles).max() < NEUTRAL_RAD
 
@@ -242,7 +292,7 @@ VICTIM_CHECKS: dict[str, Callable[[WatchedGraph, Kill], None]] = {
 
 @pytest.mark.parametrize('victim', VICTIMS)
 def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watched, victim):
-    assert _wait(lambda: _all_streaming(watched.log), BACK_WITHIN_S), 'not streaming before'
+    assert _wait(lambda: _all_streaming(watched), BACK_WITHIN_S), 'not streaming before'
     before = watched.pids()
     assert set(before) == set(VICTIMS), before
     killed_at, killed_wall = time.monotonic(), time.time()
@@ -257,13 +307,13 @@ def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watche
     watched.kills[victim] = kill
     delay = next(e.restart.delay_s for e in GRAPH if e.name == victim)
     assert kill.restarted_at - killed_at >= delay - 0.05  # the policy's delay, then a restart
-    assert _wait(lambda: _all_streaming(watched.log), BACK_WITHIN_S), 'streams did not resume'
+    assert _wait(lambda: _all_streaming(watched), BACK_WITHIN_S), 'streams did not resume'
     until = time.monotonic()
     after = watched.pids()
     assert {k: v for k, v in after.items() if k != victim} == \
         {k: v for k, v in before.items() if k != victim}
     fed = _fed_by(victim)
-    pauses = {topic: watched.log.longest_pause(_full(topic), killed_at, until)
+    pauses = {topic: watched.longest_pause(_full(topic), killed_at, until)
               for e in GRAPH if e.name not in fed for topic in e.rates_hz}
     print(f'{victim} killed: back after {kill.restarted_at - killed_at:.2f} s, streaming '
           f'after {until - killed_at:.2f} s; longest pauses of the others: '
