@@ -4,7 +4,8 @@ from dataclasses import replace
 import random
 
 import pytest
-from wirefish_sim.radio_model import (Direction, preset, PRESETS, RadioLink, RadioParameters)
+from wirefish_sim.radio_model import (Direction, frame_units, preset, PRESETS, RadioLink,
+                                      RadioParameters)
 
 TO_FISH, TO_HOST = Direction.TO_FISH, Direction.TO_HOST
 
@@ -23,9 +24,9 @@ def run(link: RadioLink, until: float, step: float = 0.0005) -> list[Delivery]:
 
 
 def clean(params: RadioParameters) -> RadioParameters:
-    """Return ``params`` without loss, corruption or jitter."""
+    """Return ``params`` without loss, corruption, jitter or UART: the channel alone."""
     return replace(params, loss_good=0.0, loss_bad=0.0, byte_error_good=0.0,
-                   byte_error_bad=0.0, jitter_s=0.0, bad_mean_s=0.0)
+                   byte_error_bad=0.0, jitter_s=0.0, bad_mean_s=0.0, uart_baud=0.0)
 
 
 def test_a_wired_frame_arrives_after_its_air_time_whole():
@@ -213,4 +214,23 @@ def test_the_presets_capacities():
     # What each preset carries one way in full packets (bytes/s): the figures of REFERENCE.md.
     assert PRESETS['wired'].capacity_bytes_s == pytest.approx(11520.0)
     assert PRESETS['bluetooth'].capacity_bytes_s == pytest.approx(11520.0)
-    assert PRESETS['rf433'].capacity_bytes_s == pytest.approx(60 / (69 * 8 / 9600))
+    assert PRESETS['rf433'].capacity_bytes_s == pytest.approx(960.0)   # its UART binds
+    assert clean(PRESETS['rf433']).capacity_bytes_s == pytest.approx(60 / (69 * 8 / 9600))
+
+
+def test_frames_are_cut_at_their_boundaries():
+    assert frame_units(b'\x00ab\x00\x00cd\x00') == [b'\x00ab\x00', b'\x00cd\x00']
+    assert frame_units(b'raw bytes') == [b'raw bytes']
+
+
+def test_the_uart_paces_the_bytes_and_refuses_whole_frames():
+    params = replace(clean(PRESETS['rf433']), uart_baud=9600.0, uart_buffer_bytes=100)
+    link = RadioLink(params, random.Random(1), 0.0)
+    frame = b'\x00' + bytes(range(1, 59)) + b'\x00'          # 60 bytes
+    heartbeat = b'\x00' + bytes(range(1, 13)) + b'\x00'      # 14 bytes
+    link.send(TO_HOST, frame + frame + heartbeat, 0.0)       # the second frame does not fit
+    assert link.stats.to_host.frames_refused == 1
+    got = run(link, 1.0)
+    assert b''.join(data for _, _, data in got) == frame + heartbeat
+    # 74 bytes at 960 B/s reach the module after 77 ms; then the packet's air time.
+    assert got[0][0] >= 60 / 960.0

@@ -8,6 +8,12 @@ comes from one seeded ``random.Random``: the same seed and the same calls give t
 
 What a transparent serial radio does to the bytes, and how the model says it:
 
+- The UART to the module. Each end writes into its UART's transmit queue
+  (``uart_buffer_bytes``), which takes or refuses whole frames of the wire format (a write is
+  cut at each frame boundary, ``0x00 0x00``): a frame that does not fit is lost whole
+  (``frames_refused``), as a firmware's transmit ring or a non-blocking tty write refuses it.
+  The queue feeds the module at ``uart_baud`` (10 bits a byte); ``uart_baud`` 0: the bytes reach
+  the module at once (the UART is the channel itself, as ``wired``).
 - Packets. A module gathers the bytes its serial input receives until the input has been idle
   for ``gather_s`` or ``max_packet_bytes`` are waiting, then sends them as one packet with
   ``packet_overhead_bytes`` of preamble, sync word, header and CRC. Its buffer holds
@@ -83,6 +89,8 @@ class RadioParameters:
     loss_bad: float = 0.0
     byte_error_good: float = 0.0
     byte_error_bad: float = 0.0
+    uart_baud: float = 0.0
+    uart_buffer_bytes: int = 4096
 
     def __post_init__(self) -> None:
         """Refuse numbers no radio has (a clear ValueError naming the field)."""
@@ -115,8 +123,9 @@ class RadioParameters:
 
     @property
     def capacity_bytes_s(self) -> float:
-        """Return the payload bytes a second the channel carries in full packets, one way."""
-        return self.max_packet_bytes / self.air_time_s(self.max_packet_bytes)
+        """Return the bytes a second one way: full packets on the air, or the UART if slower."""
+        air = self.max_packet_bytes / self.air_time_s(self.max_packet_bytes)
+        return min(air, self.uart_baud / 10.0) if self.uart_baud > 0.0 else air
 
 
 # The presets of `wirefish up --radio`. docs/REFERENCE.md gives each number's source; what a
@@ -126,24 +135,48 @@ PRESETS: dict[str, RadioParameters] = {
     'wired': RadioParameters('wired', bit_rate_bps=115200.0, bits_per_byte=10.0,
                              max_packet_bytes=64, buffer_bytes=4096),
     # A Bluetooth Classic SPP module (HC-05 class) at its 115200 baud UART: the UART is the
-    # bottleneck; its radio slots both ways. At the surface the 2.4 GHz antenna dips under
-    # water in bursts (a tail beat, a wave): BAD ~0.3 s every ~3 s, where nearly all is lost.
-    'bluetooth': RadioParameters('bluetooth', bit_rate_bps=115200.0, bits_per_byte=10.0,
+    # bottleneck (BR/EDR's ACL carries ~700 kbit/s); its radio slots both ways. At the surface
+    # the 2.4 GHz antenna dips under water in bursts (a tail beat, a wave): BAD ~0.3 s every
+    # ~3 s, where nearly all is lost.
+    'bluetooth': RadioParameters('bluetooth', bit_rate_bps=700000.0, bits_per_byte=8.0,
+                                 packet_overhead_bytes=16, uart_baud=115200.0,
+                                 uart_buffer_bytes=1024,
                                  max_packet_bytes=128, gather_s=0.002, buffer_bytes=1024,
                                  latency_s=0.015, jitter_s=0.010, good_mean_s=3.0,
                                  bad_mean_s=0.3, loss_good=0.002, loss_bad=0.9,
                                  byte_error_good=1e-6, byte_error_bad=1e-4),
-    # A transparent sub-GHz module (433 MHz, HC-12 / HAC-UM class) at 9600 bit/s on the air,
-    # half duplex: a few ms to turn around, ~12-30 ms of module latency, packets gathered after
-    # 3 byte times of idle input, a 256-byte buffer. 433 MHz reaches over the surface much
+    # A transparent sub-GHz module (433 MHz, HC-12 / HAC-UM class) at 9600 bit/s on the air
+    # and on its UART (the factory default), the sender's transmit queue 512 bytes, half
+    # duplex: a few ms to turn around, ~12-30 ms of module latency, packets gathered after 3 byte
+    # times of idle input, a 256-byte buffer. 433 MHz reaches over the surface much
     # better than 2.4 GHz: shorter, rarer bursts.
     'rf433': RadioParameters('rf433', bit_rate_bps=9600.0, bits_per_byte=8.0,
+                             uart_baud=9600.0, uart_buffer_bytes=512,
                              packet_overhead_bytes=9, max_packet_bytes=60, gather_s=0.003,
                              buffer_bytes=256, half_duplex=True, turnaround_s=0.003,
                              latency_s=0.015, jitter_s=0.010, good_mean_s=8.0,
                              bad_mean_s=0.15, loss_good=0.005, loss_bad=0.5,
                              byte_error_good=1e-6, byte_error_bad=1e-4),
 }
+
+
+def frame_units(data: bytes) -> list[bytes]:
+    """
+    Return ``data`` cut at each frame boundary of the wire format (``0x00 0x00``).
+
+    Frames are ``0x00 COBS(body) 0x00``, so two frames written together meet as ``00 00``;
+    bytes without that pattern are one unit.
+    """
+    units = []
+    start = 0
+    index = data.find(b'\x00\x00')
+    while index >= 0:
+        units.append(data[start:index + 1])
+        start = index + 1
+        index = data.find(b'\x00\x00', start)
+    if start < len(data):
+        units.append(data[start:])
+    return units
 
 
 def preset(name: str) -> RadioParameters:
@@ -159,7 +192,8 @@ def preset(name: str) -> RadioParameters:
 class DirectionStats:
     """What crossed (or failed to cross) the radio one way."""
 
-    bytes_offered: int = 0      # written into the sending module
+    bytes_offered: int = 0      # written into the sending end's UART
+    frames_refused: int = 0     # lost whole: the UART's transmit queue had no room
     bytes_overflowed: int = 0   # lost: the module's buffer was full
     packets_sent: int = 0
     packets_lost: int = 0       # burst loss
@@ -245,6 +279,9 @@ class RadioLink:
         self._time = now
         self._queues = (bytearray(), bytearray())
         self._last_input = [now, now]
+        # The UART stage: chunks (arrival at the module, bytes) in order, per direction.
+        self._uart: tuple[deque[tuple[float, bytes]], ...] = (deque(), deque())
+        self._uart_free = [now, now]
         self._channel_free = [now, now]     # full duplex: per direction; half: [0] only
         self._last_direction: Direction | None = None
         self._last_delivery = [now, now]
@@ -254,12 +291,31 @@ class RadioLink:
 
     # --- the ends -----------------------------------------------------------------------
     def send(self, direction: Direction, data: bytes, now: float) -> None:
-        """Write ``data`` into the module that sends ``direction`` at ``now``."""
+        """Write ``data`` into the UART of the end that sends ``direction`` at ``now``."""
         self._advance(now)
         if not data:
             return
         stats = self.stats.of(direction)
         stats.bytes_offered += len(data)
+        if self.params.uart_baud <= 0.0:
+            self._into_module(direction, data, now)
+            self._advance(now)
+            return
+        uart = self._uart[direction]
+        byte_s = 10.0 / self.params.uart_baud
+        for unit in frame_units(data):
+            queued = sum(len(chunk) for _, chunk in uart)
+            if queued + len(unit) > self.params.uart_buffer_bytes:
+                stats.frames_refused += 1
+                continue
+            self._uart_free[direction] = (max(now, self._uart_free[direction])
+                                          + len(unit) * byte_s)
+            uart.append((self._uart_free[direction], unit))
+        self._advance(now)
+
+    def _into_module(self, direction: Direction, data: bytes, now: float) -> None:
+        """Put ``data`` into the module's buffer at ``now`` (what overflows is lost)."""
+        stats = self.stats.of(direction)
         queue = self._queues[direction]
         room = max(self.params.buffer_bytes - len(queue), 0)
         if len(data) > room:
@@ -267,7 +323,6 @@ class RadioLink:
             data = data[:room]
         queue.extend(data)
         self._last_input[direction] = now
-        self._advance(now)
 
     def poll(self, now: float) -> list[tuple[Direction, bytes]]:
         """Return the packets delivered by ``now``, in delivery order, as (direction, bytes)."""
@@ -287,6 +342,7 @@ class RadioLink:
     def next_event_s(self) -> float | None:
         """Return when ``poll`` next has work (a delivery or a packet to start), or None."""
         times = [self._in_flight[0].deliver_s] if self._in_flight else []
+        times += [uart[0][0] for uart in self._uart if uart]
         for direction in Direction:
             ready = self._ready_s(direction)
             if ready is not None:
@@ -311,13 +367,19 @@ class RadioLink:
         return self._last_input[direction] + self.params.gather_s
 
     def _advance(self, now: float) -> None:
-        """Start every packet whose channel and data are ready by ``now``."""
+        """Move the UARTs' bytes and start every packet, in time order, up to ``now``."""
         while True:
-            choice = self._next_start(now)
-            if choice is None:
+            arrivals = [(uart[0][0], d) for d, uart in zip(Direction, self._uart) if uart]
+            arrival = min(arrivals) if arrivals else None
+            choice = self._next_start(now if arrival is None or arrival[0] > now
+                                      else arrival[0])
+            if choice is not None and (arrival is None or choice[1] <= arrival[0]):
+                self._transmit(*choice)
+            elif arrival is not None and arrival[0] <= now:
+                t, direction = arrival
+                self._into_module(direction, self._uart[direction].popleft()[1], t)
+            else:
                 break
-            direction, start = choice
-            self._transmit(direction, start)
         self._time = max(self._time, now)
         self._medium.forget(now - _MEDIUM_MEMORY_S)
 
