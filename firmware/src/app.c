@@ -4,8 +4,9 @@
  *
  * Stream mode (from boot): the host's SERVO_CMD sets the servos; a failsafe moves them to
  * neutral at a bounded slew. Gait mode (from an accepted GAIT): the board integrates eq 1
- * itself (wf/cpg.h) one 1 ms step per millisecond of its clock, and through a link gap it
- * coasts on the last gait, then brings the oscillator to rest through its own convergence.
+ * itself (wf/cpg.h) one 1 ms step per millisecond of its clock, starting from the angles
+ * stream mode held, and through a link gap it coasts on the last gait, then brings the
+ * oscillator to rest through its own convergence.
  *
  * The firmware rules are the virtual fish's (wirefish_sim.virtual_fish), and
  * test/firmware/test_fw_virtual_fish_parity.py holds the two to the same output frames and
@@ -294,8 +295,11 @@ static void on_gait(wf_app_t *app, const wf_msg_t *msg)
     if (app->gait_mode) {
         wf_cpg_set_params(&app->cpg, &app->gait); /* targets only: no step */
     } else {
+        /* From rest at this poll's time, but with the offsets where stream mode left the
+         * servos (the last command, or part way through the failsafe's slew): the output
+         * starts at the angles the servos hold and converges to the gait through alpha. */
         app->gait_mode = true;
-        wf_cpg_init(&app->cpg, &app->gait); /* from rest, at this poll's time */
+        wf_cpg_start(&app->cpg, &app->gait, app->target);
         app->cpg_time_ms = app->now_ms;
     }
     app->gaits_accepted++;

@@ -11,7 +11,8 @@
 #define TWO_PI_LO -0x1.777a5cp-23f
 #define PI_F 0x1.921fb6p+1f /* the binary32 just above pi */
 /* A phase this far from [-pi, pi) after one step means a degenerate coupling (|w| ~ 1e4/s
- * and beyond): its value carries nothing worth keeping. */
+ * and beyond): its value carries nothing worth keeping. GAIT never brings one (|w| <= 100/s,
+ * wf_cpg_params_valid); the guard keeps a CPG given unchecked parameters finite. */
 #define PHASE_SANE 64.0f
 
 static const float SIXTH_H = WF_CPG_STEP_S / 6.0f;
@@ -27,7 +28,9 @@ bool wf_cpg_params_valid(const wf_cpg_params_t *p, float limit)
         }
     }
     bool ok = p->frequency_hz > 0.0f && p->frequency_hz <= 10.0f && p->alpha > 0.0f &&
-              p->alpha <= 200.0f;
+              p->alpha <= 200.0f && fabsf(p->w12) <= WF_CPG_MAX_COUPLING &&
+              fabsf(p->w21) <= WF_CPG_MAX_COUPLING && fabsf(p->phi12) <= WF_CPG_MAX_PHASE_BIAS &&
+              fabsf(p->phi21) <= WF_CPG_MAX_PHASE_BIAS;
     for (unsigned i = 0; i < WF_CPG_OSCILLATORS; i++) {
         ok = ok && p->amplitude[i] >= 0.0f && p->amplitude[i] <= limit &&
              fabsf(p->offset[i]) <= limit;
@@ -51,6 +54,13 @@ void wf_cpg_init(wf_cpg_t *cpg, const wf_cpg_params_t *params)
 {
     memset(cpg, 0, sizeof *cpg);
     wf_cpg_set_params(cpg, params);
+}
+
+void wf_cpg_start(wf_cpg_t *cpg, const wf_cpg_params_t *params, const float offset[2])
+{
+    wf_cpg_init(cpg, params);
+    cpg->b[0] = offset[0];
+    cpg->b[1] = offset[1];
 }
 
 /* s + e == a + b exactly (Knuth's TwoSum; needs IEEE rounding and no contraction, which ISO

@@ -586,8 +586,9 @@ static void test_an_invalid_gait_is_refused_with_error_6_and_ack_6(void)
     send_gait(1, 3, &good);
     run_until(2, 101); /* the refusals below come at 101 too: no step in between */
     const wf_host_gait_snapshot_t before = gait_snap();
-    wf_cpg_params_t bad[9];
-    for (int i = 0; i < 9; i++) {
+    enum { BAD = 15 };
+    wf_cpg_params_t bad[BAD];
+    for (int i = 0; i < BAD; i++) {
         bad[i] = good;
     }
     bad[0].frequency_hz = 0.0f;
@@ -599,7 +600,14 @@ static void test_an_invalid_gait_is_refused_with_error_6_and_ack_6(void)
     bad[6].alpha = 200.5f;
     bad[7] = good; /* gait_id 0 below */
     bad[8].frequency_hz = -1.0f;
-    for (int i = 0; i < 9; i++) {
+    /* Couplings beyond 100/s, phase biases beyond 2 pi (binary32 2 pi is just above it). */
+    bad[9].w12 = 100.00001f;
+    bad[10].w21 = -1e30f;
+    bad[11].phi12 = 6.2831855f;
+    bad[12].phi21 = -7.0f;
+    bad[13].w12 = -3e38f;
+    bad[14].phi12 = 1e30f;
+    for (int i = 0; i < BAD; i++) {
         board_output(out, 256);
         const uint16_t seq = send_gait(101, i == 7 ? 0 : 9, &bad[i]);
         const size_t n = board_output(out, 256);
@@ -627,6 +635,41 @@ static void test_an_invalid_gait_is_refused_with_error_6_and_ack_6(void)
     const size_t m = board_output(out, 256);
     const size_t a = find(out, m, WF_MSG_ACK);
     CHECK(a < m && out[a].n[2] == WF_ERR_VERSION_MISMATCH && !gait_snap().gait_mode);
+}
+
+static float largest_ms_change(uint32_t t0, uint32_t t1, bool with_heartbeats, float *worst);
+
+static void test_couplings_and_biases_at_their_bounds_are_accepted(void)
+{
+    const float limit = 1.57079625f;
+    wf_cpg_params_t p = table1_gait();
+    p.w12 = 100.0f;
+    p.w21 = -100.0f;
+    p.phi12 = WF_CPG_MAX_PHASE_BIAS;
+    p.phi21 = -WF_CPG_MAX_PHASE_BIAS;
+    CHECK(wf_cpg_params_valid(&p, limit));
+    CHECK((double)WF_CPG_MAX_PHASE_BIAS <= 2.0 * 3.14159265358979323846 &&
+          (double)nextafterf(WF_CPG_MAX_PHASE_BIAS, 7.0f) > 2.0 * 3.14159265358979323846);
+    const float too_far[4] = {nextafterf(100.0f, 101.0f), nextafterf(-100.0f, -101.0f),
+                              nextafterf(WF_CPG_MAX_PHASE_BIAS, 7.0f),
+                              -nextafterf(WF_CPG_MAX_PHASE_BIAS, 7.0f)};
+    for (int i = 0; i < 4; i++) {
+        wf_cpg_params_t q = p;
+        float *field[4] = {&q.w12, &q.w21, &q.phi12, &q.phi21};
+        *field[i] = too_far[i];
+        CHECK(!wf_cpg_params_valid(&q, limit));
+        const wf_gait_t gait = {.gait_id = 1, .params = q};
+        CHECK(!wf_gait_valid(&gait, limit));
+    }
+    /* The board swims the strongest coupling allowed: finite, the amplitudes reached. */
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_gait(1, 2, &p);
+    float worst = 0.0f;
+    largest_ms_change(2, 3000, true, &worst);
+    const wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(g.gait_mode && g.gait_id == 2 && worst <= 1.0f);
+    CHECK(fabsf(g.r[0] - 0.38f) < 1e-3f && fabsf(g.r[1] - 0.47f) < 1e-3f);
 }
 
 /* Runs the board t0..t1 and returns the largest change of a target over one ms, and in
@@ -752,9 +795,71 @@ static void test_servo_cmd_in_gait_mode_returns_to_stream_mode(void)
     const size_t n = board_output(out, 256);
     const size_t t = find(out, n, WF_MSG_TELEMETRY);
     CHECK(t < n && out[t].n[0] == 0);
-    /* Back to gait mode: from rest again. */
+    /* Back to gait mode: from rest again, but for the offsets at the angles held. */
     send_gait(111, 6, &p);
-    CHECK(gait_snap().gait_mode && gait_snap().cpg_steps == 0 && gait_snap().target[0] == 0.0f);
+    const wf_host_gait_snapshot_t back = gait_snap();
+    CHECK(back.gait_mode && back.cpg_steps == 0 && back.r[0] == 0.0f && back.dr[1] == 0.0f);
+    CHECK(back.b[0] == 0.3f && back.b[1] == -0.3f && back.db[0] == 0.0f);
+    CHECK(back.target[0] == 0.3f && back.target[1] == -0.3f);
+}
+
+/* Gait mode entered while stream mode holds a command, or slews to neutral: the output starts
+ * at the angles held (the switch's ms moves nothing), then each ms moves within the
+ * oscillator's own rate (h |dTheta/dt| at either end of the ms: no step), and it converges to
+ * the gait through alpha. The board runs the steps of a lone CPG started there, bit for bit. */
+static void test_gait_mode_starts_from_the_angles_stream_mode_held(void)
+{
+    const wf_cpg_params_t p = table1_gait();
+    /* Holding +0.3 and -0.3 rad (a command every 100 ms: no timeout). */
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    for (uint32_t t = 1; t <= 401; t += 100) {
+        send_command(t, 0.3f, -0.3f);
+        run_until(t + 1, t + 99);
+    }
+    CHECK(snap().status == 0 && snap().target[0] == 0.3f && snap().target[1] == -0.3f);
+    send_gait(501, 1, &p);
+    wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(g.gait_mode && g.target[0] == 0.3f && g.target[1] == -0.3f); /* no change at all */
+    CHECK(g.rate[0] == 0.0f && g.rate[1] == 0.0f && g.r[0] == 0.0f && g.b[0] == 0.3f);
+    wf_cpg_t lone;
+    const float held[2] = {0.3f, -0.3f};
+    wf_cpg_start(&lone, &p, held);
+    float worst = 0.0f;
+    float largest = 0.0f;
+    for (uint32_t t = 502; t <= 3500; t += 100) {
+        largest = fmaxf(largest, largest_ms_change(t, t + 99, true, &worst));
+        for (int k = 0; k < 100; k++) {
+            wf_cpg_step(&lone);
+        }
+        float angle[2];
+        wf_cpg_output(&lone, angle, NULL);
+        g = gait_snap();
+        CHECK(g.target[0] == angle[0] && g.target[1] == angle[1]);
+    }
+    /* Within the oscillator's own rate every ms, never more than swimming itself asks for
+     * (r 2 pi v h: 5.9 mrad at 2 Hz), and at the gait after 3 s of alpha = 20. */
+    CHECK(worst <= 1.0f);
+    CHECK(largest < 0.47f * 6.2832f * 2.0f * 1e-3f * 1.3f);
+    CHECK(fabsf(g.b[0]) < 1e-4f && fabsf(g.b[1] - 0.1f) < 1e-4f && fabsf(g.r[1] - 0.47f) < 1e-4f);
+
+    /* Part way through the failsafe's slew to neutral (0.8 rad at 2 rad/s). */
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_command(1, 0.8f, -0.8f);
+    run_until(2, 200);
+    send_heartbeat(200, WF_PROTOCOL_VERSION);
+    run_until(201, 700);
+    const float before = snap().target[0];
+    CHECK((snap().status & WF_STATUS_FAILSAFE_COMMAND) && before > 0.3f && before < 0.7f);
+    send_gait(701, 2, &p);
+    g = gait_snap();
+    CHECK(g.gait_mode && g.target[0] == before && g.target[1] == -before);
+    CHECK((snap().status & WF_STATUS_FAILSAFE_COMMAND) == 0);
+    worst = 0.0f;
+    largest = largest_ms_change(702, 3700, true, &worst);
+    CHECK(worst <= 1.0f && largest < 0.47f * 6.2832f * 2.0f * 1e-3f * 1.3f);
+    CHECK(fabsf(gait_snap().b[0]) < 1e-4f && fabsf(gait_snap().b[1] - 0.1f) < 1e-4f);
 }
 
 static void test_another_version_leaves_gait_mode_and_slews_to_neutral(void)
@@ -958,8 +1063,9 @@ static void test_the_lone_cpg_follows_eq_1(void)
 
 static void test_degenerate_couplings_keep_the_output_finite(void)
 {
-    /* GAIT allows any finite coupling: 1e30/s makes the phase rate overflow. The state stays
-     * finite (the phase restarts), the amplitude law is untouched. */
+    /* GAIT refuses such couplings (|w| > 100/s); a CPG given them unchecked still stays
+     * finite: 1e30/s makes the phase rate overflow, the phase restarts, the amplitude law is
+     * untouched. */
     wf_cpg_params_t p = table1_gait();
     p.w12 = 1e30f;
     p.w21 = -3e38f;
@@ -1002,10 +1108,12 @@ int main(void)
     test_imu_sample_reaches_the_telemetry();
     test_gait_is_acked_and_the_board_runs_eq_1_at_1_khz();
     test_an_invalid_gait_is_refused_with_error_6_and_ack_6();
+    test_couplings_and_biases_at_their_bounds_are_accepted();
     test_a_new_gait_swaps_the_targets_without_a_step();
     test_a_link_gap_coasts_then_rests_without_a_step();
     test_coast_0_rests_at_the_link_timeout();
     test_servo_cmd_in_gait_mode_returns_to_stream_mode();
+    test_gait_mode_starts_from_the_angles_stream_mode_held();
     test_another_version_leaves_gait_mode_and_slews_to_neutral();
     test_link_config_is_applied_at_once_and_acked();
     test_acks_go_out_one_per_poll_from_a_bounded_queue();
@@ -1014,6 +1122,6 @@ int main(void)
     test_the_imu_lost_and_found_is_counted();
     test_the_lone_cpg_follows_eq_1();
     test_degenerate_couplings_keep_the_output_finite();
-    printf("test_core: 37 tests, %d checks passed\n", checks);
+    printf("test_core: 39 tests, %d checks passed\n", checks);
     return 0;
 }

@@ -23,7 +23,10 @@ The streams cover stream mode (hello, commands beyond the limit, both timeouts a
 neutral, a version mismatch, low battery, damaged, split and invalid frames) and gait mode
 (GAITs accepted, refused and in a burst past the ACK queue, a gait beyond the servo limit,
 LINK_CONFIG with compact telemetry and its HEALTH period, a gap long enough to coast and rest,
-the link back, a SERVO_CMD back to stream mode, a version mismatch in gait mode).
+the link back, a SERVO_CMD back to stream mode, a version mismatch in gait mode) and the
+switch from stream to gait mode while stream mode holds a command, while it slews to neutral
+and right after a SERVO_CMD of the same chunk: both start the oscillator with its offsets at
+the angles held, so the switch's millisecond moves no servo at all.
 """
 
 from collections.abc import Iterator
@@ -65,6 +68,7 @@ class Scenario:
     # Frames sent at given times (gait scenarios), and a window without any host frame.
     events: dict[int, tuple[ProtocolMessage, ...]] = field(default_factory=dict)
     silent: tuple[int, int] = (0, 0)
+    command: tuple[float, float] | None = None  # every SERVO_CMD's angles (else random)
 
 
 GAIT_EVENTS = {
@@ -79,6 +83,16 @@ GAIT_EVENTS = {
     2700: (LinkConfig(10, TelemetryForm.COMPACT, 0, 1500, 3000),),
     2900: (replace(TABLE_1, gait_id=11),),
     3300: (ServoCommand(0.5, -0.4),),
+}
+# Into gait mode from stream mode: holding (0.3, -0.3) rad (commands every 10 ms up to 290);
+# part way through the failsafe's slew (commands stop at 1000, the slew starts at 1501); and
+# with a SERVO_CMD just before the GAIT in one chunk (the board sets its outputs at the
+# command, so gait mode starts from that command's angles).
+HELD_EVENTS = {
+    300: (TABLE_1,),
+    1000: (ServoCommand(0.3, -0.2),),
+    1580: (replace(TABLE_1, gait_id=2),),
+    2200: (ServoCommand(0.5, -0.4), replace(TABLE_1, gait_id=3, offset_1=-0.2)),
 }
 SCENARIOS = [
     Scenario('nominal'),
@@ -99,6 +113,9 @@ SCENARIOS = [
              events={100: (TABLE_1,), 500: (Heartbeat(1, Role.HOST, 500),),
                      600: (replace(TABLE_1, gait_id=2), LinkConfig(50)), 800: (Heartbeat(),),
                      900: (replace(TABLE_1, gait_id=3),)}),
+    Scenario('gait_from_held_angles', duration_ms=3000, commands_until_ms=300,
+             heartbeats_until_ms=3000, resume_at_ms=3000, events=HELD_EVENTS,
+             command=(0.3, -0.3)),
 ]
 
 
@@ -123,7 +140,8 @@ def host_stream(scenario: Scenario, rng: np.random.Generator) -> Iterator[bytes]
             commands += 1
             next_command += 498 + commands % 5 if scenario.near_timeouts else 10
             if t < scenario.commands_until_ms or active:
-                angles = rng.uniform(-2.0, 2.0, 2).astype(np.float32).tolist()
+                angles = (list(scenario.command) if scenario.command is not None
+                          else rng.uniform(-2.0, 2.0, 2).astype(np.float32).tolist())
                 chunk += encoder.encode(ServoCommand(*angles))
         for message in scenario.events.get(t, ()):
             chunk += encoder.encode(message)
@@ -204,9 +222,18 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     seen: set[str] = set()
     statuses: set[int] = set()
     worst = Deviation()
+    entries: list[tuple[int, tuple[float, float]]] = []   # (ms, angles held) into gait mode
+    board_held = (0.0, 0.0)
     for k, chunk in enumerate(host_stream(scenario, rng)):
+        held, was_gait, commands = fish.target, fish.cpg is not None, fish.commands_received
         if chunk:  # as fish_sim does: the firmware's own clock runs the rest
             fish.receive(chunk)
+        commanded = fish.commands_received != commands
+        if commanded:
+            # A SERVO_CMD of this chunk (back to stream mode) set the outputs before the GAIT
+            # that follows it (binary32 on the wire).
+            held = fish.target
+            board_held = tuple(float(v) for v in np.float32(held))
         fish.step(0.001)
         fish_out = fish_frames.feed(b''.join(fish.take_output()))
         board_out = board_frames.feed(board.step(k + 1, chunk))
@@ -218,6 +245,12 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
             fish.cpg is not None, fish.gait_id, int(fish.gap)), f'at {k + 1} ms'
         worst.see(tuple(state.target), fish.target, k + 1)
         statuses.add(state.status)
+        if gait.gait_mode and (commanded or not was_gait):
+            # No step: the oscillator starts at the angles held, both sides exactly.
+            assert fish.target == held, f'at {k + 1} ms'
+            assert tuple(state.target) == board_held, f'at {k + 1} ms'
+            entries.append((k + 1, held))
+        board_held = tuple(state.target)
     print(f'{scenario.name}: servo angles within {worst.rad:.2e} rad (at {worst.at_ms} ms)')
     assert board.gait().acks_dropped == fish.acks_dropped
     if len(scenario.events.get(900, ())) == 6 and not scenario.damage:
@@ -238,6 +271,9 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     assert all(bool(s & Status.LOW_BATTERY) == scenario.low_battery for s in statuses)
     if scenario.events:
         assert 'Ack' in seen and any(s & Status.GAIT_MODE for s in statuses)
+    if scenario.command is not None:
+        print(f'{scenario.name}: into gait mode at {entries}')
+        assert [held != (0.0, 0.0) for _, held in entries] == [True] * 3
     if scenario.silent[1]:
         assert any(s & Status.SERVO_CLAMPED and s & Status.GAIT_MODE for s in statuses)
         assert {Status.COASTING, Status.RESTING} <= {s & GAP_FLAGS for s in statuses}

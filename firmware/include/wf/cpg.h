@@ -9,7 +9,8 @@
  *
  * Fixed-step classical RK4, step WF_CPG_STEP_MS. New parameters only swap the targets (R, B,
  * v, w, phi, alpha): the state persists, so the output and its rate never step. The state
- * starts at rest (every phase, amplitude, offset and rate 0).
+ * starts at rest (every phase, amplitude, offset and rate 0), or (wf_cpg_start) at rest with
+ * the offsets b_i at given angles.
  *
  * Precision: the phase is kept as an unevaluated sum hi + lo of two binary32, hi wrapped to
  * [-pi, pi). The free-running part of each step, 2 pi v h, is added with an error-free sum
@@ -60,15 +61,34 @@ typedef struct {
     wf_cpg_params_t params;
     float omega;                   /* 2 pi v (rad/s) */
     float omega_h_hi, omega_h_lo;  /* 2 pi v h as an unevaluated sum (rad per step) */
-    uint32_t steps;                /* steps taken since wf_cpg_init */
+    uint32_t steps;                /* steps taken since wf_cpg_init or wf_cpg_start */
 } wf_cpg_t;
 
+/* The couplings GAIT accepts. |w_ij| <= 100/s: with r_j <= pi/2 a coupling term is at most
+ * 157 rad/s, so a phase moves at most 0.22 rad per 1 ms step (with 2 pi 10 Hz) and the phase
+ * difference's stiffness r (|w12| + |w21|) <= 314/s gives h lambda <= 0.31, well inside RK4's
+ * stability (2.78) and its accurate range; the paper's Table 1 has |w| < 1 and the CPG node
+ * allows 10. |phi_ij| <= 2 pi: every bias has a representative there; beyond it is a unit
+ * mistake (degrees), not a gait. WF_CPG_MAX_PHASE_BIAS is the largest binary32 not above 2 pi,
+ * so a binary32 bias is refused exactly when wirefish_bridge's Gait.problem refuses it (its
+ * 2 pi is a double). */
+#define WF_CPG_MAX_COUPLING 100.0f
+#define WF_CPG_MAX_PHASE_BIAS 0x1.921fb4p+2f
+
 /* True when params can drive the board: every value finite, 0 < v <= 10 Hz,
- * 0 <= R_i <= limit, |B_i| <= limit, 0 < alpha <= 200 (1/s) (the GAIT rules of PROTOCOL.md). */
+ * 0 <= R_i <= limit, |B_i| <= limit, |w12|, |w21| <= WF_CPG_MAX_COUPLING (1/s),
+ * |phi12|, |phi21| <= WF_CPG_MAX_PHASE_BIAS (rad), 0 < alpha <= 200 (1/s) (the GAIT rules of
+ * PROTOCOL.md). */
 bool wf_cpg_params_valid(const wf_cpg_params_t *params, float servo_limit_rad);
 
 /* At rest (all state 0) with params' targets. */
 void wf_cpg_init(wf_cpg_t *cpg, const wf_cpg_params_t *params);
+
+/* At rest but for the offsets: b_i = offset[i] (rad), every phase, amplitude and rate 0, so
+ * the output starts at Theta_i = offset[i] with rate 0 and converges to the targets through
+ * alpha. Gait mode starts here from the angles stream mode held: no step at the switch. */
+void wf_cpg_start(wf_cpg_t *cpg, const wf_cpg_params_t *params,
+                  const float offset[WF_CPG_OSCILLATORS]);
 
 /* Swaps the targets; the state persists (CpgIntegrator.set_parameters). */
 void wf_cpg_set_params(wf_cpg_t *cpg, const wf_cpg_params_t *params);

@@ -292,9 +292,13 @@ class ServoCommand(ProtocolMessage, kind=MsgType.SERVO_CMD, layout='<ff'):
         return cls(*values) if _finite(values) else None
 
 
-# GAIT's ranges (PROTOCOL.md): beyond them the fish answers ERROR 6 and ACK 6.
+# GAIT's ranges (PROTOCOL.md): beyond them the fish answers ERROR 6 and ACK 6. |w| <= 100/s
+# keeps the board's 1 ms RK4 accurate (coupling stiffness r (|w12| + |w21|) <= 314/s with
+# r <= pi/2: h lambda <= 0.31); every phase bias has a representative within 2 pi.
 GAIT_MAX_FREQUENCY_HZ = 10.0
 GAIT_MAX_ALPHA = 200.0
+GAIT_MAX_COUPLING = 100.0
+GAIT_MAX_PHASE_BIAS = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -336,7 +340,8 @@ class Gait(ProtocolMessage, kind=MsgType.GAIT, layout='<H' + 'f' * 10):
         Return why a fish with servo limit ``servo_limit_rad`` refuses this gait, or None.
 
         Valid: gait_id != 0, 0 < frequency <= 10 Hz, 0 <= amplitude <= limit, |offset| <=
-        limit, 0 < alpha <= 200 (and every float finite).
+        limit, |w12|, |w21| <= 100 /s, |phi12|, |phi21| <= 2 pi, 0 < alpha <= 200 (and every
+        float finite).
         """
         floats = self.to_wire()[1:]
         if not _finite(floats):
@@ -353,6 +358,14 @@ class Gait(ProtocolMessage, kind=MsgType.GAIT, layout='<H' + 'f' * 10):
             value = getattr(self, name)
             if not abs(value) <= servo_limit_rad:
                 return f'{name} {value:g} rad beyond the servo limit {servo_limit_rad:g}'
+        for name in ('w12', 'w21'):
+            value = getattr(self, name)
+            if not abs(value) <= GAIT_MAX_COUPLING:
+                return f'{name} {value:g} /s beyond +-{GAIT_MAX_COUPLING:g}'
+        for name in ('phi12', 'phi21'):
+            value = getattr(self, name)
+            if not abs(value) <= GAIT_MAX_PHASE_BIAS:
+                return f'{name} {value:g} rad beyond +-2 pi'
         if not 0.0 < self.alpha <= GAIT_MAX_ALPHA:
             return f'alpha {self.alpha:g} outside (0, {GAIT_MAX_ALPHA:g}]'
         return None

@@ -11,9 +11,9 @@ part speaks protocol version 2 (PROTOCOL.md) by the rules of the board's C core
 frames (``receive``); in stream mode it drives the servos to each SERVO_CMD and slews them to
 neutral at a bounded rate when commands or host heartbeats stop; in gait mode (an accepted
 GAIT) it integrates eq 1 itself with ``wirefish_cpg.oscillator.CpgIntegrator`` (RK4, 1 ms
-steps of its clock), coasts when the link is lost and comes to rest after the coast; it
-answers GAIT and LINK_CONFIG with ACKs and emits telemetry (full or compact), heartbeats and
-HEALTH as encoded frames (``take_output``).
+steps of its clock, from the angles stream mode held), coasts when the link is lost and comes
+to rest after the coast; it answers GAIT and LINK_CONFIG with ACKs and emits telemetry (full
+or compact), heartbeats and HEALTH as encoded frames (``take_output``).
 
 Clocks: a frame received at time t acts on the physics step that starts at t (its rules run
 at t, as the board's poll at the end of that millisecond runs them); what the step emits is
@@ -34,7 +34,8 @@ from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, 
                                       Heartbeat, LinkConfig, MsgType, PROTOCOL_VERSION,
                                       ResetCause, Role, ServoCommand, Status, Telemetry,
                                       TelemetryCompact, TelemetryForm)
-from wirefish_cpg.oscillator import at_rest, CpgIntegrator, CpgParameters
+from wirefish_cpg.oscillator import (at_rest, CpgIntegrator, CpgParameters, initial_state,
+                                     OFFSET)
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust, reactive_state,
                                            tail_tip_lateral_positions)
@@ -242,6 +243,9 @@ class VirtualFish:
         self.last_command = (servo_1, servo_2)
         self._commanded = (servo_1, servo_2)
         self._last_command_time = self.state.time_s
+        # The board sets its outputs at each command (two in one poll both reach the PWM), so
+        # a GAIT right after it in the same poll starts gait mode from this command's angles.
+        self._update_failsafe()
 
     def heartbeat(self) -> None:
         """Register a host heartbeat, as a HEARTBEAT frame from the host would."""
@@ -252,7 +256,9 @@ class VirtualFish:
         """
         Apply a GAIT now as the board does; return the ACK's result (0 or an ErrorCode).
 
-        From stream mode the CPG starts from rest now; in gait mode only its targets change,
+        From stream mode the CPG starts now from rest but for its offsets b_i, at the servo
+        targets stream mode held (r = 0, rates 0, phases 0): the output goes on from there and
+        converges to the gait through alpha, no step. In gait mode only its targets change,
         for the steps after now. A host of another version is refused (5), a gait out of range
         too (6): nothing changes.
         """
@@ -265,7 +271,9 @@ class VirtualFish:
         self._advance_cpg()
         if self.cpg is None:
             self._cpg_start_ms = _whole_ms(self.state.time_s)
-            self.cpg = CpgIntegrator(params, step_s=self.config.cpg_step_s)
+            start = initial_state()
+            start[OFFSET] = self.target
+            self.cpg = CpgIntegrator(params, step_s=self.config.cpg_step_s, state=start)
         else:
             self.cpg.set_parameters(params)
         self.gait = gait
