@@ -60,8 +60,8 @@ test-fast: setup  ## cores and lint, no node processes (under a minute)
 lint: setup  ## flake8, pep257, mypy (mypy.ini) and the package.xml dependency check
 	@$(WFENV) python -m pytest -m linter $(PYTEST_ARGS)
 
-bench: setup  ## benchmarks: rewrites BENCHMARKS.md
-	@$(WFENV) python -m wirefish_bench.bench
+bench: setup  ## benchmarks: rewrites BENCHMARKS.md (ONLY=firmware,...: those sections' rows)
+	@$(WFENV) python -m wirefish_bench.bench $(if $(ONLY),--only $(ONLY))
 
 shell: setup  ## an interactive shell with the workspace sourced
 	@$(WFENV) bash -i

@@ -1,11 +1,19 @@
 """Render benchmark results (the dict of `wirefish_bench.bench`) as BENCHMARKS.md."""
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import StrEnum
+import re
+
+import numpy as np
 from wirefish_bench.bench_firmware import row as firmware_row
 from wirefish_bench.bench_old_new import rows as old_new_rows
 from wirefish_bench.bench_radio_link import row as radio_row
 from wirefish_bench.bench_recorder import row as recorder_row
 from wirefish_bench.bench_view import row as view_row
 from wirefish_common.executors import ExecutorKind
+
+Row = tuple[str, str, str, str, str]  # figure, goal, measured, verdict, how
 
 
 def _fmt(value, spec: str = '.3g') -> str:
@@ -63,7 +71,7 @@ def _by_executor(items, *keys) -> dict:
     return grouped
 
 
-def _cpg_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+def _cpg_rows(results: dict) -> list[Row]:
     rows = [('CPG node rate', '', r['error'], 'failed', '')
             for r in results.get('cpg_rate', []) if 'error' in r]
     for (rate,), pair in _by_executor(results.get('cpg_rate', []), 'rate_hz').items():
@@ -94,7 +102,7 @@ def _cpg_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
-def _link_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+def _link_rows(results: dict) -> list[Row]:
     links = results.get('links_by_executor', {})
     rows = []
     for key, label in (('command', 'servo_cmd publish → frame bytes on the fish side'),
@@ -110,7 +118,7 @@ def _link_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
-def _kinematics_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+def _kinematics_rows(results: dict) -> list[Row]:
     rows = [('Kinematics node CPU', '—', r['error'], 'failed', '')
             for r in results.get('kinematics_cpu', []) if 'error' in r]
     for (stations, rate), pair in _by_executor(results.get('kinematics_cpu', []),
@@ -142,7 +150,7 @@ def _onboard_names(one_fish: dict) -> list[str]:
     return ['?']
 
 
-def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+def _fleet_rows(results: dict) -> list[Row]:
     fleet = results.get('fleet', [])
     rows = [('Fish graphs on one machine', '8 at default rates', r['error'], 'failed', '')
             for r in fleet if 'error' in r]
@@ -215,7 +223,7 @@ def _fleet_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
 LIBRARY_GOAL_S = 0.020  # the same wave twice, the second from the library
 
 
-def _library_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
+def _library_rows(results: dict) -> list[Row]:
     table = []
     lib = results.get('retune_library')
     figure = 'Retune goal answered from the gait library (the same wave again): round trip'
@@ -243,14 +251,13 @@ def _library_rows(results: dict) -> list[tuple[str, str, str, str, str]]:
     return table
 
 
-def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
-    """Return (figure, goal, measured, verdict, how) rows."""
-    table = [*_cpg_rows(results), *_link_rows(results)]
-    retune = results.get('retune', {})
-    if 'error' in retune:
+def _retune_rows(results: dict) -> list[Row]:
+    table: list[Row] = []
+    retune = results.get('retune')
+    if retune is not None and 'error' in retune:
         table.append(('Retune of the §5.2 case', '≤ 0.2 s, ≥ 50× baseline', retune['error'],
                       'not measured', ''))
-    else:
+    elif retune is not None:
         wall, ratio = retune.get('wall_s_median'), retune.get('ratio')
         table.append(('Retune of the §5.2 case: wall time, ratio vs pyswarms + per-particle ODE',
                       '≤ 0.2 s, ≥ 50×',
@@ -260,37 +267,196 @@ def rows(results: dict) -> list[tuple[str, str, str, str, str]]:
                       _verdict(wall, wall is not None and ratio is not None and wall <= 0.2
                                and ratio >= 50),
                       _fmt(retune.get('how', 'see bench_retune.py'))))
-    table += _library_rows(results)
-    if 'radio_link' in results:
-        table.append(radio_row(results['radio_link']))
-    if 'firmware' in results:
-        table.append(firmware_row(results['firmware']))
-    table += _kinematics_rows(results)
+    return table + _library_rows(results)
+
+
+def _recording_rows(results: dict) -> list[Row]:
     rec = results.get('recording', {})
     if 'error' in rec:
-        table.append(('Recording, 60 s at default rates', '0 lost', rec['error'], 'failed', ''))
-    elif rec:
-        missing = rec.get('missing_from_sequences')
-        table.append(('Recording, 60 s at default rates: messages in the bag, lost',
-                      '0 lost', f'{rec["messages"]} messages; lost {missing} (numbers missing '
-                      "from the publishers' sequences); "
-                      f'{rec.get("skipped_ticks")} publisher '
-                      'ticks skipped (gaps in the header stamps: nothing sent, nothing lost)',
-                      _verdict(rec, missing == 0),
-                      "wirefish up --duration; the recorder counts each publisher's DDS "
-                      'sequence numbers; skipped ticks from the stamps at the median period '
-                      '(report.py)'))
-    if 'recorder_cpu' in results:
-        table.append(recorder_row(results['recorder_cpu']))
-    if 'view_cpu' in results:
-        table.append(view_row(results['view_cpu']))
-    if 'old_new' in results:
-        table += old_new_rows(results['old_new'])
-    table += _fleet_rows(results)
+        return [('Recording, 60 s at default rates', '0 lost', rec['error'], 'failed', '')]
+    if not rec:
+        return []
+    missing = rec.get('missing_from_sequences')
+    return [('Recording, 60 s at default rates: messages in the bag, lost',
+             '0 lost', f'{rec["messages"]} messages; lost {missing} (numbers missing '
+             "from the publishers' sequences); "
+             f'{rec.get("skipped_ticks")} publisher '
+             'ticks skipped (gaps in the header stamps: nothing sent, nothing lost)',
+             _verdict(rec, missing == 0),
+             "wirefish up --duration; the recorder counts each publisher's DDS "
+             'sequence numbers; skipped ticks from the stamps at the median period '
+             '(report.py)')]
+
+
+# The sweep's goal: at most a third of the old wall time on the same machine, in the same run.
+SWEEP_OF_OLD = 1.0 / 3.0
+# Each point's fish in the school swims the physics it swims alone (the same speeds to the bit):
+# a difference above this is a change of the figures, not rounding (they print to 1 mm/s).
+SWEEP_SAME_SPEED_M_S = 1e-6
+
+
+def _sim_clock_rows(results: dict) -> list[Row]:
+    if 'sim_clock' not in results:
+        return []
+    sim = results['sim_clock']
+    sweep_figure = ("`wirefish sweep` over the paper's grid (virtual fish): wall and CPU time, "
+                    'old (a point after another) vs new (the points as one school)')
+    sweep_goal = ('wall ≤ ⅓ of old in the same run; the same speeds '
+                  f'(≤ {SWEEP_SAME_SPEED_M_S:g} m/s)')
+    clock_figure = ("One fish's graph on simulated time at --speed max: real-time factor, and "
+                    "CPU per simulated second against the wall clock's")
+    clock_goal = "— (the factor printed beside the wall clock's CPU per simulated s)"
+    table: list[Row] = []
+    sweep = sim.get('sweep', sim)
+    if 'error' in sweep:
+        table.append((sweep_figure, sweep_goal, sweep['error'], 'not measured', ''))
+    else:
+        old, new = sweep['old'], sweep['new']
+        ratio = new['median_wall_s'] / old['median_wall_s']
+        old_cpu, new_cpu = float(np.median(old['cpu_s'])), float(np.median(new['cpu_s']))
+        difference = sweep['largest_speed_difference_m_s']
+
+        def runs(values: list[float]) -> str:
+            return ' / '.join(f'{v:.1f}' for v in values)
+        table.append((
+            sweep_figure, sweep_goal,
+            f"wall old {old['median_wall_s']:.1f} s (runs {runs(old['wall_s'])}), new "
+            f"{new['median_wall_s']:.1f} s (runs {runs(new['wall_s'])}): {ratio:.2f} of old; "
+            f'CPU old {old_cpu:.1f} s, new {new_cpu:.1f} s: {new_cpu / old_cpu:.2f} of old; '
+            f"largest speed difference {difference:.1e} m/s over {sweep['points']} points",
+            'met' if ratio <= SWEEP_OF_OLD and difference <= SWEEP_SAME_SPEED_M_S else 'missed',
+            'run_sweep in a fresh interpreter each, old and new alternated '
+            f"{len(old['wall_s'])} times, medians; old = src/wirefish_analysis before the points "
+            'swam as schools, from git (bench_sim_clock.SWEEP_COMMIT)'))
+    wall, fast = sim.get('wall_clock', sim), sim.get('speed_max', sim)
+    failed = next((r['error'] for r in (wall, fast) if 'error' in r), None)
+    if failed is not None:
+        table.append((clock_figure, clock_goal, failed, 'not measured', ''))
+    else:
+        table.append((
+            clock_figure, clock_goal,
+            f"--speed max: {fast['real_time_factor']:.2f} simulated s per wall s, "
+            f"{fast['cpu_s_per_simulated_s']:.2f} CPU s per simulated s; wall clock: "
+            f"{wall['real_time_factor']:.2f} simulated s per wall s, "
+            f"{wall['cpu_s_per_simulated_s']:.2f} CPU s per simulated s (--speed max "
+            f"{fast['cpu_s_per_simulated_s'] / wall['cpu_s_per_simulated_s']:.2f} of it); "
+            f"{wall['processes']} processes",
+            '—',
+            f"wirefish up --sim's graph (one process per node) on the wall clock, then at "
+            f"--speed max (graph.on_simulated_time); {wall['wall_s']:.0f} s wall windows once "
+            'imu/data streams; simulated time from the /clock topic; psutil CPU of the '
+            "graph's processes (bench_sim_clock.graph_clock)"))
     return table
 
 
+def _one(key: str, row_of: Callable[[dict], Row]) -> Callable[[dict], list[Row]]:
+    """Return the rows of a section whose result ``key`` makes one row."""
+    return lambda results: [row_of(results[key])] if key in results else []
+
+
+class Section(StrEnum):
+    """A section of a run, in run_all's order: `bench --only` names these."""
+
+    CPG_RATE = 'cpg-rate'
+    LINKS = 'links'
+    RETUNE = 'retune'
+    RADIO_LINK = 'radio-link'
+    FIRMWARE = 'firmware'
+    KINEMATICS = 'kinematics'
+    RECORDING = 'recording'
+    RECORDER = 'recorder'
+    VIEW = 'view'
+    OLD_NEW = 'old-new'
+    SIM_CLOCK = 'sim-clock'
+    FLEET = 'fleet'
+
+
+SECTION_ROWS: dict[Section, Callable[[dict], list[Row]]] = {
+    Section.CPG_RATE: _cpg_rows,
+    Section.LINKS: _link_rows,
+    Section.RETUNE: _retune_rows,
+    Section.RADIO_LINK: _one('radio_link', radio_row),
+    Section.FIRMWARE: _one('firmware', firmware_row),
+    Section.KINEMATICS: _kinematics_rows,
+    Section.RECORDING: _recording_rows,
+    Section.RECORDER: _one('recorder_cpu', recorder_row),
+    Section.VIEW: _one('view_cpu', view_row),
+    Section.OLD_NEW: lambda results: (old_new_rows(results['old_new'])
+                                      if 'old_new' in results else []),
+    Section.SIM_CLOCK: _sim_clock_rows,
+    Section.FLEET: _fleet_rows,
+}
+
+
+def rows(results: dict) -> list[Row]:
+    """Return (figure, goal, measured, verdict, how) rows of every section, in order."""
+    return [row for section in Section for row in SECTION_ROWS[section](results)]
+
+
+# BENCHMARKS.md: a table per section, each naming its run; the runs, each with its machine and
+# load, in the header. A run of some sections (--only) rewrites those sections' tables and
+# keeps every other row as the file had it, byte for byte: the markdown is the record of the
+# earlier runs (their raw JSON stays on the machine that ran them).
 HISTORY_HEADING = '## History'
+TABLE_HEAD = ('| figure | goal | measured | verdict | how |', '|---|---|---|---|---|')
+WHOLE_RUN = 'whole run'
+QUICK = ', --quick (short windows)'
+_DATE = r'\d{4}-\d\d-\d\d \d\d:\d\d(?::\d\d)? UTC'
+_NAME = r'[a-z0-9-]+'
+_RUN_LINE = re.compile(rf'^- (?P<date>{_DATE}), '
+                       rf'(?P<what>(?:{WHOLE_RUN}|`--only {_NAME}(?:,{_NAME})*`)'
+                       rf'(?:{re.escape(QUICK)})?): '
+                       rf'(?P<machine>.+)\. Its rows: {_NAME}(?:, {_NAME})*\.$')
+_SECTION_HEADING = re.compile(rf'^## `(?P<name>{_NAME})`, run of (?P<date>{_DATE})$')
+# The file before it had sections: one table from one run under a "Machine:" line.
+_LEGACY_MACHINE = re.compile(rf'^Machine: (?P<machine>.+); (?P<date>{_DATE})'
+                             r'(?:, load average (?P<load>[\d.]+) at the start)?\. ')
+_LEGACY_FIGURES: dict[Section, tuple[str, ...]] = {
+    Section.CPG_RATE: ('CPG node at ', 'CPG node rate'),
+    Section.LINKS: ('servo_cmd publish → frame bytes', 'telemetry bytes written → imu/data'),
+    Section.RETUNE: ('Retune of the §5.2 case', 'Retune goal answered', '`wirefish gaits build`'),
+    Section.RADIO_LINK: ('Fish-shore radio link',),
+    Section.FIRMWARE: ('Firmware:',),
+    Section.KINEMATICS: ('Kinematics node CPU',),
+    Section.RECORDING: ('Recording, 60 s',),
+    Section.RECORDER: ('Recorder CPU',),
+    Section.VIEW: ('View server',),
+    Section.OLD_NEW: ('CPG period error at the source', 'Virtual fish of a fleet of ',
+                      'Servo intakes at ', "planner_node's imu/data intake"),
+    Section.FLEET: ("One fish's onboard graph", 'Fish at default rates on this machine',
+                    'Fish graphs on one machine', r'\d+ fish, one process per '),
+}
+
+
+class MergeError(ValueError):
+    """A previous BENCHMARKS.md whose rows cannot be told apart by section and run."""
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of `make bench`: when (its key), what it ran, the machine and its load."""
+
+    date: str
+    what: str  # WHOLE_RUN or '`--only a,b`', and QUICK after it for short windows
+    machine: str
+
+
+@dataclass(frozen=True)
+class Block:
+    """One section's rows (markdown lines, verbatim) and the date of the run they come from."""
+
+    section: str
+    run: str
+    rows: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Document:
+    """A BENCHMARKS.md as runs, sections and the History section (verbatim)."""
+
+    runs: dict[str, Run]
+    blocks: tuple[Block, ...]
+    history: str = ''
 
 
 def kept_history(previous: str) -> str:
@@ -299,21 +465,123 @@ def kept_history(previous: str) -> str:
     return previous[at + 1:] if at >= 0 else ''
 
 
-def render_markdown(results: dict, history: str = '') -> str:
-    """Return the whole BENCHMARKS.md text: this run's table, then ``history`` as it was."""
-    m = results['machine']
+def _machine_text(m: dict) -> str:
+    return (f'{m["cpu"]}, {m["cores"]} cores, Python {m["python"]}, numpy {m["numpy"]}, '
+            f'kernel {m["kernel"]}' + (f'; load average {m["load_average_1min"]:.1f} at the start'
+                                       if 'load_average_1min' in m else ''))
+
+
+def ran_sections(results: dict) -> list[Section]:
+    """Return the sections ``results`` ran (results['sections']; every section if unsaid)."""
+    return [Section(s) for s in results.get('sections', list(Section))]
+
+
+def _fresh(results: dict, what: str) -> tuple[Run, list[Block]]:
+    run = Run(results['machine']['date'], what + (QUICK if results.get('quick') else ''),
+              _machine_text(results['machine']))
+    return run, [Block(section, run.date, tuple(
+        f'| {figure} | {goal} | {measured} | {verdict} | {how} |'
+        for figure, goal, measured, verdict, how in SECTION_ROWS[section](results)))
+        for section in ran_sections(results)]
+
+
+def _legacy(lines: list[str], history: str) -> Document:
+    machine = next((m for m in map(_LEGACY_MACHINE.match, lines) if m), None)
+    if machine is None:
+        raise MergeError('BENCHMARKS.md has neither sections nor a "Machine:" line to date its '
+                         'table by')
+    date = machine['date']
+    load = f'; load average {machine["load"]} at the start' if machine['load'] else ''
+    rows: dict[Section, list[str]] = {}
+    for line in lines:
+        if not line.startswith('| ') or line in TABLE_HEAD:
+            continue
+        figure = line[2:].split(' | ', 1)[0]
+        section = next((s for s, patterns in _LEGACY_FIGURES.items()
+                        if any(re.match(p, figure) for p in patterns)), None)
+        if section is None:
+            raise MergeError(f'a row of BENCHMARKS.md belongs to no section: {figure!r}')
+        rows.setdefault(section, []).append(line)
+    return Document({date: Run(date, WHOLE_RUN, machine['machine'] + load)},
+                    tuple(Block(s, date, tuple(rows[s])) for s in Section if s in rows), history)
+
+
+def parse_markdown(text: str) -> Document:
+    """
+    Read a BENCHMARKS.md: its runs, each section's row lines (verbatim) and its History.
+
+    A file from before the sections (one table under a "Machine:" line) is one whole run, its
+    rows given to sections by their figure. Raise MergeError when a row cannot be placed.
+    """
+    history = kept_history(text)
+    lines = text[:len(text) - len(history)].splitlines()
+    if not any(_SECTION_HEADING.match(line) for line in lines):
+        if not text.strip():
+            return Document({}, (), history)
+        return _legacy(lines, history)
+    runs: dict[str, Run] = {}
+    blocks: list[Block] = []
+    for line in lines:
+        if (run := _RUN_LINE.match(line)) is not None:
+            runs[run['date']] = Run(run['date'], run['what'], run['machine'])
+        elif (heading := _SECTION_HEADING.match(line)) is not None:
+            blocks.append(Block(heading['name'], heading['date'], ()))
+        elif blocks and line.startswith('| ') and line not in TABLE_HEAD:
+            last = blocks[-1]
+            blocks[-1] = Block(last.section, last.run, (*last.rows, line))
+    for block in blocks:
+        if block.run not in runs:
+            raise MergeError(f'section {block.section} names the run of {block.run}, which the '
+                             "header's runs do not list")
+    if len({b.section for b in blocks}) != len(blocks):
+        raise MergeError('a section appears twice in BENCHMARKS.md')
+    return Document(runs, tuple(blocks), history)
+
+
+def render_document(document: Document) -> str:
+    """Return the BENCHMARKS.md text of ``document``: header with its runs, sections, History."""
+    used = [run for date, run in sorted(document.runs.items())
+            if any(b.run == date for b in document.blocks)]
     lines = ['# Benchmarks', '',
-             'Written by `make bench` (`python -m wirefish_bench.bench`); figures from one '
-             'run.',
-             f'Machine: {m["cpu"]}, {m["cores"]} cores, Python {m["python"]}, numpy '
-             f'{m["numpy"]}, kernel {m["kernel"]}; {m["date"]}'
-             + (f', load average {m["load_average_1min"]:.1f} at the start'
-                if 'load_average_1min' in m else '')
-             + '. Shared and noisy: medians and p99 from one run, ratios within that run.', '',
-             '| figure | goal | measured | verdict | how |', '|---|---|---|---|---|']
-    for figure, goal, measured, verdict, how in rows(results):
-        lines.append(f'| {figure} | {goal} | {measured} | {verdict} | {how} |')
-    lines += ['', 'Raw numbers: `out/bench/results.json` of the same run. Why the figures are '
-              'what they are (py-spy profiles, what limits each missed goal, what would close '
-              'it): [docs/PROFILING.md](docs/PROFILING.md).', '']
-    return '\n'.join(lines) + ('\n' + history if history else '')
+             'Written by `make bench` (`python -m wirefish_bench.bench`): a whole run rewrites '
+             'every section; `make bench ONLY=firmware,sim-clock` (`--only`) runs the named '
+             'sections and rewrites their rows, keeping every other row as its run wrote it. '
+             'Each section names its run; the runs (machine, load average at the start):', '']
+    for run in used:
+        names = ', '.join(b.section for b in document.blocks if b.run == run.date)
+        lines.append(f'- {run.date}, {run.what}: {run.machine}. Its rows: {names}.')
+    lines += ['', 'Shared and noisy: medians and p99 from one run, ratios within that run; rows '
+              'of different runs differ by their load too.', '']
+    for block in document.blocks:
+        lines += [f'## `{block.section}`, run of {block.run}', '', *TABLE_HEAD, *block.rows, '']
+    lines += ['Raw numbers: `out/bench/results.json` of each run, on the machine that ran it (a '
+              'run of some sections holds those). Why the figures are what they are (py-spy '
+              'profiles, what limits each missed goal, what would close it): '
+              '[docs/PROFILING.md](docs/PROFILING.md).', '']
+    text = '\n'.join(lines)
+    return text + ('\n' + document.history if document.history else '')
+
+
+def render_markdown(results: dict, history: str = '') -> str:
+    """Return the whole BENCHMARKS.md text of a whole run, then ``history`` as it was."""
+    run, blocks = _fresh(results, WHOLE_RUN)
+    return render_document(Document({run.date: run}, tuple(blocks), history))
+
+
+def merge_markdown(previous: Document, results: dict) -> str:
+    """
+    Return BENCHMARKS.md with the sections ``results`` ran replaced, every other row kept.
+
+    Kept rows stay byte for byte with their run; a section new to the file is added in
+    run_all's order; sections the file has and the tool no longer runs stay after them.
+    """
+    ran = ran_sections(results)
+    run, fresh = _fresh(results, f'`--only {",".join(ran)}`')
+    if run.date in previous.runs:
+        raise MergeError(f'BENCHMARKS.md already has a run of {run.date}')
+    by_section = {b.section: b for b in previous.blocks}
+    by_section.update({b.section: b for b in fresh})
+    known = [by_section[s] for s in Section if s in by_section]
+    others = [b for b in previous.blocks if b.section not in set(Section)]
+    return render_document(Document({**previous.runs, run.date: run}, (*known, *others),
+                                    previous.history))
