@@ -73,8 +73,15 @@ GOOD_GAIT = Gait(1, 1.0, 0.38, 0.47, 0.0, 0.0, -0.41, 0.64, 1.76, 1.06, 20.0)
 def test_a_table_1_gait_is_valid():
     assert GOOD_GAIT.problem(LIMIT) is None
     edge = dataclasses.replace(GOOD_GAIT, gait_id=65535, frequency_hz=10.0, amplitude_1=0.0,
-                               amplitude_2=LIMIT, offset_1=-LIMIT, offset_2=LIMIT, alpha=200.0)
+                               amplitude_2=LIMIT, offset_1=-LIMIT, offset_2=LIMIT, alpha=200.0,
+                               w12=100.0, w21=-100.0, phi12=2 * math.pi, phi21=-2 * math.pi)
     assert edge.problem(LIMIT) is None
+    # The largest binary32 bias a GAIT can carry within 2 pi (the board's bound) is valid; the
+    # binary32 nearest 2 pi is just above it and refused, on both sides alike.
+    below = float(np.nextafter(np.float32(2 * math.pi), np.float32(0)))
+    assert dataclasses.replace(GOOD_GAIT, phi12=below).problem(LIMIT) is None
+    above = float(np.float32(2 * math.pi))
+    assert 'phi21' in dataclasses.replace(GOOD_GAIT, phi21=-above).problem(LIMIT)
 
 
 @pytest.mark.parametrize('change, word', [
@@ -82,6 +89,8 @@ def test_a_table_1_gait_is_valid():
     ({'frequency_hz': 10.01}, 'frequency'), ({'amplitude_1': -0.01}, 'amplitude_1'),
     ({'amplitude_2': 1.6}, 'amplitude_2'), ({'offset_1': -1.6}, 'offset_1'),
     ({'alpha': 0.0}, 'alpha'), ({'alpha': 201.0}, 'alpha'), ({'w12': math.nan}, 'finite'),
+    ({'w12': 100.001}, 'w12'), ({'w21': -1e30}, 'w21'), ({'phi12': 6.3}, 'phi12'),
+    ({'phi21': -7.0}, 'phi21'),
 ])
 def test_each_gait_out_of_range_is_named(change, word):
     problem = dataclasses.replace(GOOD_GAIT, **change).problem(LIMIT)

@@ -10,7 +10,7 @@ from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, 
                                       ServoCommand, Status, Telemetry, TelemetryCompact,
                                       TelemetryForm)
 from wirefish_bridge.telemetry_limits import telemetry_problem
-from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
+from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters, OFFSET
 from wirefish_sim.virtual_fish import Gap, ImuNoise, SimConfig, VirtualFish
 
 TABLE_1 = Gait(1, 1.0, 0.38, 0.47, 0.0, 0.0, -0.41, 0.64, 1.76, 1.06, 20.0)
@@ -87,7 +87,9 @@ def test_a_new_gait_changes_the_tail_without_a_step():
 
 
 @pytest.mark.parametrize('change', [{'gait_id': 0}, {'frequency_hz': 11.0},
-                                    {'amplitude_1': 1.6}, {'offset_2': -1.6}, {'alpha': 0.0}])
+                                    {'amplitude_1': 1.6}, {'offset_2': -1.6}, {'alpha': 0.0},
+                                    {'w12': 100.5}, {'w21': -1e30}, {'phi12': 6.3},
+                                    {'phi21': -1e30}])
 def test_a_gait_out_of_range_gets_error_6_then_ack_6_and_changes_nothing(change):
     host = Host()
     host.run(5, Heartbeat())
@@ -97,6 +99,61 @@ def test_a_gait_out_of_range_gets_error_6_then_ack_6_and_changes_nothing(change)
     assert refusal == [ErrorReport(ErrorCode.COMMAND_OUT_OF_RANGE, seq),
                        Ack(MsgType.GAIT, seq, ErrorCode.COMMAND_OUT_OF_RANGE)]
     assert host.fish.gait is None and not host.fish.status & Status.GAIT_MODE
+
+
+def test_a_gait_with_couplings_beyond_the_bounds_leaves_the_running_gait_as_it_is():
+    host = Host()
+    host.run(5, Heartbeat())
+    host.run(500, TABLE_1, every_ms={200: Heartbeat()})
+    state = host.fish.cpg.state
+    out = host.run(1, dataclasses.replace(FAST, w12=1e30, w21=-1e30))
+    seq = host.last_seqs[0]
+    assert Ack(MsgType.GAIT, seq, ErrorCode.COMMAND_OUT_OF_RANGE) in out
+    assert host.fish.gait_id == 1 and host.fish.cpg.parameters.w12 == pytest.approx(-0.41)
+    # One more step of the same gait: the phases went on, nothing restarted.
+    assert np.abs(host.fish.cpg.state - state).max() < 2 * np.pi * 1.0 * 1e-3 * 1.1
+
+
+def test_gait_mode_starts_from_the_angles_stream_mode_held():
+    host = Host()
+    host.run(5, Heartbeat())
+    host.run(300, ServoCommand(0.3, -0.3), every_ms={100: ServoCommand(0.3, -0.3)})
+    held = host.fish.target
+    assert held == pytest.approx((0.3, -0.3), abs=1e-7)  # binary32 on the wire
+    start = len(host.targets)
+    host.run(3000, TABLE_1, every_ms={200: Heartbeat()})
+    targets = np.array([held] + host.targets[start:])
+    # The switch's millisecond moves nothing; then the output is the oscillator's from rest
+    # but for its offsets at the angles held (phases, amplitudes and rates 0).
+    assert tuple(targets[1]) == held
+    f32 = [float(np.float32(v)) for v in TABLE_1.to_wire()[1:]]
+    initial = np.zeros((5, 2))
+    initial[OFFSET] = held
+    cpg = CpgIntegrator(CpgParameters(f32[0], tuple(f32[1:3]), tuple(f32[3:5]), *f32[5:]),
+                        state=initial)
+    expected = []
+    for k in range(3000):
+        cpg.advance(k * 1e-3)
+        expected.append(cpg.output(cpg.time_s)[0])
+    np.testing.assert_allclose(targets[1:], expected, atol=1e-12)
+    # Never more per ms than swimming itself (r 2 pi v h at 1 Hz, 3 mrad), and the offsets
+    # converged to the gait's through alpha = 20 (0.3 (1 + 10 t) e^-10t: 4e-12 rad at 3 s).
+    assert np.abs(np.diff(targets, axis=0)).max() < 0.47 * 2 * np.pi * 1.0 * 1e-3 * 1.3
+    assert np.abs(host.fish.cpg.state[OFFSET]).max() < 1e-9
+    assert max(abs(a) for a, _ in host.targets[-1000:]) == pytest.approx(0.38, abs=0.02)
+
+
+def test_gait_mode_entered_during_the_failsafe_slew_goes_on_from_the_slew():
+    host = Host(command_timeout_s=0.5)
+    host.run(5, Heartbeat())
+    host.run(700, ServoCommand(0.8, -0.8), every_ms={200: Heartbeat()})
+    held = host.fish.target
+    assert host.fish.status & Status.FAILSAFE_COMMAND and 0.3 < held[0] < 0.7
+    start = len(host.targets)
+    host.run(1000, TABLE_1, every_ms={200: Heartbeat()})
+    targets = np.array([held] + host.targets[start:])
+    assert tuple(targets[1]) == held
+    assert np.abs(np.diff(targets, axis=0)).max() < 0.47 * 2 * np.pi * 1.0 * 1e-3 * 1.3
 
 
 def test_a_servo_command_in_gait_mode_goes_back_to_stream_mode():
