@@ -304,8 +304,9 @@ class RadioLink:
         uart = self._uart[direction]
         byte_s = 10.0 / self.params.uart_baud
         for unit in frame_units(data):
-            queued = sum(len(chunk) for _, chunk in uart)
-            if queued + len(unit) > self.params.uart_buffer_bytes:
+            # The bytes the UART has not shifted out yet: it frees room byte by byte.
+            queued = max(0.0, self._uart_free[direction] - now) / byte_s
+            if queued + len(unit) > self.params.uart_buffer_bytes + 1e-9:
                 stats.frames_refused += 1
                 continue
             self._uart_free[direction] = (max(now, self._uart_free[direction])
