@@ -1,4 +1,4 @@
-"""`make bench` rewrites BENCHMARKS.md's table and keeps its History section as it was."""
+"""A whole `make bench` rewrites BENCHMARKS.md's tables and keeps its History section as it was."""
 
 from wirefish_bench.bench_report import kept_history, render_markdown
 
