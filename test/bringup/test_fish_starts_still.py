@@ -16,7 +16,8 @@ def test_the_fish_starts_still_and_swims_at_the_first_cmd_vel(ros_domain_id, ros
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
-    from wirefish_msgs.msg import PlannerState
+    from wirefish_common.qos import LATCHED
+    from wirefish_msgs.msg import CpgParams, PlannerState
 
     graph = start_graph(ros_domain_id, tmp_path, namespace=NAMESPACE, swimming=False)
     node = rclpy.create_node('still_probe', namespace=NAMESPACE, context=ros_context)
@@ -32,6 +33,9 @@ def test_the_fish_starts_still_and_swims_at_the_first_cmd_vel(ros_domain_id, ros
                                  qos_profile_sensor_data)
         node.create_subscription(PlannerState, 'planner_state', lambda m: modes.append(m.mode),
                                  10)
+        # What the CPG says it runs (a bridge in gait mode sends it to the board as the gait).
+        params: list = []
+        node.create_subscription(CpgParams, 'cpg_params', params.append, LATCHED)
         assert spin_until(executor, lambda: servo and modes, timeout_s=30.0)
         heard = len(servo)
         assert spin_until(executor, lambda: len(servo) > heard + 100 * STILL_WINDOW_S,
@@ -39,6 +43,7 @@ def test_the_fish_starts_still_and_swims_at_the_first_cmd_vel(ros_domain_id, ros
         # Every sample since start-up at neutral, and every state says so.
         assert max(abs(angle) for sample in servo for angle in sample) == 0.0
         assert set(modes) == {'still'}, set(modes)
+        assert params and all(list(p.amplitude) == [0.0, 0.0] for p in params), params
 
         cmd_vel = node.create_publisher(Twist, 'cmd_vel', 10)
         command = Twist()

@@ -272,8 +272,14 @@ def _effective_params(args: argparse.Namespace, run_dir: Path
     def put(key: str, name: str, value: object) -> None:
         options.setdefault(key, {'ros__parameters': {}})['ros__parameters'][name] = value
 
-    if args.start_swimming:
+    if args.start_swimming:  # Table 1's gait (the defaults file starts with amplitudes 0)
+        from wirefish_cpg.cpg_node_parameters import flat_values
+        from wirefish_cpg.oscillator import CpgParameters
+
+        table1 = flat_values(CpgParameters())
         put('/**/cpg_node', 'autostart', True)
+        put('/**/cpg_node', 'amplitude_1', table1['amplitude_1'])
+        put('/**/cpg_node', 'amplitude_2', table1['amplitude_2'])
         put('/**/planner_node', 'rest_at_start', False)
     if args.view_port is not None:
         put('/**/view_node', 'port', args.view_port)
