@@ -67,7 +67,9 @@ void board_bor_init(void)
 #if !WF_PORT_QEMU
     enum { OPTION_WRITE_LOOPS = 4000000 };   /* > 0.5 s at 16 MHz: a sector erase is ~ms */
     if ((FLASH_OPTCR & FLASH_OPTCR_BOR_LEV_MASK) != FLASH_OPTCR_BOR_LEV3) {
-        /* Only BOR_LEV changes: read protection and write protection keep their values. */
+        /* Only BOR_LEV changes: read protection and write protection keep their values. Done
+         * once in a board's life; the option bytes are loaded at reset, so the level holds
+         * from the next one (the check below reads the programmed register). */
         FLASH_OPTKEYR = FLASH_OPTKEY1;
         FLASH_OPTKEYR = FLASH_OPTKEY2;
         for (uint32_t i = 0u; i < OPTION_WRITE_LOOPS && (FLASH_SR & FLASH_SR_BSY); i++) {
