@@ -151,8 +151,9 @@ def virtual_fish_speeds(geometry: FishGeometry,
                  else amplitude_scale_for(point.tip_amplitude, point.frequency_hz, geometry))
         gaits.append((table1_locked_at(point.frequency_hz, scale), point.frequency_hz))
     runs = run_steady_school(gaits, geometry)
-    for point in points if progress is not None else ():
-        progress.step(text=f'virtual fish at {point.frequency_hz:g} Hz')
+    if progress is not None:
+        for point in points:
+            progress.step(text=f'virtual fish at {point.frequency_hz:g} Hz')
     return [run.speed for run in runs]
 
 

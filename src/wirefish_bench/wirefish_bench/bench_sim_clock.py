@@ -119,7 +119,7 @@ def graph_clock(speed: str | None, window_s: float, domain_id: int = DOMAIN) -> 
         wall = time.monotonic() - started
         cpu = sum(sum(p.cpu_times()[:2]) for p in procs) - cpu_start
         sim_end = latest[-1] if latest else None
-    simulated = (sim_end - sim_start) if sim_start is not None else wall
+    simulated = (sim_end - sim_start) if sim_start is not None and sim_end is not None else wall
     return {'speed': speed or 'wall clock', 'wall_s': wall, 'simulated_s': simulated,
             'real_time_factor': simulated / wall, 'cpu_s': cpu,
             'cpu_s_per_simulated_s': cpu / simulated, 'processes': len(procs)}

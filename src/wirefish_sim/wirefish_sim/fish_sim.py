@@ -44,7 +44,7 @@ from pathlib import Path
 import select
 import sys
 import time
-from typing import NoReturn
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -187,7 +187,7 @@ class GroundTruthPublisher:
         self._odometry = Odometry
         self.publishers = [self.node.create_publisher(
             Odometry, prefixed(name, 'sim/ground_truth'), RELIABLE) for name in names]
-        self._clock_publisher = None
+        self._clock_publisher: Any = None  # an rclpy Publisher once the clock is published
 
     def publish_clock(self, time_ns: int) -> None:
         """Publish ``time_ns`` on the node's ``clock`` (made at the first call)."""
