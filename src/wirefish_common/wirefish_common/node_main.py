@@ -65,6 +65,9 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
     signals = SignalShutdown()  # before rclpy.init: no window with rclpy's handlers
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     factory = executor_factory or chosen_executor_factory()
+    if signals.requested:  # a stop while rclpy started: no node to build, nothing to undo
+        rclpy.try_shutdown()
+        exit_now(0)
     node = create_node_or_exit(node_class)
     executor = factory()
     executor.add_node(node)
