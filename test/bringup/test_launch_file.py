@@ -20,6 +20,7 @@ from wirefish_bringup.graph import entry
 from wirefish_common.frames import FRAME_PREFIX
 from wirefish_common.parameter_table import ParameterSpec
 from wirefish_common.startup_signals import held_start_prefix
+import yaml
 
 LAUNCH_FILE = (Path(__file__).resolve().parents[2] / 'src' / 'wirefish_bringup' / 'launch'
                / 'wirefish.launch.py')
@@ -125,6 +126,8 @@ def declared(node_name: str) -> dict[str, ParameterSpec]:
     specs = {s.name: s for s in declared_specs(entry(node_name))}
     if entry(node_name).frames:
         specs[FRAME_PREFIX] = ParameterSpec(FRAME_PREFIX, '', 'frame id prefix')
+    # rclpy's own, on every node: simulated time (the virtual fish's clock).
+    specs['use_sim_time'] = ParameterSpec('use_sim_time', False, 'follow /clock')
     return specs
 
 
@@ -237,3 +240,24 @@ def test_a_real_fish_without_a_port_names_the_launch_argument(monkeypatch):
     with pytest.raises(ValueError, match=r'port:=/dev/ttyUSB0') as refused:
         launched_nodes(monkeypatch, sim='false')
     assert '--port' not in str(refused.value)
+
+
+def test_the_virtual_fish_on_one_host_runs_the_graph_on_its_clock(monkeypatch):
+    nodes = {n['name']: n for n in launched_nodes(monkeypatch, **LAUNCHES['sim'],
+                                                  speed='max')}
+    assert nodes['fish_sim']['arguments'][-2:] == ['--speed', 'max']
+    for name, node in nodes.items():
+        if name == 'fish_sim':
+            continue
+        assert node['parameters'][-1]['use_sim_time'] is True, name
+        assert ('/clock', '/rt/clock') in node['remappings'], name
+    override = yaml.safe_load(Path(nodes['bridge_node']['parameters'][1]).read_text())
+    assert override['/**/bridge_node']['ros__parameters']['max_command_rate_hz'] == 1000.0
+
+
+def test_a_real_fish_and_two_hosts_run_on_the_wall_clock(monkeypatch):
+    for launch in ('real fish', 'fish role, prefixed', 'shore role'):
+        for node in launched_nodes(monkeypatch, **LAUNCHES[launch]):
+            assert '--speed' not in node['arguments'] and not node['remappings'], launch
+            assert all('use_sim_time' not in values for values in node['parameters']
+                       if isinstance(values, dict)), launch

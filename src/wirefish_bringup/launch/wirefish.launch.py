@@ -1,7 +1,7 @@
 """
 Start one fish's graph on a full ROS 2 Jazzy install.
 
-    ros2 launch wirefish_bringup wirefish.launch.py sim:=true namespace:=/wirefish
+    ros2 launch wirefish_bringup wirefish.launch.py sim:=true namespace:=/wirefish speed:=max
     ros2 launch wirefish_bringup wirefish.launch.py sim:=false port:=/dev/ttyUSB0
     ros2 launch wirefish_bringup wirefish.launch.py role:=fish   # on the fish's computer
     ros2 launch wirefish_bringup wirefish.launch.py role:=shore  # on the shore's
@@ -28,7 +28,8 @@ from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
 from wirefish_bringup.dds_profile import (profile_path, PROFILES_VARIABLE, TRANSPORTS,
                                           TRANSPORTS_VARIABLE)
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, Role
+from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, on_simulated_time, Role
+from wirefish_common.input_checks import parse_speed
 from wirefish_common.startup_signals import held_start_prefix
 
 
@@ -74,6 +75,23 @@ def _prefix(held, spec):
     return [f'{held} ', user]
 
 
+def _simulated_time_overrides():
+    """Return a parameter file of what simulated time changes in the parameter file's sections."""
+    # launch_ros writes a dict of values under /**, which a /**/bridge_node section of the
+    # parameter file overrides: a file of its own, after that one, carries the bridge's value.
+    import tempfile
+
+    import yaml
+    from wirefish_bringup.graph import SIM_TIME_COMMAND_RATE_HZ
+
+    overrides = {'/**/bridge_node': {'ros__parameters': {
+        'max_command_rate_hz': float(SIM_TIME_COMMAND_RATE_HZ)}}}
+    with tempfile.NamedTemporaryFile('w', prefix='wirefish_sim_time_', suffix='.yaml',
+                                     delete=False) as file:
+        yaml.safe_dump(overrides, file)
+    return file.name
+
+
 def _nodes(context):
     sim = LaunchConfiguration('sim').perform(context).lower() in ('true', '1', 'yes')
     port = LaunchConfiguration('port').perform(context) or None
@@ -81,6 +99,7 @@ def _nodes(context):
     params_file = LaunchConfiguration('params_file').perform(context) or None
     role = LaunchConfiguration('role').perform(context)
     frame_prefix = LaunchConfiguration('frame_prefix').perform(context)
+    speed = LaunchConfiguration('speed').perform(context)
     actions = []
     # A Ctrl-C while a node's interpreter starts waits for the node's own handler (every
     # registry executable unblocks the stop signals once it is in place), not a trace.
@@ -88,15 +107,25 @@ def _nodes(context):
     if not sim and not port:  # fish_graph's own words name wirefish up's --port
         raise ValueError('sim:=false drives a real fish: give its serial port, e.g. '
                          'port:=/dev/ttyUSB0')
-    for spec in fish_graph(namespace, sim=sim, port=port, params_file=params_file, role=role,
-                           frame_prefix=frame_prefix):
+    specs = fish_graph(namespace, sim=sim, port=port, params_file=params_file, role=role,
+                       frame_prefix=frame_prefix)
+    # The virtual fish on one host owns the graph's clock, as under `wirefish up --sim`; a
+    # real fish and two hosts run on the wall clock.
+    simulated = sim and role == Role.ALL
+    if simulated:
+        parse_speed(speed)  # a clear error for a speed that is none
+        specs = on_simulated_time(specs, speed)
+    for spec in specs:
         # The recorder (the only entry that parses its own options) runs with --duration
         # under `wirefish up` only: fish_graph adds it only when given a bag.
         actions.append(Node(
             package=spec.package, executable=spec.executable, name=spec.name,
             exec_name=spec.name,
             namespace=spec.namespace, arguments=list(spec.arguments),
-            parameters=[spec.params_file, spec.typed_parameters()],
+            parameters=[spec.params_file,
+                        *([_simulated_time_overrides()] if simulated else []),
+                        spec.typed_parameters()],
+            remappings=list(spec.remaps.items()),
             respawn=spec.restart.respawn, respawn_delay=spec.restart.delay_s,
             respawn_max_retries=spec.restart.max_restarts,
             on_exit=_shutdown_after_last_retry(spec) if spec.restart.required else None,
@@ -128,5 +157,9 @@ def generate_launch_description():
                               'the link relay to shore); shore: tuner (and recorder); all: both'),
         DeclareLaunchArgument('frame_prefix', default_value='',
                               description='prefix of frame ids (fish_1 -> fish_1/base_link)'),
+        DeclareLaunchArgument('speed', default_value='1',
+                              description='sim:=true on one host: the virtual fish owns the '
+                              'clock, every node on simulated time at this factor on real time '
+                              '(1; max: as fast as the graph answers)'),
         OpaqueFunction(function=_nodes),
     ])
