@@ -42,3 +42,19 @@ def test_the_view_binds_where_it_is_told_and_warns_when_wider(spawn, options, ad
     output, _ = view.communicate(timeout=20)
     assert view.returncode == 0, output
     assert ('binding 0.0.0.0' in output) == warned, output
+
+
+def test_a_port_in_use_is_one_fatal_line_not_a_traceback(spawn):
+    ws_port, http_port = free_port(), free_port()
+    first = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'view', '--namespace', '/view_one',
+                   '--port', str(ws_port), '--http-port', str(http_port)])
+    assert _listening(first.pid, {ws_port, http_port}, 30.0) == {'127.0.0.1'}
+    for ports in ((ws_port, free_port()), (0, http_port)):
+        second = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'view', '--namespace',
+                        '/view_two', '--port', str(ports[0]), '--http-port', str(ports[1])])
+        output, _ = second.communicate(timeout=60)
+        assert second.returncode == 1, output
+        assert 'Traceback' not in output and output.count('[FATAL]') == 1, output
+        assert 'another view' in output and str(ws_port if ports[0] else http_port) in output
+    first.send_signal(2)
+    first.communicate(timeout=20)

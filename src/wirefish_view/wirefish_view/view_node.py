@@ -57,7 +57,7 @@ from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare
+from wirefish_common.parameter_table import declare, InvalidParameters
 from wirefish_common.qos import RELIABLE, SENSOR_DATA, TF
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
@@ -168,14 +168,23 @@ class ViewNode(Node):
             supported_encodings=['cdr', 'json'], server_listener=_Listener(self),
             services=services,
             context=self._fox_context)
-        self._front = FrontDoor(address, self._values['port'], self._server.port, self,
-                                self.get_logger().warn)
         self._web = None
+        try:
+            self._front = FrontDoor(address, self._values['port'], self._server.port, self,
+                                    self.get_logger().warn)
+        except OSError as error:
+            self._server.stop()
+            raise _unbound('port', address, self._values['port'], error) from None
         if self._values['http_port'] >= 0:
-            self._web = DashboardServer(address, self._values['http_port'], {
-                'websocket_port': self._front.port, 'namespace': self._namespace,
-                'max_speed': self._values['max_speed'], 'max_turn': self._values['max_turn'],
-                'frames': self._frames})
+            try:
+                self._web = DashboardServer(address, self._values['http_port'], {
+                    'websocket_port': self._front.port, 'namespace': self._namespace,
+                    'max_speed': self._values['max_speed'],
+                    'max_turn': self._values['max_turn'], 'frames': self._frames})
+            except OSError as error:
+                self._front.stop()
+                self._server.stop()
+                raise _unbound('http_port', address, self._values['http_port'], error) from None
         self.get_logger().info(
             f'Foxglove WebSocket ws://{address}:{self._front.port}'
             + (f', dashboard http://{address}:{self._web.port}/' if self._web else ''))
@@ -383,6 +392,14 @@ def _service_schema(name: str, request: type, response: type) -> Any:
         return foxglove.MessageSchema(encoding='json', schema=schema)
     return foxglove.ServiceSchema(name, request=message(request, 'Request'),
                                   response=message(response, 'Response'))
+
+
+def _unbound(name: str, address: str, port: int, error: OSError) -> InvalidParameters:
+    """Return the start-up refusal of a port that cannot be bound (one FATAL line, exit 1)."""
+    return InvalidParameters(
+        f'view_node: {name} {port} on {address}: {error.strerror or error}; another view '
+        '(wirefish view, wirefish up --view) may hold it: give it another port (wirefish '
+        'view --port/--http-port, or 0 for any free one)')
 
 
 def _json_safe(value: Any) -> Any:
