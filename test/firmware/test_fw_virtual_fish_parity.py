@@ -26,7 +26,8 @@ LINK_CONFIG with compact telemetry and its HEALTH period, a gap long enough to c
 the link back, a SERVO_CMD back to stream mode, a version mismatch in gait mode) and the
 switch from stream to gait mode while stream mode holds a command, while it slews to neutral
 and right after a SERVO_CMD of the same chunk: both start the oscillator with its offsets at
-the angles held, so the switch's millisecond moves no servo at all.
+the angles held, so the switch's millisecond moves no servo at all; and GAITs just within and
+just beyond the coupling and phase-bias bounds, accepted and refused alike.
 """
 
 from collections.abc import Iterator
@@ -87,12 +88,19 @@ GAIT_EVENTS = {
 # Into gait mode from stream mode: holding (0.3, -0.3) rad (commands every 10 ms up to 290);
 # part way through the failsafe's slew (commands stop at 1000, the slew starts at 1501); and
 # with a SERVO_CMD just before the GAIT in one chunk (the board sets its outputs at the
-# command, so gait mode starts from that command's angles).
+# command, so gait mode starts from that command's angles). Then GAITs at the coupling and
+# bias bounds (binary32 on the wire): the next binary32 beyond 100/s and 2 pi refused (ACK
+# 6), 100/s and the binary32 below 2 pi accepted, by both alike.
+ABOVE_2PI = float(np.float32(2 * np.pi))
+BELOW_2PI = float(np.nextafter(np.float32(2 * np.pi), np.float32(0)))
 HELD_EVENTS = {
     300: (TABLE_1,),
     1000: (ServoCommand(0.3, -0.2),),
     1580: (replace(TABLE_1, gait_id=2),),
     2200: (ServoCommand(0.5, -0.4), replace(TABLE_1, gait_id=3, offset_1=-0.2)),
+    2600: (replace(TABLE_1, gait_id=4, w12=float(np.nextafter(np.float32(100), np.inf))),
+           replace(TABLE_1, gait_id=5, phi21=-ABOVE_2PI),
+           replace(TABLE_1, gait_id=6, w21=-100.0, phi12=BELOW_2PI)),
 }
 SCENARIOS = [
     Scenario('nominal'),
@@ -274,6 +282,7 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     if scenario.command is not None:
         print(f'{scenario.name}: into gait mode at {entries}')
         assert [held != (0.0, 0.0) for _, held in entries] == [True] * 3
+        assert fish.gait_id == 6 and board.gait().gaits_refused == 2
     if scenario.silent[1]:
         assert any(s & Status.SERVO_CLAMPED and s & Status.GAIT_MODE for s in statuses)
         assert {Status.COASTING, Status.RESTING} <= {s & GAP_FLAGS for s in statuses}
