@@ -184,7 +184,8 @@ void wf_telemetry_compact(const wf_telemetry_t *full, wf_telemetry_compact_t *co
 bool wf_link_config_valid(const wf_link_config_t *config);
 
 /* The rules a receiver applies to a well-formed GAIT: gait_id 1..65535 and the parameters
- * within wf_cpg_params_valid for the board's servo limit. */
+ * within wf_cpg_params_valid for the board's servo limit (frequency, amplitudes and offsets,
+ * couplings |w| <= 100/s, phase biases |phi| <= 2 pi, alpha). */
 bool wf_gait_valid(const wf_gait_t *gait, float servo_limit_rad);
 
 /* Why a run was dropped, or that it is a frame; the checks in the order they are made. */
