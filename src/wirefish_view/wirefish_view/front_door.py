@@ -34,10 +34,11 @@ from websockets.asyncio.server import serve, ServerConnection
 from websockets.datastructures import Headers
 from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
+from websockets.typing import Subprotocol
 from wirefish_view.errors import Refusal, RefusedInput
 
-SUBPROTOCOLS = ('foxglove.sdk.v1', 'foxglove.websocket.v1')
-UPSTREAM_SUBPROTOCOL = 'foxglove.sdk.v1'
+SUBPROTOCOLS = (Subprotocol('foxglove.sdk.v1'), Subprotocol('foxglove.websocket.v1'))
+UPSTREAM_SUBPROTOCOL = Subprotocol('foxglove.sdk.v1')
 STATUS_PERIOD_S = 1.0
 CLIENT_MESSAGE_DATA = 0x01
 WARNING = 1  # the protocol's status levels: 0 info, 1 warning, 2 error
@@ -60,9 +61,9 @@ def offered_subprotocols(headers: Headers) -> list[str]:
             for name in value.split(',') if name.strip()]
 
 
-def chosen_subprotocol(offered: Sequence[str]) -> str | None:
+def chosen_subprotocol(offered: Sequence[str]) -> Subprotocol | None:
     """Return the first offered name the view speaks, or None."""
-    return next((name for name in offered if name in SUBPROTOCOLS), None)
+    return next((Subprotocol(name) for name in offered if name in SUBPROTOCOLS), None)
 
 
 @dataclass
@@ -137,7 +138,7 @@ class FrontDoor:
                          select_subprotocol=lambda _c, offered: chosen_subprotocol(offered),
                          process_request=self._check_handshake, compression=None,
                          server_header=None) as server:
-            bound.append(server.sockets[0].getsockname()[1])
+            bound.append(next(iter(server.sockets)).getsockname()[1])
             ready.set()
             await self._stopped.wait()
 

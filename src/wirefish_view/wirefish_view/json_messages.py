@@ -75,7 +75,7 @@ def _field_schema(kind: str) -> dict:
     return json_schema(message_class(kind), kind)
 
 
-def json_schema(cls: type, title: str | None = None) -> dict:
+def json_schema(cls: Any, title: str | None = None) -> dict:
     """Return the JSON Schema of a rosidl message class (nested types inlined)."""
     return {'type': 'object', 'title': title or f'{cls.__module__.split(".")[0]}/{cls.__name__}',
             'properties': {name: _field_schema(kind)
