@@ -78,6 +78,27 @@ def test_a_board_that_forgot_the_gait_gets_it_again():
     assert link.due(5.01) is not None
 
 
+def test_a_newer_gait_acknowledged_covers_the_older_ones():
+    link = GaitLink(resend_s=0.5)
+    link.set_gait(STRAIGHT, 0.0)
+    link.sent(1, 0.0)
+    link.set_gait(TURN, 0.1)          # supersedes gait 1 before its ACK
+    link.sent(2, 0.1)
+    link.on_ack(Ack(MsgType.GAIT, 2), 0.3)
+    assert link.acknowledged
+    assert sorted(link.ack_latencies_s) == [pytest.approx(0.2), pytest.approx(0.3)]
+    link.on_ack(Ack(MsgType.GAIT, 1), 0.35)   # late: nothing left to acknowledge
+    assert len(link.ack_latencies_s) == 2
+
+
+def test_new_gaits_keep_the_minimum_interval():
+    link = GaitLink(resend_s=0.5, min_interval_s=0.1)
+    link.set_gait(STRAIGHT, 0.0)
+    link.sent(1, 0.0)
+    link.set_gait(TURN, 0.05)
+    assert link.due(0.05) is None and link.due(0.1).gait_id == 2
+
+
 def test_gait_ids_skip_zero():
     assert next_gait_id(0) == 1
     assert next_gait_id(65534) == 65535

@@ -108,7 +108,7 @@ class BridgeNode(Node):
         # Gait mode's state: the executor sets and sends, the reader thread reports what the
         # board runs; one lock between them.
         self._gait_lock = threading.Lock()
-        self._gait = GaitLink(self._values['gait_resend_s'])
+        self._gait = GaitLink(self._values['gait_resend_s'], self._values['gait_min_interval_s'])
         self._config = ConfigLink(link_config(self._values), self._values['gait_resend_s'])
         self._watch = OscillatorWatch(self._values['divergence_window_s'],
                                       self._values['divergence_bound_rad'])
@@ -147,6 +147,7 @@ class BridgeNode(Node):
         self._battery_rate.rate_hz = self._values['battery_rate_hz']
         with self._gait_lock:
             self._gait.resend_s = self._values['gait_resend_s']
+            self._gait.min_interval_s = self._values['gait_min_interval_s']
             self._config.resend_s = self._values['gait_resend_s']
             self._watch.window_s = self._values['divergence_window_s']
             self._watch.bound_rad = self._values['divergence_bound_rad']

@@ -99,6 +99,9 @@ PARAMETERS = (
     ParameterSpec('gait_resend_s', 0.4,
                   'Gait mode: an unacknowledged GAIT or LINK_CONFIG is sent again this often (s)',
                   0.05, 10.0),
+    ParameterSpec('gait_min_interval_s', 0.1,
+                  'Gait mode: a new GAIT goes out no sooner than this after the last one; '
+                  'changes in between are coalesced, the newest goes (s)', 0.0, 10.0),
     ParameterSpec('divergence_bound_rad', 0.1,
                   "Gait mode: the board's servo_state may differ from servo_cmd by this much in "
                   'offset + amplitude over divergence_window_s before /diagnostics warns (rad)',

@@ -30,7 +30,7 @@ the mean, R / sqrt(2) for a sine) over the last ``window_s``. The divergence is 
 
 from __future__ import annotations
 
-from collections import deque
+from collections import deque, OrderedDict
 from dataclasses import dataclass
 import math
 
@@ -118,75 +118,97 @@ class _Acknowledged:
 class GaitLink:
     """What the board should run in gait mode, and whether it does (see the module doc)."""
 
-    def __init__(self, resend_s: float) -> None:
-        """Nothing to send yet; an unacknowledged GAIT goes again every ``resend_s``."""
+    def __init__(self, resend_s: float, min_interval_s: float = 0.0) -> None:
+        """
+        Nothing to send yet.
+
+        An unacknowledged GAIT goes again every ``resend_s``; a new gait goes out no sooner
+        than ``min_interval_s`` after the last GAIT (changes in between are coalesced: the
+        newest goes).
+        """
+        self.resend_s = resend_s
+        self.min_interval_s = min_interval_s
         self.parameters: GaitParameters | None = None
         self.gait_id = 0
         self.board_gait_id = 0   # as the newest telemetry says
-        self.ack_latencies_s: deque[float] = deque(maxlen=1000)
+        self.ack_latencies_s: deque[float] = deque(maxlen=2000)
         self.changes = 0
-        self._state = _Acknowledged(MsgType.GAIT, resend_s)
-
-    @property
-    def resend_s(self) -> float:
-        """Return the resend period (s)."""
-        return self._state.resend_s
-
-    @resend_s.setter
-    def resend_s(self, value: float) -> None:
-        self._state.resend_s = value
+        self.sends = 0
+        self.refusal: int | None = None   # ErrorCode with which the current gait was refused
+        # Gaits taken and not yet acknowledged, in the order taken: id -> when taken. A gait
+        # the board runs (or a newer one) acknowledges every older one with it.
+        self._pending: OrderedDict[int, float] = OrderedDict()
+        self._seq_gait: dict[int, int] = {}   # seq of a GAIT frame -> its gait id
+        self._last_sent_s: float | None = None    # the current gait's last send
+        self._last_any_s = -math.inf              # any GAIT's last send
 
     @property
     def acknowledged(self) -> bool:
         """Return True when the board runs the current gait."""
-        return self._state.acknowledged
-
-    @property
-    def refusal(self) -> int | None:
-        """Return the ErrorCode with which the board refused the current gait, or None."""
-        return self._state.refusal
-
-    @property
-    def sends(self) -> int:
-        """Return how many GAIT frames went out."""
-        return self._state.sends
+        return self.parameters is not None and self.gait_id not in self._pending
 
     def set_gait(self, parameters: GaitParameters, now: float) -> bool:
-        """Take the CPG node's parameters; return True when they are a new gait (due now)."""
+        """Take the CPG node's parameters; return True when they are a new gait."""
         if parameters == self.parameters:
             return False
         self.parameters = parameters
         self.gait_id = next_gait_id(self.gait_id)
+        self._pending.pop(self.gait_id, None)   # an id taken 65535 gaits ago
+        self._pending[self.gait_id] = now
         self.changes += 1
-        self._state.renew(now)
+        self.refusal = None
+        self._last_sent_s = None
         return True
 
     def due(self, now: float) -> Gait | None:
         """Return the GAIT to send now (new, or its resend), or None."""
-        if self.parameters is None or not self._state.due(now):
+        if self.parameters is None or self.acknowledged or self.refusal is not None:
+            return None
+        if self._last_sent_s is None:
+            if now - self._last_any_s < self.min_interval_s:
+                return None
+        elif now - self._last_sent_s < self.resend_s:
             return None
         return self.parameters.message(self.gait_id)
 
     def sent(self, seq: int, now: float) -> None:
         """Note that the due GAIT went out with sequence number ``seq``."""
-        self._state.sent(seq, now)
+        if len(self._seq_gait) > 4096:   # frames long answered or lost
+            self._seq_gait.clear()
+        self._seq_gait[seq] = self.gait_id
+        self._last_sent_s = self._last_any_s = now
+        self.sends += 1
 
     def on_ack(self, ack: Ack, now: float) -> None:
         """Take an ACK from the fish."""
-        if self._state.on_ack(ack):
-            self._acknowledged(now)
+        if ack.acked_type != MsgType.GAIT or ack.acked_seq not in self._seq_gait:
+            return
+        gait_id = self._seq_gait.pop(ack.acked_seq)
+        if not ack.accepted:
+            if gait_id == self.gait_id:
+                self.refusal = ack.result
+            return
+        self._acknowledge_through(gait_id, now)
 
     def on_telemetry(self, gait_id: int, now: float) -> None:
         """Take the gait id the board reports."""
         self.board_gait_id = gait_id
-        if self.parameters is None or self._state.refusal is not None:
+        if self.parameters is None:
             return
-        if gait_id == self.gait_id:
-            if not self._state.acknowledged and self._state.seqs:
-                self._state.acknowledged = True
-                self._acknowledged(now)
-        elif self._state.acknowledged:
-            self._state.again()   # the board no longer runs it (reset, stream mode)
+        if gait_id in self._pending and gait_id in self._seq_gait.values():
+            self._acknowledge_through(gait_id, now)
+        elif self.acknowledged and gait_id != self.gait_id and self.refusal is None:
+            self.on_fish_restart()   # the board no longer runs it (reset, stream mode)
+
+    def _acknowledge_through(self, gait_id: int, now: float) -> None:
+        """Acknowledge ``gait_id`` and every gait taken before it."""
+        if gait_id not in self._pending:
+            return
+        while self._pending:
+            taken_id, taken_s = self._pending.popitem(last=False)
+            self.ack_latencies_s.append(now - taken_s)
+            if taken_id == gait_id:
+                break
 
     def resting_gait(self) -> Gait | None:
         """
@@ -204,16 +226,16 @@ class GaitLink:
 
     def on_fish_restart(self) -> None:
         """Take a board restart: it runs no gait until the current one reaches it again."""
-        if self.parameters is not None:
-            self._state.again()
-
-    def _acknowledged(self, now: float) -> None:
-        if self._state.changed_s is not None:
-            self.ack_latencies_s.append(now - self._state.changed_s)
+        if self.parameters is None:
+            return
+        if self.gait_id not in self._pending:
+            # Due again, but not a change: its acknowledgement adds no gait change's latency.
+            self._pending[self.gait_id] = math.nan
+        self._last_sent_s = None   # due at once
 
     def values(self) -> dict[str, object]:
         """Return the /diagnostics values of the gait link."""
-        latencies = sorted(self.ack_latencies_s)
+        latencies = sorted(v for v in self.ack_latencies_s if not math.isnan(v))
         return {
             'gait_id': self.gait_id, 'board_gait_id': self.board_gait_id,
             'gait_acknowledged': self.acknowledged, 'gait_changes': self.changes,

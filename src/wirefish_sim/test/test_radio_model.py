@@ -176,12 +176,13 @@ def test_the_same_seed_gives_the_same_link():
 def test_link_use_is_air_time_over_elapsed_time():
     params = clean(PRESETS['rf433'])
     link = RadioLink(params, random.Random(1), 0.0)
-    # 60-byte writes at 5 Hz: 5 * (9 + 60) * 8 / 9600 = 0.2875 of the air.
+    # 60-byte writes at 5 Hz: 5 * (9 + 60) * 8 / 15000 = 0.184 of the air.
     for k in range(50):
         link.send(TO_HOST, bytes(60), k * 0.2)
         link.poll(k * 0.2)
     assert link.stats.use(TO_HOST, 10.0) == pytest.approx(5 * params.air_time_s(60), rel=0.01)
     assert link.stats.use(TO_FISH, 10.0) == 0.0
+    assert link.stats.load(TO_HOST, 10.0, 1000.0) == pytest.approx(0.3)
 
 
 def test_next_event_says_when_to_poll():
@@ -215,7 +216,7 @@ def test_the_presets_capacities():
     assert PRESETS['wired'].capacity_bytes_s == pytest.approx(11520.0)
     assert PRESETS['bluetooth'].capacity_bytes_s == pytest.approx(11520.0)
     assert PRESETS['rf433'].capacity_bytes_s == pytest.approx(960.0)   # its UART binds
-    assert clean(PRESETS['rf433']).capacity_bytes_s == pytest.approx(60 / (69 * 8 / 9600))
+    assert clean(PRESETS['rf433']).capacity_bytes_s == pytest.approx(60 / (69 * 8 / 15000))
 
 
 def test_frames_are_cut_at_their_boundaries():

@@ -145,12 +145,12 @@ PRESETS: dict[str, RadioParameters] = {
                                  latency_s=0.015, jitter_s=0.010, good_mean_s=3.0,
                                  bad_mean_s=0.3, loss_good=0.002, loss_bad=0.9,
                                  byte_error_good=1e-6, byte_error_bad=1e-4),
-    # A transparent sub-GHz module (433 MHz, HC-12 / HAC-UM class) at 9600 bit/s on the air
-    # and on its UART (the factory default), the sender's transmit queue 512 bytes, half
-    # duplex: a few ms to turn around, ~12-30 ms of module latency, packets gathered after 3 byte
-    # times of idle input, a 256-byte buffer. 433 MHz reaches over the surface much
-    # better than 2.4 GHz: shorter, rarer bursts.
-    'rf433': RadioParameters('rf433', bit_rate_bps=9600.0, bits_per_byte=8.0,
+    # A transparent sub-GHz module (433 MHz, HC-12 class) at its factory default: 9600 baud on
+    # the UART (the bottleneck: 960 B/s), 15 kbit/s on the air (FU3 mode at 9600 baud), the
+    # sender's transmit queue 512 bytes, half duplex: a few ms to turn around, ~12-30 ms of
+    # module latency, packets gathered after 3 byte times of idle input, a 256-byte buffer.
+    # 433 MHz reaches over the surface much better than 2.4 GHz: shorter, rarer bursts.
+    'rf433': RadioParameters('rf433', bit_rate_bps=15000.0, bits_per_byte=8.0,
                              uart_baud=9600.0, uart_buffer_bytes=512,
                              packet_overhead_bytes=9, max_packet_bytes=60, gather_s=0.003,
                              buffer_bytes=256, half_duplex=True, turnaround_s=0.003,
@@ -194,6 +194,7 @@ class DirectionStats:
 
     bytes_offered: int = 0      # written into the sending end's UART
     frames_refused: int = 0     # lost whole: the UART's transmit queue had no room
+    bytes_refused: int = 0      # their bytes
     bytes_overflowed: int = 0   # lost: the module's buffer was full
     packets_sent: int = 0
     packets_lost: int = 0       # burst loss
@@ -219,6 +220,12 @@ class RadioStats:
     def use(self, direction: Direction, now: float) -> float:
         """Return the share of time ``direction``'s packets held the air since the start."""
         return self.of(direction).air_time_s / max(now - self.started_s, 1e-9)
+
+    def load(self, direction: Direction, now: float, capacity_bytes_s: float) -> float:
+        """Return the bytes a second ``direction`` carried (not refused) over ``capacity``."""
+        stats = self.of(direction)
+        carried = stats.bytes_offered - stats.bytes_refused - stats.bytes_overflowed
+        return carried / max(now - self.started_s, 1e-9) / capacity_bytes_s
 
 
 @dataclass
@@ -308,6 +315,7 @@ class RadioLink:
             queued = max(0.0, self._uart_free[direction] - now) / byte_s
             if queued + len(unit) > self.params.uart_buffer_bytes + 1e-9:
                 stats.frames_refused += 1
+                stats.bytes_refused += len(unit)
                 continue
             self._uart_free[direction] = (max(now, self._uart_free[direction])
                                           + len(unit) * byte_s)

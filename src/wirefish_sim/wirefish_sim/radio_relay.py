@@ -87,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help='write the link counters here as JSON (every --stats-every s)')
     p.add_argument('--stats-every', type=float, default=1.0, help='(s)')
     p.add_argument('--tap', type=Path, default=None,
-                   help="record what the fish sends, before the radio (TAP_RECORD records: "
+                   help='record what the fish sends, before the radio (TAP_RECORD records: '
                    'monotonic time, length, bytes)')
     return p
 
@@ -106,12 +106,21 @@ def parse_cut(text: str) -> tuple[float, float]:
 
 def stats_document(stats: RadioStats, preset_name: str, now: float,
                    cuts: list[tuple[float, float]]) -> dict[str, object]:
-    """Return the JSON document of ``--stats``: counters, use per direction, the cuts."""
+    """
+    Return the JSON document of ``--stats``: counters, use per direction, the cuts.
+
+    ``use_*``: the share of time each direction's packets held the air; ``load_*``: the bytes
+    a second each direction carried over the preset's rate (``capacity_bytes_s``).
+    """
+    capacity_bytes_s = preset(preset_name).capacity_bytes_s
     return {
         'preset': preset_name, 'started': stats.started_s, 'now': now,
         'elapsed_s': now - stats.started_s, 'turnarounds': stats.turnarounds,
         'use_to_fish': stats.use(Direction.TO_FISH, now),
         'use_to_host': stats.use(Direction.TO_HOST, now),
+        'capacity_bytes_s': capacity_bytes_s,
+        'load_to_fish': stats.load(Direction.TO_FISH, now, capacity_bytes_s),
+        'load_to_host': stats.load(Direction.TO_HOST, now, capacity_bytes_s),
         'to_fish': asdict(stats.to_fish), 'to_host': asdict(stats.to_host),
         'cuts': [list(cut) for cut in cuts],
     }
