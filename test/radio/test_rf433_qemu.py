@@ -69,8 +69,8 @@ def test_qemu_board_steps_no_servo(rf433, board):
     worst = worst_step(driving, speed)
     stream = [f for f in driving if not f.status & Status.GAIT_MODE]
     print(f'QEMU rf433 gait: {len(driving)} board telemetry frames while driving and through '
-          f'the cut, {len(stream)} not in gait mode; smooth bound {speed:.2f} rad/s; largest excess '
-          f'{worst:+.4f} rad')
+          f'the cut, {len(stream)} not in gait mode; smooth bound {speed:.2f} rad/s; largest '
+          f'excess {worst:+.4f} rad')
     assert not stream
     assert worst <= 0.0
 
