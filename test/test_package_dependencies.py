@@ -47,6 +47,7 @@ THIRD_PARTY = {
     'scipy': 'python3-scipy',
     'selenium': 'python3-selenium',
     'serial': 'python3-serial',
+    'websockets': 'python3-websockets',
     'yaml': 'python3-yaml',
 }
 # ROS Python packages that the PyPI-wheels road does not install (used by the launch file only,

@@ -96,13 +96,13 @@ def fish_urdf(geometry: FishGeometry, imu: tuple[float, float, float] = (-0.12, 
 
 
 def main() -> None:
-    """Print the URDF of the default params file's fish (the shipped urdf/wirefish.urdf)."""
-    import yaml
-    from wirefish_bringup.graph import default_params_file
+    """
+    Print the URDF of the default fish (the shipped urdf/wirefish.urdf).
 
-    values = yaml.safe_load(default_params_file().read_text())['/**']['ros__parameters']
-    names = ('l1', 'l2', 'l3', 'body_length', 'fin_span')
-    print(fish_urdf(FishGeometry(**{name: float(values[name]) for name in names})), end='')
+    FishGeometry's defaults are config/wirefish.yaml's values; test/tf/test_robot_model.py
+    holds the shipped file to the params file's geometry.
+    """
+    print(fish_urdf(FishGeometry()), end='')
 
 
 if __name__ == '__main__':
