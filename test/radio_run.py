@@ -290,7 +290,7 @@ class CutFigures:
     coast_s: float               # from the first COASTING to the first RESTING frame
     rest_amplitude: float        # largest |servo| of the last RESTING frames before the end
     link_back_s: float           # from the cut's end to the first servo_state at the bridge
-    gait_back_s: float           # from the cut's end to the board running the final gait
+    gait_back_s: float           # from the cut's end to the board running the current gait
 
     def line(self) -> str:
         """Return the figures as one printable line."""
@@ -313,8 +313,10 @@ def cut_figures(record: Drive, board: list[BoardFrame]) -> CutFigures:
     rested = [f for f in resting if f.t <= end]
     amplitude = max(max(abs(v) for v in f.servo) for f in rested[-5:])
     after = [t for t, *_ in record.servo if t > end]
-    final_gait = int(record.bridge_values('gait_id')[-1][1])
-    again = [f.t for f in board if f.t > end and f.gait_id == final_gait
+    # The gait the bridge had when the cut ended (its /diagnostics at 1 Hz: the newest before
+    # the end), or a newer one the planner chose since: ids only grow within a drive.
+    current = max(int(v) for t, v in record.bridge_values('gait_id') if t <= end)
+    again = [f.t for f in board if f.t > end and f.gait_id >= current
              and not f.status & (Status.COASTING | Status.RESTING)]
     return CutFigures(start, end, coasting[0] - start, resting[0].t - coasting[0], amplitude,
                       after[0] - end if after else math.inf,
