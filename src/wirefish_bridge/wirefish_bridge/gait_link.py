@@ -329,7 +329,8 @@ class OscillatorWatch:
         self._host.clear()
         self._board.clear()
 
-    def _add(self, samples: deque, now: float, angles: tuple[float, float]) -> None:
+    def _add(self, samples: deque[tuple[float, float, float]], now: float,
+             angles: tuple[float, float]) -> None:
         samples.append((now, float(angles[0]), float(angles[1])))
         while samples and samples[0][0] < now - self.window_s:
             samples.popleft()
@@ -357,7 +358,8 @@ class OscillatorWatch:
                 f'(offset + amplitude, bound {self.bound_rad:g} rad)')
 
 
-def _mean_and_rms(samples: deque, servo: int) -> tuple[float, float]:
+def _mean_and_rms(samples: deque[tuple[float, float, float]], servo: int
+                  ) -> tuple[float, float]:
     values = [sample[servo] for sample in samples]
     mean = sum(values) / len(values)
     rms = math.sqrt(sum((v - mean) ** 2 for v in values) / len(values))
