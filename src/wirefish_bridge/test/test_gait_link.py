@@ -99,6 +99,19 @@ def test_new_gaits_keep_the_minimum_interval():
     assert link.due(0.05) is None and link.due(0.1).gait_id == 2
 
 
+def test_the_wait_of_the_oldest_unacknowledged_gait_is_kept():
+    link = GaitLink(resend_s=0.5)
+    assert link.waiting_s(1.0) == 0.0
+    link.set_gait(STRAIGHT, 1.0)
+    link.sent(1, 1.0)
+    link.set_gait(TURN, 1.5)
+    assert link.waiting_s(2.0) == pytest.approx(1.0)
+    link.on_telemetry(2, 2.1)
+    link.sent(2, 1.6)
+    link.on_telemetry(2, 2.2)
+    assert link.waiting_s(3.0) == 0.0
+
+
 def test_gait_ids_skip_zero():
     assert next_gait_id(0) == 1
     assert next_gait_id(65534) == 65535

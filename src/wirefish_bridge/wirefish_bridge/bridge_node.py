@@ -83,6 +83,10 @@ from wirefish_msgs.msg import CpgParams
 
 # Rate of the command tick (Hz): the failsafe and held commands (see _make_timers).
 COMMAND_TICK_HZ = 20.0
+# Gait mode: a gait change waiting longer than this for the fish's acknowledgement is a WARN (s).
+# rf433's round trip is 0.2-0.4 s and a GAIT is resent every gait_resend_s (0.4 s): twice the
+# slowest of a working link.
+UNACKNOWLEDGED_WARN_S = 1.0
 
 
 class BridgeNode(Node):
@@ -360,8 +364,9 @@ class BridgeNode(Node):
             return 'gait mode: no cpg_params yet'
         if gait.refusal is not None:
             return f'the fish refused gait {gait.gait_id} (error {gait.refusal})'
-        if not gait.acknowledged:
-            return f'gait {gait.gait_id} not acknowledged yet'
+        waiting = gait.waiting_s(now)
+        if waiting > UNACKNOWLEDGED_WARN_S:   # one in flight is normal: a radio's round trip
+            return f'the fish has acknowledged no gait for {waiting:.1f} s (gait {gait.gait_id})'
         if self._config.refusal is not None:
             return f'the fish refused LINK_CONFIG (error {self._config.refusal})'
         return self._watch.problem(now)

@@ -147,6 +147,13 @@ class GaitLink:
         """Return True when the board runs the current gait."""
         return self.parameters is not None and self.gait_id not in self._pending
 
+    def waiting_s(self, now: float) -> float:
+        """Return how long the oldest gait not yet acknowledged has waited (0: none waits)."""
+        times = [t for t in self._pending.values() if not math.isnan(t)]
+        if self.parameters is not None and self.gait_id in self._pending and not times:
+            times = [self._last_sent_s if self._last_sent_s is not None else now]
+        return now - min(times) if times else 0.0
+
     def set_gait(self, parameters: GaitParameters, now: float) -> bool:
         """Take the CPG node's parameters; return True when they are a new gait."""
         if parameters == self.parameters:
