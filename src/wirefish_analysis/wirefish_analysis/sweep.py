@@ -56,7 +56,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('-o', '--out', type=Path, default=Path('out', 'sweep'),
                         help='where the PNGs and sweep.csv go')
     parser.add_argument('--model-only', action='store_true',
-                        help='skip the virtual fish (eq 18 only, a second instead of a minute)')
+                        help='skip the virtual fish (eq 18 only, a second instead of ten)')
 
 
 def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) -> SweepPoint:
