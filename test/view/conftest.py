@@ -4,6 +4,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 import os
 from pathlib import Path
+import shutil
 import socket
 import time
 
@@ -12,6 +13,7 @@ from foxglove_client import free_port
 import pytest
 from ros_utils import stop_process
 from wirefish_bringup.graph import default_params_file
+import yaml
 
 
 @dataclass
@@ -43,17 +45,25 @@ def _wait_listening(port: int, timeout_s: float) -> bool:
 
 @pytest.fixture(scope='module')
 def view_graph(tmp_path_factory, request) -> Iterator[ViewGraph]:
-    """Start `wirefish up --sim --view` with the view on free ports; stop it afterwards."""
+    """
+    Start `wirefish up --sim --view` with the view on free ports; stop it afterwards.
+
+    A module may set ``GRAPH_OPTIONS`` (more `wirefish up` options) and ``GRAPH_PARAMS``
+    ({node: {parameter: value}}, over the default parameter file's).
+    """
     domain = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21')) + 19
     out = tmp_path_factory.mktemp('view_run')
     ws_port, http_port = free_port(), free_port()
     params = Path(out, 'params.yaml')
-    params.write_text(default_params_file().read_text() + (
-        f'\n/**/view_node:\n  ros__parameters:\n    port: {ws_port}\n'
-        f'    http_port: {http_port}\n'))
+    document = yaml.safe_load(default_params_file().read_text())
+    wanted = {'view_node': {'port': ws_port, 'http_port': http_port},
+              **getattr(request.module, 'GRAPH_PARAMS', {})}
+    for node, values in wanted.items():
+        document.setdefault(f'/**/{node}', {}).setdefault('ros__parameters', {}).update(values)
+    params.write_text(yaml.safe_dump(document))
     namespace = '/e2e_' + request.module.__name__.rsplit('.', 1)[-1]
     graph = start_graph(domain, out, '--view', '--params-file', str(params),
-                        namespace=namespace)
+                        *getattr(request.module, 'GRAPH_OPTIONS', ()), namespace=namespace)
     children = descendants(graph.launcher.pid)
     try:
         assert _wait_listening(ws_port, 30.0), 'the view does not listen'
@@ -79,3 +89,50 @@ def graph_context(view_graph: ViewGraph, monkeypatch: pytest.MonkeyPatch):
         yield context
     finally:
         rclpy.try_shutdown(context=context)
+
+
+class DashboardPage:
+    """The dashboard in headless chromium (Debian's) driven by Selenium, and its live values."""
+
+    def __init__(self, driver) -> None:
+        """Wrap a Selenium ``driver`` on the page."""
+        self.driver = driver
+
+    def live(self, expression: str):
+        """Return the value of a JavaScript expression on the page."""
+        return self.driver.execute_script(f'return {expression};')
+
+    def wait(self, expression: str, timeout_s: float) -> bool:
+        """Return True once ``expression`` is true on the page, False after ``timeout_s``."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.live(expression):
+                return True
+            time.sleep(0.1)
+        return bool(self.live(expression))
+
+    def text(self, element_id: str) -> str:
+        """Return the visible text of the element ``element_id``."""
+        from selenium.webdriver.common.by import By
+        return self.driver.find_element(By.ID, element_id).text
+
+
+@pytest.fixture(scope='module')
+def dashboard(view_graph: ViewGraph) -> Iterator[DashboardPage]:
+    """Yield the module's graph's dashboard in a headless chromium (1400 x 1300); quit it after."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    chromium, chromedriver = shutil.which('chromium'), shutil.which('chromedriver')
+    assert chromium and chromedriver, 'apt-get install chromium chromium-driver'
+    options = webdriver.ChromeOptions()
+    options.binary_location = chromium
+    for argument in ('--headless=new', '--no-sandbox', '--disable-gpu',
+                     '--disable-dev-shm-usage', '--window-size=1400,1300'):
+        options.add_argument(argument)
+    driver = webdriver.Chrome(options=options, service=Service(chromedriver))
+    try:
+        driver.get(view_graph.http_url)
+        yield DashboardPage(driver)
+    finally:
+        driver.quit()

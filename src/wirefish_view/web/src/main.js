@@ -6,6 +6,7 @@ import { FoxgloveClient } from '@foxglove/ws-protocol';
 import { parse } from '@foxglove/rosmsg';
 import { MessageReader } from '@foxglove/rosmsg2-serialization';
 import uPlot from 'uplot';
+import { COUNTERS, health, linkState, number, observedRate, text } from './board.js';
 
 // Either name of the protocol: the view accepts both.
 const SUBPROTOCOLS = ['foxglove.sdk.v1', 'foxglove.websocket.v1'];
@@ -14,12 +15,15 @@ const WINDOW_S = 15; // seconds of history in the time plots
 const DRIVE_HZ = 10; // cmd_vel rate while driving (the planner's timeout is 0.5 s)
 const SPEED_STEP = 0.05; // m/s, as `wirefish drive`
 const TURN_STEP = 0.1; // rad/s
+const SLEW_WINDOW_S = 0.25; // servo_state kept for the observed failsafe slew
+const SLEW_SAMPLES = 200; // at most this many of them (1 kHz servo_state would be 250)
 const WANTED = ['servo_cmd', 'servo_state', 'body_wave', 'planner_state', 'speed_estimate',
   'sim/ground_truth', 'battery', 'cmd_vel', '/diagnostics', '/tf', '/tf_static', 'view/retune'];
 
 const live = {
   connected: false, counts: {}, latest: {}, plots: {}, drive: { speed: 0, turn: 0 },
   retune: null, retuneLog: [], refusals: [], errors: [], estimates: [], topdown: null,
+  board: null, boardLog: [],
 };
 // A bounded log: the newest KEPT entries (a flood of statuses or errors cannot grow the page).
 function keep(list, entry) {
@@ -27,6 +31,8 @@ function keep(list, entry) {
   if (list.length > KEPT) list.splice(0, list.length - KEPT);
 }
 window.wirefish = live;
+// The panels' pure functions, for a look at values no fish of the test graph sends (a fault).
+live.boardView = { linkState, health };
 
 const $ = (id) => document.getElementById(id);
 const stampS = (s) => s.sec + s.nanosec * 1e-9;
@@ -162,7 +168,12 @@ function onMessage(topic, m) {
       live.latest.servo_cmd = { position: Array.from(m.position) };
       break;
     }
-    case 'servo_state': live.latest.servo_state = { position: Array.from(m.position) }; break;
+    case 'servo_state':
+      live.latest.servo_state = { position: Array.from(m.position) };
+      recent.push({ t: stampS(m.header.stamp), position: Array.from(m.position) });
+      while (recent.length > SLEW_SAMPLES
+        || (recent.length > 1 && recent[0].t < recent[recent.length - 1].t - SLEW_WINDOW_S)) recent.shift();
+      break;
     case 'body_wave':
       wave = { q: Array.from(m.q), x: Array.from(m.x), y: Array.from(m.y), yd: Array.from(m.y_desired) };
       live.latest.body_wave = { tip_y: wave.y[wave.y.length - 1], desired: wave.yd.length > 0 };
@@ -218,11 +229,13 @@ function onMessage(topic, m) {
       break;
     case 'cmd_vel': live.latest.cmd_vel = { speed: m.linear.x, turn: m.angular.z }; break;
     case '/diagnostics': {
-      const link = m.status.find((s) => /bridge|link/i.test(s.name));
+      // This fish's bridge only: other graphs' bridges publish on the same global topic.
+      const link = m.status.find((s) => s.name.startsWith(`${ns}/bridge_node:`));
       if (link) {
         const level = ['OK', 'WARN', 'ERROR', 'STALE'][link.level] || String(link.level);
         live.latest.link = { level, message: link.message };
         $('v-link').textContent = `${level} ${link.message}`;
+        showBoard(Object.fromEntries(link.values.map((kv) => [kv.key, kv.value])), link.message);
       }
       break;
     }
@@ -234,6 +247,52 @@ function onMessage(topic, m) {
     case 'view/retune': onRetune(m); break;
     default: break;
   }
+}
+
+// --- the link, gait and health panels (what bridge_node reports in /diagnostics) -------------
+const recent = []; // servo_state of the last SLEW_WINDOW_S: the failsafe slew as observed
+
+function showBoard(values, message) {
+  const state = linkState(values);
+  const h = health(values);
+  const hostGait = text(values, 'gait_id'); const boardGait = text(values, 'board_gait_id');
+  const stream = text(values, 'drive_mode') === 'stream';
+  const rate = observedRate(recent);
+  let failsafe = '';
+  if (stream && state.state === 'failsafe') {
+    failsafe = rate !== null && rate > 0.01
+      ? `slewing to neutral, ${rate.toFixed(2)} rad/s observed` : 'holding neutral';
+  } else if (stream && text(values, 'failsafe') === 'True') {
+    failsafe = 'no servo_cmd: the bridge commands neutral';
+  } else if (stream && state.state === 'stream') failsafe = 'off';
+  const divergence = number(values, 'oscillator_divergence_rad');
+  const board = { ...state, drive_mode: text(values, 'drive_mode'), gait_id: hostGait,
+    board_gait_id: boardGait, failsafe, health: h };
+  if (!live.board || live.board.state !== board.state) keep(live.boardLog, { state: board.state, words: board.words, at: Date.now() });
+  live.board = board;
+  const badge = $('v-link-badge');
+  badge.textContent = state.words; badge.className = `badge ${state.level}`;
+  badge.dataset.state = state.state;
+  $('v-drive-mode').textContent = board.drive_mode;
+  $('v-gait-id').textContent = hostGait || boardGait ? `${hostGait} / ${boardGait}` : '';
+  $('v-fish-status').textContent = text(values, 'fish_status');
+  $('v-failsafe').textContent = failsafe;
+  $('v-divergence').textContent = divergence === null ? '' : `${divergence.toFixed(3)} rad`;
+  $('v-link-message').textContent = message;
+  $('v-reset-cause').textContent = h.reset_cause;
+  $('v-uptime').textContent = h.uptime;
+  $('v-clock').textContent = h.clock.words;
+  $('v-clock').className = h.clock.fallback ? 'fallback' : '';
+  $('v-stack').textContent = h.stack;
+  $('v-health-flags').textContent = h.flags;
+  const table = $('v-counters');
+  if (!table.rows.length) {
+    COUNTERS.forEach(([key, label]) => {
+      const row = table.insertRow(); const th = document.createElement('th');
+      th.textContent = label; row.appendChild(th); row.insertCell().id = `v-${key}`;
+    });
+  }
+  h.counters.forEach(({ key, value }) => { $(`v-${key}`).textContent = value; });
 }
 
 // Legends show the latest values while the pointer is not over a plot (uPlot's own legend
