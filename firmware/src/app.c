@@ -443,17 +443,18 @@ static void sample_battery(wf_app_t *app)
 }
 
 /* --- gait mode: the CPG and the gap ------------------------------------------------------ */
-/* One RK4 step per millisecond of the board's clock, up to now. */
+/* One RK4 step per millisecond of the board's clock, up to now; a backlog beyond
+ * WF_CPG_MAX_LAG_MS is dropped (a pause of the gait, never a jump of its output). */
 static void advance_cpg(wf_app_t *app)
 {
     if (!app->gait_mode) {
         return;
     }
     if (app->now_ms - app->cpg_time_ms > WF_CPG_MAX_LAG_MS) {
-        app->cpg_time_ms = app->now_ms; /* stalled, or the clock went back: go on from here */
-        return;
+        /* Stalled, or the clock went back (a huge modular lag): go on from the state. */
+        app->cpg_time_ms = app->now_ms - WF_CPG_MAX_LAG_MS;
     }
-    for (unsigned n = 0; n < WF_CPG_STEPS_PER_POLL && app->cpg_time_ms != app->now_ms; n++) {
+    while (app->cpg_time_ms != app->now_ms) {
         wf_cpg_step(&app->cpg);
         app->cpg_time_ms += WF_CPG_STEP_MS;
     }

@@ -577,6 +577,77 @@ static void test_gait_is_acked_and_the_board_runs_eq_1_at_1_khz(void)
     CHECK(telemetry == 100);
 }
 
+/* The largest change of either target between polls `apart` ms apart, over a lone CPG's
+ * run from rest (angles as wf_host_cpg_run gives them, steps 1..n). */
+static float largest_change(const float *angles, uint32_t n, uint32_t apart)
+{
+    float worst = 0.0f;
+    for (uint32_t k = apart; k < n; k++) {
+        for (unsigned i = 0; i < 2; i++) {
+            const float d = fabsf(angles[2 * k + i] - angles[2 * (k - apart) + i]);
+            worst = d > worst ? d : worst;
+        }
+    }
+    return worst;
+}
+
+static void test_a_stall_pauses_the_gait_without_a_step(void)
+{
+    /* A poll loop blocked 157 ms (an emulator descheduled by its loaded host): the next poll
+     * takes WF_CPG_MAX_LAG_MS steps and drops the rest, so the output moves no more than
+     * 5 ms of the gait's own motion, then 1 ms per poll: the trajectory is the lone CPG's,
+     * paused. The same when the clock goes back. */
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t p = table1_gait();
+    send_gait(5, 7, &p);
+    wf_host_cpg_init(&p);
+    static float angles[2 * 3000];
+    wf_host_cpg_run(3000, angles, NULL);
+    const float per_ms = largest_change(angles, 3000, 1);
+    const float per_lag = largest_change(angles, 3000, WF_CPG_MAX_LAG_MS);
+    run_until(6, 1005); /* 1000 steps */
+    wf_host_gait_snapshot_t before = gait_snap();
+    CHECK(before.cpg_steps == 1000 && before.cpg_time_ms == 1005);
+    /* A lag of exactly WF_CPG_MAX_LAG_MS is caught up whole. */
+    wf_host_board_step(1005 + WF_CPG_MAX_LAG_MS, NULL, 0, NULL, 0);
+    wf_host_gait_snapshot_t g = gait_snap();
+    CHECK(g.cpg_steps == 1000 + WF_CPG_MAX_LAG_MS && g.cpg_time_ms == 1010);
+    /* 157 ms without a poll. */
+    before = g;
+    wf_host_board_step(1010 + 157, NULL, 0, NULL, 0);
+    g = gait_snap();
+    uint32_t steps = before.cpg_steps + WF_CPG_MAX_LAG_MS;
+    CHECK(g.cpg_steps == steps && g.cpg_time_ms == 1167);
+    CHECK(g.target[0] == angles[2 * (steps - 1)] && g.target[1] == angles[2 * steps - 1]);
+    const float stall_jump = fmaxf(fabsf(g.target[0] - before.target[0]),
+                                   fabsf(g.target[1] - before.target[1]));
+    CHECK(stall_jump <= per_lag && per_lag < 0.1f);
+    /* Then one step per poll, each within the gait's own 1 ms motion. */
+    for (uint32_t t = 1168; t < 1400; t++) {
+        before = g;
+        wf_host_board_step(t, NULL, 0, NULL, 0);
+        g = gait_snap();
+        steps++;
+        CHECK(g.cpg_steps == steps && g.cpg_time_ms == t);
+        CHECK(fabsf(g.target[0] - before.target[0]) <= per_ms &&
+              fabsf(g.target[1] - before.target[1]) <= per_ms);
+    }
+    /* The clock going back 100 ms: the same bounded pause. */
+    before = g;
+    wf_host_board_step(1299, NULL, 0, NULL, 0);
+    g = gait_snap();
+    steps += WF_CPG_MAX_LAG_MS;
+    CHECK(g.cpg_steps == steps && g.cpg_time_ms == 1299);
+    const float back_jump = fmaxf(fabsf(g.target[0] - before.target[0]),
+                                  fabsf(g.target[1] - before.target[1]));
+    CHECK(back_jump <= per_lag);
+    printf("stall of 157 ms: the output moved %.4f rad in the poll after it, %.4f rad after "
+           "the clock went back (the gait's largest in %d ms: %.4f rad, in 1 ms: %.4f rad)\n",
+           (double)stall_jump, (double)back_jump, WF_CPG_MAX_LAG_MS, (double)per_lag,
+           (double)per_ms);
+}
+
 static void test_an_invalid_gait_is_refused_with_error_6_and_ack_6(void)
 {
     static wf_host_msg_t out[256];
@@ -1107,6 +1178,7 @@ int main(void)
     test_battery_below_threshold_sets_low_battery();
     test_imu_sample_reaches_the_telemetry();
     test_gait_is_acked_and_the_board_runs_eq_1_at_1_khz();
+    test_a_stall_pauses_the_gait_without_a_step();
     test_an_invalid_gait_is_refused_with_error_6_and_ack_6();
     test_couplings_and_biases_at_their_bounds_are_accepted();
     test_a_new_gait_swaps_the_targets_without_a_step();
@@ -1122,6 +1194,6 @@ int main(void)
     test_the_imu_lost_and_found_is_counted();
     test_the_lone_cpg_follows_eq_1();
     test_degenerate_couplings_keep_the_output_finite();
-    printf("test_core: 39 tests, %d checks passed\n", checks);
+    printf("test_core: 40 tests, %d checks passed\n", checks);
     return 0;
 }

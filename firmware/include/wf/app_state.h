@@ -54,11 +54,15 @@ enum { WF_REPORTED_KINDS = 5, WF_ERROR_MIN_INTERVAL_MS = 20 };
  * GAIT or LINK_CONFIG that finds the queue full gets no ACK (the host resends it). */
 enum { WF_ACK_QUEUE = 4 };
 
-/* In gait mode, more than this many steps behind the clock are dropped (the state is kept):
- * a stalled board resumes from where it stopped instead of racing through the backlog; and at
- * most WF_CPG_STEPS_PER_POLL steps are taken in one poll (about 60 us of a Cortex-M4's time
- * each 1 ms poll when catching up). */
-enum { WF_CPG_MAX_LAG_MS = 1000, WF_CPG_STEPS_PER_POLL = 50 };
+/* In gait mode a poll steps the CPG at most this many 1 ms steps: a larger backlog (a blocked
+ * poll loop, an emulator descheduled by its host, the clock going back) is dropped, cpg_time
+ * re-based to now minus this, the state kept: the gait pauses and goes on from where it
+ * stood, never jumps. The output then moves by at most 5 ms of the gait's own motion within a
+ * PWM frame, less than the gait itself moves in a 20 ms frame at 50 Hz (and the 5 steps
+ * cost about 6 us of a Cortex-M4's 1 ms poll). A healthy loop polls every millisecond, a late poll
+ * (an I2C bus recovery, a full RX chunk) a few ms late: up to 5 ms is caught up whole, so
+ * the gait's frequency stays exact. */
+enum { WF_CPG_MAX_LAG_MS = 5 };
 
 /* Where gait mode is with the link: swimming, coasting (link lost) or resting (lost past the
  * coast). */
