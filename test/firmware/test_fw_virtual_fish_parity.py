@@ -27,7 +27,10 @@ the link back, a SERVO_CMD back to stream mode, a version mismatch in gait mode)
 switch from stream to gait mode while stream mode holds a command, while it slews to neutral
 and right after a SERVO_CMD of the same chunk: both start the oscillator with its offsets at
 the angles held, so the switch's millisecond moves no servo at all; and GAITs just within and
-just beyond the coupling and phase-bias bounds, accepted and refused alike.
+just beyond the coupling and phase-bias bounds, accepted and refused alike; and stalls of the
+firmware's poll loop (``VirtualFish.stall``; the board not polled): in gait mode the first poll
+after a stall steps the CPG ``CPG_MAX_LAG_MS`` and drops the rest of the backlog on both, in
+stream mode the slew takes the whole gap, and the schedules catch up alike.
 """
 
 from collections.abc import Iterator
@@ -43,7 +46,7 @@ from wirefish_bridge.protocol import (ANGLE_LSB_RAD, Gait, Heartbeat, LinkConfig
                                       PROTOCOL_VERSION, ProtocolMessage, quantize, Role,
                                       ServoCommand, Status, Telemetry, TelemetryCompact,
                                       TelemetryForm)
-from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
+from wirefish_sim.virtual_fish import CPG_MAX_LAG_MS, ImuNoise, SimConfig, VirtualFish
 
 TOLERANCE_RAD = 1e-4
 ADC_8_2_V = 3392
@@ -70,6 +73,8 @@ class Scenario:
     events: dict[int, tuple[ProtocolMessage, ...]] = field(default_factory=dict)
     silent: tuple[int, int] = (0, 0)
     command: tuple[float, float] | None = None  # every SERVO_CMD's angles (else random)
+    # Stalls of the firmware's poll loop: start -> length (ms); the host is silent meanwhile.
+    stalls: dict[int, int] = field(default_factory=dict)
 
 
 GAIT_EVENTS = {
@@ -124,6 +129,15 @@ SCENARIOS = [
     Scenario('gait_from_held_angles', duration_ms=3000, commands_until_ms=300,
              heartbeats_until_ms=3000, resume_at_ms=3000, events=HELD_EVENTS,
              command=(0.3, -0.3)),
+    # Stalls: in stream mode holding a command, then slewing to neutral; in gait mode one
+    # within the CPG's bound (caught up whole), one just beyond it, the 157 ms of a QEMU
+    # descheduled on a loaded host (telemetry, heartbeat and HEALTH all due at once), and one
+    # past the link timeout (coasting at the first poll after it).
+    Scenario('stalls', duration_ms=4400, commands_until_ms=400, heartbeats_until_ms=4400,
+             resume_at_ms=4400, command=(0.3, -0.3),
+             events={1000: (TABLE_1,), 1800: (replace(TABLE_1, gait_id=2, frequency_hz=2.0),)},
+             stalls={300: 40, 920: 50, 1400: CPG_MAX_LAG_MS - 1, 1500: CPG_MAX_LAG_MS,
+                     1601: 157, 2000: 200, 2400: 1600}),
 ]
 
 
@@ -133,9 +147,11 @@ def host_stream(scenario: Scenario, rng: np.random.Generator) -> Iterator[bytes]
     carry = b''
     next_command, next_heartbeat = 50, 0
     commands = heartbeats = 0
+    stalled = {t for start, length in scenario.stalls.items()
+               for t in range(start, start + length)}
     for t in range(scenario.duration_ms):
         active = t >= scenario.resume_at_ms
-        silent = scenario.silent[0] <= t < scenario.silent[1]
+        silent = scenario.silent[0] <= t < scenario.silent[1] or t in stalled
         chunk = bytearray(carry)
         carry = b''
         if t == next_heartbeat:
@@ -147,7 +163,7 @@ def host_stream(scenario: Scenario, rng: np.random.Generator) -> Iterator[bytes]
         if t == next_command:
             commands += 1
             next_command += 498 + commands % 5 if scenario.near_timeouts else 10
-            if t < scenario.commands_until_ms or active:
+            if (t < scenario.commands_until_ms or active) and t not in stalled:
                 angles = (list(scenario.command) if scenario.command is not None
                           else rng.uniform(-2.0, 2.0, 2).astype(np.float32).tolist())
                 chunk += encoder.encode(ServoCommand(*angles))
@@ -232,7 +248,17 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     worst = Deviation()
     entries: list[tuple[int, tuple[float, float]]] = []   # (ms, angles held) into gait mode
     board_held = (0.0, 0.0)
+    stall_end = 0
+    moves: list[tuple[int, float]] = []   # (stall, how far the targets moved over it)
     for k, chunk in enumerate(host_stream(scenario, rng)):
+        if k in scenario.stalls:
+            fish.stall(scenario.stalls[k] * 1e-3)
+            stall_end, before_stall = k + scenario.stalls[k], fish.target
+        if k < stall_end:   # the board is not polled; the virtual fish's physics goes on
+            assert not chunk
+            fish.step(0.001)
+            assert not fish.take_output(), f'at {k + 1} ms'
+            continue
         held, was_gait, commands = fish.target, fish.cpg is not None, fish.commands_received
         if chunk:  # as fish_sim does: the firmware's own clock runs the rest
             fish.receive(chunk)
@@ -259,7 +285,13 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
             assert tuple(state.target) == board_held, f'at {k + 1} ms'
             entries.append((k + 1, held))
         board_held = tuple(state.target)
+        if k == stall_end and k in {s + n for s, n in scenario.stalls.items()}:
+            moves.append((k, float(np.max(np.abs(np.subtract(fish.target, before_stall))))))
     print(f'{scenario.name}: servo angles within {worst.rad:.2e} rad (at {worst.at_ms} ms)')
+    if scenario.stalls:
+        print(f'{scenario.name}: the targets moved over each stall: '
+              + ', '.join(f'{m:.4f} rad by {k + 1} ms' for k, m in moves))
+        assert len(moves) == len(scenario.stalls)
     assert board.gait().acks_dropped == fish.acks_dropped
     if len(scenario.events.get(900, ())) == 6 and not scenario.damage:
         assert fish.acks_dropped == 2   # a burst of six GAITs against a queue of four
@@ -279,7 +311,7 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     assert all(bool(s & Status.LOW_BATTERY) == scenario.low_battery for s in statuses)
     if scenario.events:
         assert 'Ack' in seen and any(s & Status.GAIT_MODE for s in statuses)
-    if scenario.command is not None:
+    if scenario.events is HELD_EVENTS:
         print(f'{scenario.name}: into gait mode at {entries}')
         assert [held != (0.0, 0.0) for _, held in entries] == [True] * 3
         assert fish.gait_id == 6 and board.gait().gaits_refused == 2

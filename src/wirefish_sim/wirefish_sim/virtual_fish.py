@@ -78,6 +78,10 @@ _KEPT_FLAGS = 0xFFFF & ~(_NEUTRAL_FLAGS | _SERVO_CLAMPED | _LOW_BATTERY | _COAST
 # ACKs wait in a queue of this many and leave one per millisecond, oldest first; a GAIT or
 # LINK_CONFIG that finds it full gets none (the host resends). The board's rule (app.c).
 ACK_QUEUE = 4
+# In gait mode the firmware steps its CPG at most this many ms at once: a longer backlog (a
+# stalled poll loop, see ``stall``) is dropped and the oscillator goes on from its state, a
+# pause of the gait instead of a jump of its output (app_state.h's WF_CPG_MAX_LAG_MS).
+CPG_MAX_LAG_MS = 5
 
 
 class Gap(enum.IntEnum):
@@ -207,6 +211,8 @@ class VirtualFish:
         self._last_host_frame_time = 0.0
         self._last_output_ms: int | None = None
         self._last_momentum: tuple[float, float] | None = None  # K1, K2 of the last step
+        self._stalled_ms = 0  # the firmware's poll loop is blocked this many more ms
+        self._held_rx = bytearray()  # what came in meanwhile, for the first poll after it
         noise = c.imu_noise
         self._gyro_bias = self.rng.normal(0.0, noise.gyro_bias_rad_s, 3)
         self._accel_bias = self.rng.normal(0.0, noise.accel_bias_m_s2, 3)
@@ -214,6 +220,11 @@ class VirtualFish:
     # --- firmware: input --------------------------------------------------------------------
     def receive(self, data: bytes) -> None:
         """Feed bytes from the host (any chunking); valid frames take effect now."""
+        if self._stalled_ms > 0:  # they wait in the UART until the loop polls again
+            self._held_rx += data
+            return
+        if self._held_rx:
+            data, self._held_rx = bytes(self._held_rx) + data, bytearray()
         self._advance_cpg()  # to now with the parameters in force until now
         for frame in self.decoder.feed(data):
             message = frame.message
@@ -334,10 +345,19 @@ class VirtualFish:
             self.gap = Gap.NONE
 
     def _advance_cpg(self) -> None:
-        """Step the CPG (gait mode) to now: one RK4 step per millisecond since gait mode began."""
+        """
+        Step the CPG (gait mode) to now: one RK4 step per millisecond since gait mode began.
+
+        At most ``CPG_MAX_LAG_MS`` steps at once: a longer backlog moves the CPG's start on by
+        the excess (as the board re-bases its cpg_time), so the output pauses, never jumps.
+        """
         if self.cpg is not None:
-            self.cpg.advance((_whole_ms(self.state.time_s) - self._cpg_start_ms)
-                             * self.config.cpg_step_s)
+            step_s = self.config.cpg_step_s
+            lag_ms = (_whole_ms(self.state.time_s) - self._cpg_start_ms
+                      - round(self.cpg.time_s / step_s))
+            if not 0 <= lag_ms <= CPG_MAX_LAG_MS:
+                self._cpg_start_ms += lag_ms - CPG_MAX_LAG_MS
+            self.cpg.advance((_whole_ms(self.state.time_s) - self._cpg_start_ms) * step_s)
 
     def _leave_gait_mode(self) -> None:
         self.gait, self.cpg, self.gap = None, None, Gap.NONE
@@ -410,14 +430,33 @@ class VirtualFish:
         if count > 0:
             swim((self,), count)
 
+    def stall(self, seconds: float) -> None:
+        """
+        Block the firmware's poll loop for the next ``seconds`` (whole ms) of physics steps.
+
+        A real board's loop blocked, or an emulator descheduled by a loaded host: the
+        physics goes on with the servos held at their last targets (the PWM keeps its
+        compares), nothing is sent, received bytes wait; the step after the stall runs the
+        board's first poll after it, its clock jumped: the CPG takes ``CPG_MAX_LAG_MS`` steps
+        and drops the rest, the schedules catch up one frame of each kind per poll.
+        """
+        self._stalled_ms += _whole_ms(seconds)
+
     def firmware_target(self) -> tuple[float, float]:
         """Run the firmware's failsafe check of now; return the servo targets (rad) it sets."""
+        if self._stalled_ms > 0:
+            return self.target
+        if self._held_rx:
+            self.receive(b'')
         self._update_failsafe()
         return self.target
 
     def tick(self, step_s: float, servo_angles: np.ndarray) -> None:
         """End one physics step of ``step_s`` s: the clock moves on, due frames are emitted."""
         self.state.time_s += step_s
+        if self._stalled_ms > 0:
+            self._stalled_ms = max(self._stalled_ms - _whole_ms(step_s), 0)
+            return
         self._emit_due(servo_angles)
 
     def battery_voltage(self) -> float:
