@@ -52,7 +52,7 @@ def browser(view_graph):
     options = webdriver.ChromeOptions()
     options.binary_location = CHROMIUM
     for argument in ('--headless=new', '--no-sandbox', '--disable-gpu',
-                     '--disable-dev-shm-usage', '--window-size=1400,1100'):
+                     '--disable-dev-shm-usage', '--window-size=1400,1300'):
         options.add_argument(argument)
     driver = webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
     try:
