@@ -1089,6 +1089,41 @@ static void test_health_once_after_boot_and_every_period(void)
     CHECK(count(out, n, WF_MSG_HEALTH) == 2); /* 4000, 6000 */
 }
 
+static void test_a_frame_goes_out_whole_or_not_at_all(void)
+{
+    /* A UART that drains 4 bytes a millisecond (40 kbit/s) behind a 100-byte queue: the
+     * telemetry (64 bytes every 10 ms), heartbeats and HEALTH do not all fit. What does not
+     * fit is dropped whole: the wire holds only whole frames (the receiver drops nothing),
+     * the missing frames are seq gaps, and their bytes are tx_bytes_dropped. */
+    fresh_board();
+    wf_host_set_tx_capacity(100);
+    static uint8_t wire[20000];
+    size_t len = 0;
+    for (uint32_t t = 0; t < 3000; t++) {
+        wf_host_board_step(t, NULL, 0, NULL, 0);
+        len += wf_host_take_output(wire + len, 4);
+    }
+    len += wf_host_take_output(wire + len, sizeof wire - len);
+    static wf_host_msg_t out[2000];
+    uint32_t stats[12];
+    const size_t n = wf_host_decode_stream(wire, len, out, 2000, stats);
+    const wf_host_snapshot_t s = raw_snap();
+    for (unsigned i = 2; i <= 9; i++) {
+        CHECK(stats[i] == 0); /* no damaged run: cobs, short, crc, ..., overflow, resync */
+    }
+    CHECK(stats[0] == len && stats[1] == n && n < 2000);
+    const uint32_t missing = s.frames_sent - (uint32_t)n;
+    CHECK(stats[10] > 0 && missing > 0);
+    /* Each missing frame is 11..69 bytes on the wire, every byte of it counted. */
+    CHECK(s.tx_bytes_dropped >= 11u * missing && s.tx_bytes_dropped <= 69u * missing);
+    const size_t telemetry = count(out, n, WF_MSG_TELEMETRY);
+    CHECK(telemetry > 0 && telemetry < 300);
+    printf("tx queue of 100 bytes at 4 bytes/ms: %zu frames whole on the wire (%zu bytes), "
+           "%u dropped whole (%u bytes), no damaged run\n",
+           n, len, (unsigned)missing, (unsigned)s.tx_bytes_dropped);
+    wf_host_set_tx_capacity(WF_HOST_TX_CAPACITY);
+}
+
 static void test_the_imu_lost_and_found_is_counted(void)
 {
     memset(mpu_regs, 0, sizeof mpu_regs);
@@ -1191,9 +1226,10 @@ int main(void)
     test_acks_go_out_one_per_poll_from_a_bounded_queue();
     test_compact_telemetry_rounds_and_saturates();
     test_health_once_after_boot_and_every_period();
+    test_a_frame_goes_out_whole_or_not_at_all();
     test_the_imu_lost_and_found_is_counted();
     test_the_lone_cpg_follows_eq_1();
     test_degenerate_couplings_keep_the_output_finite();
-    printf("test_core: 40 tests, %d checks passed\n", checks);
+    printf("test_core: 41 tests, %d checks passed\n", checks);
     return 0;
 }

@@ -127,7 +127,7 @@ typedef struct {
     uint32_t commands_ignored;     /* SERVO_CMD while the host's version differs */
     uint32_t frames_sent;
     uint32_t errors_sent;
-    uint32_t tx_bytes_dropped;     /* bytes the UART's transmit queue had no room for */
+    uint32_t tx_bytes_dropped;     /* bytes of the frames the transmit queue had no room for */
     uint32_t acks_dropped;         /* ACKs that found the queue full */
     uint32_t gaits_accepted;
     uint32_t gaits_refused;

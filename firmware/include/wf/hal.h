@@ -30,8 +30,10 @@ uint32_t wf_hal_millis(void);
 /* Moves up to max received bytes into buf without blocking; returns how many. */
 size_t wf_hal_uart_read(uint8_t *buf, size_t max);
 
-/* Queues len bytes for transmission without blocking; returns how many were accepted (a full
- * transmit queue accepts fewer: the caller counts the rest as not sent). */
+/* Queues len bytes for transmission without blocking, all or nothing: returns len, or 0 (and
+ * queues nothing) when the transmit queue has less room than len. The core writes one whole
+ * frame per call, so a frame goes out whole or not at all, never cut: a cut frame would reach
+ * the receiver as a damaged run that also costs it the next frame's leading delimiter. */
 size_t wf_hal_uart_write(const uint8_t *buf, size_t len);
 
 /* Timer ticks per microsecond of the servo PWM timer, and the compare register's full period

@@ -211,10 +211,12 @@ size_t wf_hal_uart_write(const uint8_t *buf, size_t len)
 {
     /* A capacity lowered below what the queue holds leaves no room (not a wrapped size). */
     const size_t room = board.tx_len < board.tx_capacity ? board.tx_capacity - board.tx_len : 0;
-    const size_t n = len < room ? len : room;
-    memcpy(board.tx + board.tx_len, buf, n);
-    board.tx_len += n;
-    return n;
+    if (len > room) {
+        return 0; /* all or nothing (wf/hal.h) */
+    }
+    memcpy(board.tx + board.tx_len, buf, len);
+    board.tx_len += len;
+    return len;
 }
 
 /* A 1 MHz timer tick, as the stm32f4 port's (prescaled) TIM3. */

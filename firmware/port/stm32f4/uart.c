@@ -80,6 +80,11 @@ size_t wf_hal_uart_read(uint8_t *buf, size_t max)
 
 size_t wf_hal_uart_write(const uint8_t *buf, size_t len)
 {
+    /* All or nothing (wf/hal.h): the interrupt only takes bytes out, so the room seen here
+     * can only grow before the puts below, which then all succeed. */
+    if (len > tx_ring.mask + 1u - ring_used(&tx_ring)) {
+        return 0u;
+    }
     size_t count = 0u;
     while (count < len && ring_put(&tx_ring, buf[count])) {
         count++;
