@@ -34,8 +34,8 @@ def frames(label: str) -> tuple[list, list]:
     telemetry = WIRE['telemetry' if match['form'] == 'TELEMETRY' else 'compact']
     to_fish = [(float(match['heartbeat']), WIRE['heartbeat'])]
     to_host = [(1000.0 / int(match['period']), telemetry),
-               (FISH_HEARTBEAT_HZ, WIRE['heartbeat']), (1.0 / float(match['health']),
-                                                         WIRE['health'])]
+               (FISH_HEARTBEAT_HZ, WIRE['heartbeat']),
+               (1.0 / float(match['health']), WIRE['health'])]
     if match['mode'] == 'stream':
         to_fish.append((100.0, WIRE['servo_cmd']))
     else:
