@@ -13,11 +13,14 @@ The claims: the health panel shows the reset cause and the clock source the brid
 counters, and no NaN; the badge shows gait mode with the board's gait id, then coasting and
 resting each in its own words and colour, coasting before resting, and the gait again once a
 host frame arrives; each state the page showed is one the bridge's status word gave. A FAULT
-reset shows its PC and a crystal failure the fallback clock (the page's own functions on
-such values: the virtual fish does not fault). A screenshot of both panels goes to
+reset shows its PC and a crystal failure the fallback clock, unknown values are blank (the
+page's own functions on the key-values link_health and diagnostic_status make of such a
+HEALTH: the virtual fish does not fault). A screenshot of both panels goes to
 out/dashboard_board.png.
 """
 
+import json
+import math
 from pathlib import Path
 import re
 import time
@@ -28,7 +31,9 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
 from selenium.webdriver.common.by import By
-from wirefish_bridge.protocol import Status
+from wirefish_bridge.link_health import health_values
+from wirefish_bridge.protocol import ClockSource, Health, HealthFlags, ResetCause, Status
+from wirefish_bridge.ros_messages import diagnostic_status
 from wirefish_common.qos import RELIABLE
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
@@ -143,26 +148,43 @@ def test_the_badge_tells_coasting_from_resting_as_the_bridge_reports_them(
     assert dashboard.driver.save_screenshot(str(SCREENSHOT))
 
 
+def _as_published(values: dict[str, object]) -> dict[str, str]:
+    """Return ``values`` as the bridge puts them in /diagnostics (its KeyValue texts)."""
+    status = diagnostic_status('bridge_node: serial link test', 'test', 0, 'test', values)
+    return {kv.key: kv.value for kv in status.values}
+
+
 def test_a_fault_reset_shows_its_pc_and_a_dead_crystal_the_fallback_clock(dashboard):
-    values = {'fish_reset_cause': 'FAULT', 'fish_fault_pc': '0x08001234',
-              'fish_fault_lr': '0x08000abd', 'fish_fault_cfsr': '0x00008200',
-              'fish_fault_hfsr': '0x40000000', 'fish_clock': 'HSI_PLL',
-              'fish_uptime_s': 'nan', 'fish_stack_free_min': '312 of 4096 bytes',
-              'fish_rx_crc': '3'}
-    shown = dashboard.live(f'window.wirefish.boardView.health({values!r})')
+    # The bridge's own key-values of such a HEALTH (the page's functions: the virtual fish
+    # does not fault).
+    health = Health(ResetCause.FAULT, ClockSource.HSI_PLL, HealthFlags.FAULT_RECORD,
+                    fault_pc=0x08001234, fault_lr=0x08000ABD, fault_cfsr=0x8200,
+                    fault_hfsr=0x40000000, uptime_ms=1500, stack_free_min=312,
+                    stack_size=4096, rx_crc=3)
+    values = _as_published(health_values(health))
+    shown = dashboard.live(f'window.wirefish.boardView.health({json.dumps(values)})')
     assert shown['reset_cause'] == ('FAULT at PC 0x08001234 (LR 0x08000abd, CFSR 0x00008200, '
                                     'HFSR 0x40000000)')
     assert shown['clock'] == {'source': 'HSI_PLL', 'fallback': True,
                               'words': 'HSI_PLL: fallback, the crystal failed'}
-    assert shown['uptime'] == ''   # unknown: blank, never NaN
+    assert shown['uptime'] == '1.5 s'
     assert shown['stack'] == '312 of 4096 bytes never used'
+    assert shown['flags'] == 'FAULT_RECORD'
     counters = {c['key']: c['value'] for c in shown['counters']}
-    assert counters['fish_rx_crc'] == '3' and counters['fish_rx_frame'] == ''
-    none_yet = dashboard.live("window.wirefish.boardView.health({fish_reset_cause: 'none yet'})")
-    assert none_yet['reset_cause'] == '' and none_yet['clock']['words'] == ''
+    assert counters['fish_rx_crc'] == '3' and counters['fish_rx_frame'] == '0'
+    assert counters['drops'] == ''   # not in these values: blank
+    # Before the first HEALTH, and values the bridge does not know (nan, inf): blank.
+    unknown = _as_published({**health_values(None), 'fish_uptime_s': math.nan})
+    none_yet = dashboard.live(f'window.wirefish.boardView.health({json.dumps(unknown)})')
+    assert none_yet['reset_cause'] == '' and none_yet['uptime'] == ''
+    assert none_yet['clock']['words'] == ''
     # The link silent (a cut radio): the bridge's last status bits no longer say the state.
-    silent = dashboard.live(
-        "window.wirefish.boardView.linkState({link_state: 'connected', drive_mode: 'gait', "
-        "last_telemetry_age_s: '4.200', fish_status: '0x0100 (GAIT_MODE)'})")
-    assert silent == {'state': 'silent', 'level': 'bad', 'words': (
-        'no telemetry for 4.2 s: link lost (the fish coasts, then rests)')}
+    silent = _as_published({'link_state': 'connected', 'drive_mode': 'gait',
+                            'last_telemetry_age_s': 4.2, 'fish_status': '0x0100 (GAIT_MODE)'})
+    assert dashboard.live(f'window.wirefish.boardView.linkState({json.dumps(silent)})') == {
+        'state': 'silent', 'level': 'bad',
+        'words': 'no telemetry for 4.2 s: link lost (the fish coasts, then rests)'}
+    never = _as_published({'link_state': 'connected', 'drive_mode': 'stream',
+                           'last_telemetry_age_s': math.inf, 'fish_status': '0x0000 (ok)'})
+    assert dashboard.live(f'window.wirefish.boardView.linkState({json.dumps(never)})') == {
+        'state': 'silent', 'level': 'bad', 'words': 'no telemetry yet: link lost'}
