@@ -48,9 +48,9 @@ class DriveMode(enum.StrEnum):
     GAIT = 'gait'
 
 
-# What the bridge is told on each preset. rf433 (9600 bit/s, half duplex): TELEMETRY_COMPACT
-# (38 bytes on the wire, 47 ms of air with the packet's overhead) at 10 Hz, host heartbeats at
-# 2 Hz and HEALTH every 5 s: ~0.55 of the air together (PROTOCOL.md's bandwidth table).
+# What the bridge is told on each preset. rf433 (a 9600-baud UART into a half-duplex radio:
+# 960 B/s): TELEMETRY_COMPACT at 10 Hz, host heartbeats at 2 Hz and HEALTH every 5 s, 8 % of
+# the UART to the fish, 47 % from it, 36 % of the air together (PROTOCOL.md's bandwidth table).
 # bluetooth (115200 baud): full telemetry at 50 Hz (0.27 of the UART), the gait on the board so
 # that a burst at the surface steps nothing.
 RADIO_BRIDGE: dict[Radio, Mapping[str, object]] = {
