@@ -34,6 +34,7 @@ from selenium.webdriver.common.by import By
 from wirefish_bridge.link_health import health_values
 from wirefish_bridge.protocol import ClockSource, Health, HealthFlags, ResetCause, Status
 from wirefish_bridge.ros_messages import diagnostic_status
+from wirefish_bridge.transport import LinkState
 from wirefish_common.qos import RELIABLE
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
@@ -188,3 +189,8 @@ def test_a_fault_reset_shows_its_pc_and_a_dead_crystal_the_fallback_clock(dashbo
                            'last_telemetry_age_s': math.inf, 'fish_status': '0x0000 (ok)'})
     assert dashboard.live(f'window.wirefish.boardView.linkState({json.dumps(never)})') == {
         'state': 'silent', 'level': 'bad', 'words': 'no telemetry yet: link lost'}
+    opened = _as_published({'link_state': LinkState.IDENTIFYING, 'drive_mode': 'gait',
+                            'last_telemetry_age_s': math.inf, 'fish_status': '0x0000 (ok)'})
+    assert dashboard.live(f'window.wirefish.boardView.linkState({json.dumps(opened)})') == {
+        'state': 'down', 'level': 'bad',
+        'words': 'link identifying: the port is open, no fish heartbeat yet'}

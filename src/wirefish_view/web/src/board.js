@@ -76,7 +76,8 @@ export function linkState(values) {
   if (!values) return { state: 'unknown', words: 'no report from the bridge yet', level: 'warn' };
   const link = text(values, 'link_state');
   if (link && link !== 'connected') {
-    return { state: 'down', words: `link ${link}: no fish on the line`, level: 'bad' };
+    const why = link === 'identifying' ? 'the port is open, no fish heartbeat yet' : 'no fish on the line';
+    return { state: 'down', words: `link ${link}: ${why}`, level: 'bad' };
   }
   const age = number(values, 'last_telemetry_age_s');
   const gaitMode = text(values, 'drive_mode') === 'gait';
