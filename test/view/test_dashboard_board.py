@@ -179,6 +179,10 @@ def test_a_fault_reset_shows_its_pc_and_a_dead_crystal_the_fallback_clock(dashbo
     none_yet = dashboard.live(f'window.wirefish.boardView.health({json.dumps(unknown)})')
     assert none_yet['reset_cause'] == '' and none_yet['uptime'] == ''
     assert none_yet['clock']['words'] == ''
+    # A board that cannot tell its reset cause (QEMU's has no reset flags) says UNKNOWN: shown.
+    told = _as_published(health_values(Health(ResetCause.UNKNOWN, ClockSource.EMULATED)))
+    assert dashboard.live(f'window.wirefish.boardView.health({json.dumps(told)})')[
+        'reset_cause'] == 'UNKNOWN'
     # The link silent (a cut radio): the bridge's last status bits no longer say the state.
     silent = _as_published({'link_state': 'connected', 'drive_mode': 'gait',
                             'last_telemetry_age_s': 4.2, 'fish_status': '0x0100 (GAIT_MODE)'})

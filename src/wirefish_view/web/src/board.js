@@ -38,7 +38,9 @@ export const COUNTERS = [
   ['fish_restarts', 'host: fish restarts seen'],
 ];
 
-const UNKNOWN = new Set(['', 'nan', '-nan', 'inf', '-inf', 'none yet', 'unknown']);
+// Texts of values the bridge does not know. A board's own UNKNOWN (a reset cause it could not
+// tell, as on QEMU) is what the board said: shown as such.
+const UNKNOWN = new Set(['', 'nan', '-nan', 'inf', '-inf', 'none yet']);
 
 // The text of a value, or '' when the bridge does not know it.
 export function text(values, key) {
