@@ -88,9 +88,13 @@ def test_stop_brings_the_tail_to_rest_without_a_step_and_start_resumes(spawn, pr
     t, positions, velocities = probe.trace(start - 25)
     assert max_step_ratio(t, positions, velocities) <= 1.0
     assert np.abs(positions[-10:]).max() < 1e-3
+    # cpg_params says what runs: at rest while stopped (a gait-mode board swims what it says).
+    assert list(probe.cpg_params[-1].amplitude) == [0.0, 0.0]
+    assert probe.cpg_params[-1].frequency_hz == 1.0
     begin = probe.node.create_client(Trigger, 'start')
     assert probe.call(begin, Trigger.Request()).success
     probe.wait_samples(200)
+    assert list(probe.cpg_params[-1].amplitude) == pytest.approx([0.38, 0.47])
     t, positions, velocities = probe.trace(start + 100)
     assert max_step_ratio(t, positions, velocities) <= 1.0
     assert np.abs(positions[-100:, 1]).max() == pytest.approx(0.47, rel=0.03)
@@ -111,6 +115,7 @@ def test_autostart_false_holds_still_until_start(spawn, probe):
     probe.wait_samples(50)
     _, positions, _ = probe.trace()
     assert np.abs(positions).max() == 0.0
+    assert probe.cpg_params and all(list(p.amplitude) == [0.0, 0.0] for p in probe.cpg_params)
     begin = probe.node.create_client(Trigger, 'start')
     assert probe.call(begin, Trigger.Request()).success
     probe.wait_samples(200)

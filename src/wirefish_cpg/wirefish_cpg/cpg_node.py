@@ -13,7 +13,10 @@ Publishes
     has not moved publishes nothing, and a clock that jumps back (a restarted fish_sim) re-bases
     the CPG's clock, keeping its state.
     ``cpg_params`` (wirefish_msgs/CpgParams, reliable, transient local, depth 1): the targets
-    the CPG runs, re-published whenever they change (from a command or a parameter set).
+    the CPG runs, re-published whenever they change (from a command, a parameter set, start or
+    stop). While stopped that is ``oscillator.at_rest`` of the targets (amplitudes and offsets
+    0), never the targets kept for start: a bridge in gait mode sends cpg_params to the board
+    as its gait, so a stopped CPG must not say it swims.
     ``cpg_status`` (wirefish_msgs/CpgStatus, reliable, transient local, depth 1): which source
     sets the targets and why the last command was refused, re-published when it changes.
 Subscribes
@@ -51,7 +54,7 @@ from wirefish_cpg.cpg_messages import flat_message_values, to_message
 from wirefish_cpg.cpg_node_parameters import (CPG_PARAMETER_NAMES, NODE_PARAMETERS,
                                               parameters_from, SPECS)
 from wirefish_cpg.fixed_rate import FixedRateLoop
-from wirefish_cpg.oscillator import at_rest, CpgIntegrator
+from wirefish_cpg.oscillator import at_rest, CpgIntegrator, CpgParameters
 from wirefish_cpg.servo_limit import clamp_to_limit
 from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus
 
@@ -68,12 +71,12 @@ class CpgNode(Node):
         declare(self, NODE_PARAMETERS, parameters_from)
         self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
         self._control = CpgTargets(SPECS, self._values, self.get_fully_qualified_name())
-        params = self._control.targets
         self._running = bool(self._values['autostart'])
+        params = self._runs()
         # The CPG is stepped on the loop's thread and re-parameterised on the executor's.
         self._lock = threading.Lock()
         self._last_tick_ns = -1
-        self._cpg = CpgIntegrator(params if self._running else at_rest(params),
+        self._cpg = CpgIntegrator(params,
                                   step_s=self._values['integration_step_s'],
                                   time_s=self._now_s())
         self._servo_pub = self.create_publisher(JointState, 'servo_cmd',
@@ -107,6 +110,11 @@ class CpgNode(Node):
             self._loop.stop()
         super().destroy_node()
 
+    def _runs(self) -> CpgParameters:
+        """Return what the oscillator runs: the targets, or at rest while stopped."""
+        targets = self._control.targets
+        return targets if self._running else at_rest(targets)
+
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
@@ -130,21 +138,21 @@ class CpgNode(Node):
                     self._timer.timer_period_ns = round(period_s * 1e9)
             if names & set(CPG_PARAMETER_NAMES):  # a manual override (cpg_control)
                 self._control.parameters_set(self._values)
-                params = self._control.targets
-                self._cpg.set_parameters(params if self._running else at_rest(params))
+                params = self._runs()
+                self._cpg.set_parameters(params)
         if params is not None:  # announced outside the lock: the loop must not wait on DDS
             self._params_pub.publish(to_message(params))
             self._publish_status()
 
     def _on_command(self, msg: CpgCommand) -> None:
         with self._lock:
-            previous = self._control.targets
+            previous = self._runs()
             applied = self._control.command(self._values, flat_message_values(msg.targets))
-            targets = self._control.targets
-            if targets != previous:
-                self._cpg.set_parameters(targets if self._running else at_rest(targets))
-        if targets != previous:
-            self._params_pub.publish(to_message(targets))
+            runs = self._runs()
+            if runs != previous:
+                self._cpg.set_parameters(runs)
+        if runs != previous:
+            self._params_pub.publish(to_message(runs))
         if not applied:
             self.get_logger().warn(self._control.refused, throttle_duration_sec=2.0)
         self._publish_status()
@@ -172,8 +180,12 @@ class CpgNode(Node):
         response.success = True
         response.message = 'already running' if self._running else 'started'
         with self._lock:
+            changed = not self._running
             self._running = True
-            self._cpg.set_parameters(self._control.targets)
+            runs = self._runs()
+            self._cpg.set_parameters(runs)
+        if changed:
+            self._params_pub.publish(to_message(runs))
         return response
 
     def _on_stop(self, request: Trigger.Request, response: Trigger.Response
@@ -182,8 +194,12 @@ class CpgNode(Node):
         response.message = ('stopping: amplitudes and offsets converge to 0'
                             if self._running else 'already stopped')
         with self._lock:
+            changed = self._running
             self._running = False
-            self._cpg.set_parameters(at_rest(self._control.targets))
+            runs = self._runs()
+            self._cpg.set_parameters(runs)
+        if changed:
+            self._params_pub.publish(to_message(runs))
         return response
 
     def _on_tick(self) -> None:
