@@ -106,6 +106,27 @@ void trace_compare(unsigned servo)
     }
 }
 
+/* After each poll, from the main loop (no line lost): what the core did, read from its state. */
+static uint32_t accepted_seen;
+static uint32_t poll_seen_ms;
+static bool poll_seen;
+
+void trace_poll(const wf_app_t *app)
+{
+    if (app->gaits_accepted != accepted_seen) {
+        accepted_seen = app->gaits_accepted;
+        const int32_t gait[3] = {(int32_t)app->now_ms, (int32_t)app->gait_id,
+                                 (int32_t)app->gaits_accepted};
+        line('G', gait, 3u);
+    }
+    if (app->gait_mode && poll_seen && app->now_ms - poll_seen_ms > 1u) {
+        const int32_t jump[2] = {(int32_t)poll_seen_ms, (int32_t)app->now_ms};
+        line('J', jump, 2u);
+    }
+    poll_seen_ms = app->now_ms;
+    poll_seen = true;
+}
+
 /* The fault path: interrupts are masked and the main loop will not run again; everything
  * queued goes out first, then the fault's own line, synchronously. */
 void trace_fault(uint8_t cause, uint32_t pc)

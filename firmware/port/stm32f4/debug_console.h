@@ -14,6 +14,11 @@
  *   "F <cause> <pc> <ticks_0> <ticks_1>" the fault path ran: its cause, the faulting PC and
  *                         both compare registers read back after it set them neutral, written
  *                         at once, just before the reset
+ *   "G <ms> <gait_id> <accepted>" a poll accepted a GAIT (the core's count of accepted gaits
+ *                         grew): the poll's time, which is the board time the gait's targets
+ *                         took over from (the CPG had been stepped up to it with the old ones)
+ *   "J <ms_before> <ms>"  gait mode, two polls in a row more than 1 ms apart (QEMU descheduled,
+ *                         or a late SysTick): the input of the core's CPG backlog rule
  * It takes one-letter commands on its input, to make the firmware fail on purpose:
  *   "H" a HardFault (an undefined instruction with UsageFault not enabled: escalated),
  *   "W" the poll loop hangs (the watchdog resets), "S" a stack overflow (unbounded recursion).
@@ -35,6 +40,7 @@ void debug_console_poll(void);
 void trace_rx_byte(uint8_t byte);
 void trace_compare(unsigned servo);
 void trace_fault(uint8_t cause, uint32_t pc);
+void trace_poll(const wf_app_t *app);
 #else
 static inline void debug_console_init(const wf_config_t *config)
 {
@@ -52,6 +58,10 @@ static inline void trace_compare(unsigned servo)
 static inline void trace_fault(uint8_t cause, uint32_t pc)
 {
     (void)cause, (void)pc;
+}
+static inline void trace_poll(const wf_app_t *app)
+{
+    (void)app;
 }
 #endif
 

@@ -33,6 +33,7 @@ int main(void)
     board_pwm_set_failsafe(app.compare);   /* the neutral pulses wf_app_init wrote */
     for (;;) {
         wf_app_poll(&app);
+        trace_poll(&app);   /* the QEMU build: "G" and "J" lines */
         debug_console_poll();
         board_watchdog_feed();   /* here only: a poll that never ends is never fed */
         /* Sleep until the next interrupt: SysTick (1 ms) or a received byte. A byte that came
