@@ -176,6 +176,18 @@ def _old_new(scale: float) -> dict:
                             bench_old_new.run, domain_id=DOMAIN)}
 
 
+def _sim_clock(scale: float) -> dict:
+    from wirefish_bench import bench_sim_clock  # the sweep old vs new, simulated time's cost
+    window = 20.0 * scale
+    return {'sim_clock': {
+        'sweep': _run('sim clock: wirefish sweep, old vs new', bench_sim_clock.sweep_old_new,
+                      2 if scale >= 1.0 else 1),
+        'wall_clock': _run("sim clock: one fish's graph on the wall clock",
+                           bench_sim_clock.graph_clock, None, window, DOMAIN),
+        'speed_max': _run("sim clock: one fish's graph at --speed max",
+                          bench_sim_clock.graph_clock, 'max', window, DOMAIN)}}
+
+
 def _fleet(scale: float) -> dict:
     from wirefish_bench import bench_graph
     fleet: list = []
@@ -208,6 +220,8 @@ SECTIONS: dict[Section, tuple[str, Callable[[float], dict]]] = {
     Section.VIEW: ('the view server with one browser on the dashboard', _view),
     Section.OLD_NEW: ('CPG timing, virtual fish, servo and planner intakes: old vs new',
                       _old_new),
+    Section.SIM_CLOCK: ('the sweep old vs new; one graph at --speed max vs the wall clock',
+                        _sim_clock),
     Section.FLEET: ('1 to 8 fish, a process per node and per fish, both executors', _fleet),
 }
 
