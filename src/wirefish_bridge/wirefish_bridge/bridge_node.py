@@ -62,6 +62,7 @@ from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.decimator import Decimator
 from wirefish_bridge.gait_link import ConfigLink, GaitLink, GaitParameters, OscillatorWatch
+from wirefish_bridge.graph_clock import GraphTime
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
 from wirefish_bridge.link_owner import open_refusal
 from wirefish_bridge.protocol import (Ack, ErrorReport, Health, Heartbeat, LinkConfig,
@@ -98,7 +99,8 @@ class BridgeNode(Node):
         declare(self, PARAMETERS, check_combination)
         self._frame_prefix = declare_frame_prefix(self)  # fish_1 -> fish_1/imu_link
         self._values = {s.name: self.get_parameter(s.name).value for s in PARAMETERS}
-        self._started = time.monotonic()
+        self._started = time.monotonic()  # the host's uptime in its HEARTBEAT: a process age
+        self._graph_time = GraphTime()
         self._encoder = FrameEncoder()
         self._decoder = StreamDecoder()
         self._gate = CommandGate(self._values['max_command_rate_hz'],
@@ -107,7 +109,7 @@ class BridgeNode(Node):
         self._inbox: deque = deque(maxlen=1000)  # reader thread -> executor; bounded
         self._inbox_lock = threading.Lock()
         self._drain_scheduled = False  # a drain task is pending on the executor (inbox lock)
-        self._health = LinkHealth(self._values['heartbeat_timeout_s'], time.monotonic())
+        self._health = LinkHealth(self._values['heartbeat_timeout_s'], self._now_s())
         self._battery_rate = Decimator(self._values['battery_rate_hz'])
         # Gait mode's state: the executor sets and sends, the reader thread reports what the
         # board runs; one lock between them.
@@ -156,7 +158,7 @@ class BridgeNode(Node):
             self._watch.window_s = self._values['divergence_window_s']
             self._watch.bound_rad = self._values['divergence_bound_rad']
             if names & LINK_CONFIG_PARAMETERS:
-                self._config.set_config(link_config(self._values), time.monotonic())
+                self._config.set_config(link_config(self._values), self._now_s())
         if 'drive_mode' in names:
             self.get_logger().info(f'drive mode {self._values["drive_mode"]}')
             self._on_command_tick()   # gait mode: the current gait goes out now
@@ -207,14 +209,14 @@ class BridgeNode(Node):
             self._hand_over()
 
     def _publish_from_reader(self, message: Telemetry | TelemetryCompact) -> None:
-        problem = self._health.on_telemetry(message, time.monotonic())
+        problem = self._health.on_telemetry(message, self._now_s())
         if problem is not None:
             self.get_logger().warn(f'impossible telemetry dropped: {problem}',
                                    throttle_duration_sec=2.0)
             return
         telemetry = telemetry_of(message)   # either form, in SI units
         assert telemetry is not None
-        now = time.monotonic()
+        now = self._now_s()
         with self._gait_lock:
             self._gait.on_telemetry(telemetry.gait_id, now)
             if telemetry.status & Status.GAIT_MODE:
@@ -261,13 +263,13 @@ class BridgeNode(Node):
             message = item.message
             if identifies_fish(message):
                 restarts = self._health.fish_restarts
-                self._log(self._health.on_heartbeat(message, time.monotonic()))
+                self._log(self._health.on_heartbeat(message, self._now_s()))
                 if self._health.fish_restarts != restarts:   # its uptime went back
                     self.get_logger().warn('the fish restarted: configuring it again')
                     self._reconfigure_fish()
             elif isinstance(message, Ack):
                 with self._gait_lock:
-                    self._gait.on_ack(message, time.monotonic())
+                    self._gait.on_ack(message, self._now_s())
                     self._config.on_ack(message)
             elif isinstance(message, Health):
                 line = self._health.on_health(message)
@@ -294,9 +296,13 @@ class BridgeNode(Node):
         self._attitude_pub.publish(attitude_message(telemetry, stamp, frame_id))
         self._servo_pub.publish(servo_state_message(telemetry, stamp))
         low_battery = bool(telemetry.status & Status.LOW_BATTERY)
-        if self._battery_rate.due(time.monotonic(), low_battery):
+        if self._battery_rate.due(self._now_s(), low_battery):
             self._battery_pub.publish(battery_message(
                 telemetry, stamp, low_battery, prefixed(self._frame_prefix, 'base_link')))
+
+    def _now_s(self) -> float:
+        """Return the graph's time (s, never back: ``GraphTime``) from the node clock."""
+        return self._graph_time(self.get_clock().now().nanoseconds * 1e-9)
 
     @property
     def _gait_mode(self) -> bool:
@@ -313,9 +319,9 @@ class BridgeNode(Node):
             return
         if self._gait_mode:   # the board runs the gait itself: compare, never forward
             with self._gait_lock:
-                self._watch.add_host(time.monotonic(), angles)
+                self._watch.add_host(self._now_s(), angles)
             return
-        to_send = self._gate.on_command(angles, time.monotonic())
+        to_send = self._gate.on_command(angles, self._now_s())
         if to_send is not None:
             self._send(ServoCommand(*to_send))
 
@@ -325,20 +331,20 @@ class BridgeNode(Node):
             (float(msg.offset[0]), float(msg.offset[1])), float(msg.w12), float(msg.w21),
             float(msg.phi12), float(msg.phi21), float(msg.alpha))
         with self._gait_lock:
-            new = self._gait.set_gait(parameters, time.monotonic())
+            new = self._gait.set_gait(parameters, self._now_s())
         if new:
             self._send_gait_mode_frames()
 
     def _reconfigure_fish(self) -> None:
         """Make LINK_CONFIG and the current gait due: the fish may not have them."""
         with self._gait_lock:
-            self._config.link_up(time.monotonic())
+            self._config.link_up(self._now_s())
             self._gait.on_fish_restart()
         self._send_gait_mode_frames()
 
     def _send_gait_mode_frames(self) -> None:
         """Send a LINK_CONFIG and a GAIT that are due (the gait in gait mode only)."""
-        now = time.monotonic()
+        now = self._now_s()
         with self._gait_lock:
             config = self._config.due(now) if self._configures_fish() else None
             gait = self._gait.due(now) if self._gait_mode else None
@@ -377,7 +383,7 @@ class BridgeNode(Node):
                                      'link_config_acknowledged': self._config.acknowledged}
         if self._gait_mode:
             values.update(self._gait.values())
-            divergence = self._watch.divergence(time.monotonic())
+            divergence = self._watch.divergence(self._now_s())
             values['oscillator_divergence_rad'] = (math.nan if divergence is None
                                                    else divergence)
         return values
@@ -387,7 +393,7 @@ class BridgeNode(Node):
         if self._gait_mode:
             return   # no SERVO_CMD: one would put the board back in stream mode
         was_failsafe = self._gate.failsafe
-        to_send = self._gate.on_tick(time.monotonic())
+        to_send = self._gate.on_tick(self._now_s())
         if self._gate.failsafe and not was_failsafe:
             self.get_logger().warn(f'no servo_cmd for {self._gate.timeout_s:g} s: '
                                    'commanding neutral')
@@ -414,7 +420,7 @@ class BridgeNode(Node):
 
     def _publish_diagnostics(self) -> None:
         self._drain_inbox()  # heartbeats first, so the status is up to date
-        now = time.monotonic()
+        now = self._now_s()
         port, state, stats = self._values['port'], self._link.state, self._link.stats
         with self._gait_lock:
             problem = self._gait_problem(now) if self._gait_mode else None
