@@ -72,7 +72,8 @@ def test_foxglove_ws_protocol_client_decodes_every_channel_at_its_rate(view_grap
     probe = FoxgloveClient(view_graph.ws_url)
     try:
         assert probe.wait(lambda: set(nominal_rates(namespace)) <= {
-            c['topic'] for c in probe.channels.values()}, timeout_s=30.0)
+            c['topic'] for c in probe.channels.values()}, timeout_s=30.0), sorted(
+            set(nominal_rates(namespace)) - {c['topic'] for c in probe.channels.values()})
     finally:
         probe.close()
     out = tmp_path / 'client.json'
