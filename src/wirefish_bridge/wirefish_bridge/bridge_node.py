@@ -173,8 +173,8 @@ class BridgeNode(Node):
         for timer in self._bridge_timers.values():
             self.destroy_timer(timer)
         # The command tick runs the failsafe (neutral within 50 ms of command_timeout_s) and
-        # sends a held command that no newer one superseded. It no longer runs at the rate
-        # limit (100 wake-ups a second): a held command leaves with the next one.
+        # sends a held command that no newer one superseded. It need not run at the rate limit
+        # (100 wake-ups a second): a held command also leaves with the next one that arrives.
         self._bridge_timers = {
             'command': self.create_timer(1.0 / COMMAND_TICK_HZ, self._on_command_tick),
             'heartbeat': self.create_timer(1.0 / self._values['heartbeat_rate_hz'],
