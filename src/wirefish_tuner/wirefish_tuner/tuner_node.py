@@ -69,7 +69,7 @@ SERVICE_QOS = reliable(depth=1000)
 # GoalSender) may be matched by this writer only after the first iterations, or the whole of a
 # short fit, were published; a volatile writer never sends those (seen: a 5-iteration goal
 # succeeded and its new reader heard none of its 6 feedbacks). A reader asking for transient
-# local gets the last 1000 when it matches; a volatile one (rclpy's ActionClient) as before.
+# local gets the last 1000 when it matches; a volatile one (rclpy's ActionClient) what follows.
 FEEDBACK_QOS = latched(depth=1000)
 BUSY = 'busy: a retune is already running; retry when it finishes'
 CANCELED = 'canceled: nothing applied'
