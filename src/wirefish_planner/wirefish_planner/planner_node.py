@@ -25,9 +25,12 @@ Drives
 Starts
     the CPG (its ``start`` service, std_srvs/Trigger) once, at the first command since start-up:
     the first cmd_vel that asks to move, or the first manual override it hears (a retune
-    applied); and again a CPG restarted after that (its start service gone, then back). Until
-    then planner_state says ``still`` (the graph's cpg_node starts with ``autostart`` false: the
-    servos at neutral), or ``own_gait`` with ``rest_at_start`` false.
+    applied); and again a CPG restarted after that (its start service gone, then back, or a
+    cpg_status that says what the last one said: cpg_node publishes it only when it changes,
+    and once at its start, while a CPG killed outright leaves its old service matched for
+    DDS's lease time). A start is called again every ``START_RETRY_S`` until the CPG answers.
+    Until then planner_state says ``still`` (the graph's cpg_node starts with ``autostart``
+    false: the servos at neutral), or ``own_gait`` with ``rest_at_start`` false.
     Hears ``cpg_params`` (what the CPG runs: planner_state's cpg_* fields) and ``cpg_status``.
     One owner of the gait: while the CPG is under a manual override (its parameters were set,
     e.g. a retune applied) the planner sends nothing and says so (mode ``manual``); a refused
@@ -44,6 +47,7 @@ from geometry_msgs.msg import Twist
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.task import Future
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Trigger
 from wirefish_common.batch_intake import BatchIntake, intake_qos
@@ -65,6 +69,9 @@ WARN_THROTTLE_S = 2.0
 # The fastest imu/data the intake's queue is sized for (twice the board's 100 Hz telemetry):
 # two control ticks' samples at that rate.
 MAX_IMU_RATE_HZ = 200.0
+# A start call that got no answer in this long (s, node clock) is made again: a request to a
+# server that has just appeared, or its reply, can be lost (start is idempotent).
+START_RETRY_S = 1.0
 
 
 class PlannerNode(Node):
@@ -86,6 +93,7 @@ class PlannerNode(Node):
         self._commanded = False
         self._start_pending = False  # the CPG's start is due, its service not yet seen
         self._cpg_was_ready: bool | None = None  # the CPG's start service at the last tick
+        self._start_call: tuple[float, Future] | None = None  # (when, its answer) in flight
         self._wire_cpg()
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
         self._imu_intake: BatchIntake | None = None
@@ -122,6 +130,7 @@ class PlannerNode(Node):
                 self.destroy_subscription(subscription)
             self.destroy_client(self._start_client)
             self._sent = self._cpg_params = self._cpg_status = None
+            self._start_call = None
             self._wire_cpg()
 
     def _wire_cpg(self) -> None:
@@ -140,7 +149,11 @@ class PlannerNode(Node):
         self._cpg_params = msg
 
     def _on_cpg_status(self, msg: CpgStatus) -> None:
-        self._cpg_status = msg
+        previous, self._cpg_status = self._cpg_status, msg
+        if (self._commanded and previous is not None
+                and (previous.source, previous.refused) == (msg.source, msg.refused)):
+            self._start_pending = True  # a new cpg_node (no change said): it starts still
+            self._start_cpg()
         if self._manual():  # a retune applied is a command: the fish swims the fit
             self._first_command()
 
@@ -162,9 +175,18 @@ class PlannerNode(Node):
         if self._commanded and self._cpg_was_ready is False and ready:
             self._start_pending = True
         self._cpg_was_ready = ready
+        if self._start_call is not None:
+            sent_s, answer = self._start_call
+            if answer.done():
+                self._start_call = None
+                self._start_pending = False
+            elif self._now_s() - sent_s >= START_RETRY_S:
+                self._start_client.remove_pending_request(answer)  # no answer: call again
+                self._start_call = None
+            else:
+                return
         if self._start_pending and ready:
-            self._start_pending = False
-            self._start_client.call_async(Trigger.Request())
+            self._start_call = (self._now_s(), self._start_client.call_async(Trigger.Request()))
 
     # --- inputs ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
