@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # wirefish: two commands do everything on a fresh machine: `make run` and `make test`.
 SHELL := /bin/bash
 WFENV := tools/wfenv
@@ -47,7 +48,8 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 	src/wirefish_analysis/test/test_analysis_flake8.py \
 	src/wirefish_analysis/test/test_analysis_pep257.py \
 	test/test_lint.py test/test_mypy.py test/test_package_dependencies.py \
-	test/test_host_closure.py test/test_package_size.py test/test_entry_points.py
+	test/test_host_closure.py test/test_package_size.py test/test_entry_points.py \
+	test/test_spdx.py
 
 # pytest-xdist workers: one per core of the 2-core reference machine for the pure tests, one
 # more for the graphs of test/ (they mostly wait on the clock; see machine_share.py).

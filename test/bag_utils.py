@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Checks of recorded bags for the cross-process tests (recorder kill, graph kill, e2e)."""
 
 from collections.abc import Iterator

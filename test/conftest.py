@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fixtures shared by the workspace-level tests: ROS isolation and child processes.
 

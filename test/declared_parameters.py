@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The parameters each registry entry's node declares, read from its ``declare(...)`` table."""
 
 import ast

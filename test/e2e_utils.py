@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Helpers of the end-to-end tests: the whole graph started exactly as `make run` starts it."""
 
 import bisect

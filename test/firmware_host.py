@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The firmware's host build from Python: the make step and ctypes bindings of wf_host.h.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A Foxglove WebSocket client of the tests' own (protocol ``foxglove.sdk.v1``), over `websockets`.
 

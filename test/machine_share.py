@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 How test/'s modules share the machine: weighed slots taken through a turnstile.
 

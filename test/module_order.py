@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The order `make test` deals test/'s modules to its workers in: the longest first.
 

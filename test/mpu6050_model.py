@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A register-level MPU6050 on an I2C bus, from the register map (RM-MPU-6000A-00 rev 4.2).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Helpers of the in-the-loop tests: the board's debug console, a tap on the link, a ROS probe.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 One drive of the whole graph behind the radio model: `wirefish up --radio PRESET` by cmd_vel.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Small ROS peers that the cross-process tests start as separate processes.
 

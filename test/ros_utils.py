@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Helpers for tests that drive ROS nodes and child processes."""
 
 from collections.abc import Callable

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """BatchIntake: the messages of a topic wait in its queue until taken, whatever the executor."""
 
 import time

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The bootstrap (`make setup`) says what is missing in one line and redoes only what changed.
 

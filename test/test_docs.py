@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 docs/ and README.md say what the code is (pure: reads files and tables).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Importing a package changes no signal handler; each executable holds its stops itself.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What each host installs: the dependency closure of its role's packages, from the manifests.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The workspace's own Python outside the packages (tests, tools) follows the same lint rules.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """wirefish_msgs travel between processes over real DDS."""
 
 from pathlib import Path

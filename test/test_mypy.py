@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 mypy passes over every package's modules, strict on the pure ones; the configuration says why not.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """SIGINT and SIGTERM stop every node of the registry with exit code 0 and no trace."""
 
 import dataclasses

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Every package.xml declares what its package uses, and nothing it does not.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 No package grows past 2,000 lines of code without a reason in ARCHITECTURE.md.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Every node's parameter table is its package's ``<node>_parameters`` module, without rclpy."""
 
 import importlib

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The shared QoS profiles (wirefish_common.qos) deliver what their names promise, through DDS.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A burst of SIGINT/SIGTERM a few ms apart stops every process with exit code 0 and no trace.
 

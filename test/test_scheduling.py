@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`make test` deals the longest modules first and shares the machine by slots."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A node started with values it would refuse in a `ros2 param set` exits with one clear line."""
 
 import os

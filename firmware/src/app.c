@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The application: link logic, the two drive modes, failsafe, servo output, sensors and the
  * telemetry schedule.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "wf/cobs.h"
 
 size_t wf_cobs_encode(const uint8_t *in, size_t len, uint8_t *out, size_t cap)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "wf/crc16.h"
 
 /* A nibble table: 32 bytes of flash, two lookups per byte (a byte table would cost 512). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "wf/fault_record.h"
 
 enum { RECORD_MAGIC = 0x57464654u }; /* "WFFT" */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "wf/i2c_bus.h"
 
 /* Releases SCL and waits for it to read high (a slave may stretch it); false if it never does. */

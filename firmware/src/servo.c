@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "wf/servo.h"
 
 float wf_servo_clamp(float angle, float limit)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The ARM figure of one CPG step (make cpg-arm-count): a bare image for QEMU's netduinoplus2
  * (Cortex-M4F, the firmware's compiler flags) that takes STEPS steps of eq 1 from rest with

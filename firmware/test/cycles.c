@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * Cycles per received frame, per telemetry frame and per CPG step, host build (make cycles).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The differential fuzz driver (built with AddressSanitizer and UBSan, every report fatal).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * C unit tests of the core on the host port: CRC, COBS, the link logic, the failsafe and the
  * servo output. Each test is one claim; the program exits 1 at the first failed check.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The C_D calibration command (wirefish_analysis.calibrate_drag) and the paper's figures."""
 
 from dataclasses import replace

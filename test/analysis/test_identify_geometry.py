@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Geometry identification from the paper's indirect evidence."""
 
 from pathlib import Path

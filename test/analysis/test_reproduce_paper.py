@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The section 5.2 reproduction command (both fit modes) and the retune benchmark's figures."""
 
 import json

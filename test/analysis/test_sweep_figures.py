@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish sweep --model-only`'s figures: no legend for what is not drawn, none over data."""
 
 import matplotlib

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the bridge tests: fish_sim and bridge_node processes, a probe, a fake device."""
 
 from collections.abc import Callable, Iterator

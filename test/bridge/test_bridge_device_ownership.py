@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A bridge writes only into the fish it was started for, and alone.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 bridge_node in gait mode, against a fish the test plays on a pty.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """bridge_node and fish_sim as separate processes over a real pty and real DDS."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Finite but impossible telemetry, forged on the pty, is counted and never published (12.9)."""
 
 import dataclasses

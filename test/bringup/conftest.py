@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the recorder's cross-process tests: a talker, an independent listener, a seed."""
 
 from collections.abc import Iterator

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Every `wirefish` subcommand's --help describes every option and cites no issue (pure)."""
 
 import argparse

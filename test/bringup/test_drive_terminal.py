@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish drive` on a real pseudo-terminal: each key acts at once, on its own axis.
 

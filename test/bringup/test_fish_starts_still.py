@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up` on the virtual fish: servo_cmd stays at neutral until the first command."""
 
 from e2e_utils import start_graph

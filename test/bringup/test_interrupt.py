@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Long commands show their progress with an estimate, and Ctrl-C stops each in one line, exit 130.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 launch/wirefish.launch.py, checked without the launch packages (pure: stand-ins, no ROS).
 

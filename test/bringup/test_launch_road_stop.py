@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Stopping nodes started as `ros2 launch` starts them: soon after start-up, and out of the graph.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish up` stops its graph even when a DDS teardown in its own process never returns.
 

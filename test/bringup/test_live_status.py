@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """LiveStatus on real DDS: rates of what is published, latched state, hidden topics left out."""
 
 import time

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A recording on a loaded machine keeps up, or says it did not.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up --params-file`: a refused parameter is said on the terminal, never restarted."""
 
 import subprocess

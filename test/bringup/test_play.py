@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish play`: a bag written by rosbags plays into a subscriber, every message in order."""
 
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish record` writes a rosbag2 MCAP bag that rosbags reads back, and `report` reads it."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish record --duration` on a terminal: its bar is not broken by log lines."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish record --namespace <a typo>`: a warning, and no word of a killed recorder."""
 
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A recorder killed with SIGKILL at a random moment loses at most about its last second.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The supervisor tracks, restarts and stops every process it starts.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish topic` and `wirefish param` against a node of the test's own, on real DDS."""
 
 import os

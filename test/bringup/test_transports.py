@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The graph's transports: UDPv4 unless the user chose others.
 

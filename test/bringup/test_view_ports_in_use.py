@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up --view` beside another dashboard: one line naming the port and the flag."""
 
 import socket

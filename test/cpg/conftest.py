@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the CPG/tuner cross-process tests (helpers live in cpg_probe.py)."""
 
 from collections.abc import Iterator

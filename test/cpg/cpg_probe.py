@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Helpers of the CPG/tuner cross-process tests: a probe node and service-call helpers."""
 
 from dataclasses import dataclass, field

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """cpg_node as a separate process: servo stream, parameters, start/stop, clamping."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish gaits build | list | plot` on a library file of the test's own."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 GoalSender against a real tuner: a goal whose answer is lost is adopted from the status.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fresh clients against restarted servers with the workspace's Fast DDS profile: every call answered.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The retune_gait action across processes: feedback, result, cancel, rejection, library."""
 
 import os

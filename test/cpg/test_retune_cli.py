@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish retune` against a tuner_node process: the fit, refusals, Ctrl-C, bad options."""
 
 import signal

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """tuner_node as a separate process: fits, refusals, bursts, the library, applying to cpg_node."""
 
 import math

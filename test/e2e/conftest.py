@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the end-to-end tests: one whole graph shared by a module's tests."""
 
 from collections.abc import Iterator

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 One fish on the classic executor (WIREFISH_EXECUTOR=classic), the fallback executor.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A second `wirefish up` in a namespace whose nodes already run refuses, unless told otherwise.
 

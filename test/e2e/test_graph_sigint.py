@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """SIGINT to `wirefish up` (Ctrl-C in `make run`) stops every process with 0, leaving none."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Under `wirefish up` a node killed with SIGKILL is back and streaming, and the rest never stops.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up --single-process`: a retune with apply reaches the CPG in the same process."""
 
 import re

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The whole graph, started exactly as `make run` starts it, behaves as one robot.
 

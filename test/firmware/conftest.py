@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the firmware tests: the host build (made once per worker) and its C API."""
 
 from collections.abc import Iterator

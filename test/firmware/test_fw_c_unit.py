@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The C unit tests of the core (firmware/test/test_core.c).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The board's CPG (firmware/src/cpg.c, binary32) against wirefish_cpg's CpgIntegrator (float64).
 

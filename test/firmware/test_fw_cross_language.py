@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Cross-language: 100,000 random valid messages through both codecs, both ways.
 

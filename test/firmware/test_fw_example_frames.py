@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The example frames of PROTOCOL.md (v2), produced and accepted byte for byte by the C core."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The firmware's fail-safe parts on the host port: the reset path, servo limits, a checked IMU.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fuzz: 1,000,000 random and mutated inputs to the C decoder built with ASan and UBSan.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """wirefish-fw-host is a virtual board on a real pty: identification, hello, commands, SIGINT."""
 
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The MPU6050 driver and the attitude filter on the host port, against a register-level model.
 

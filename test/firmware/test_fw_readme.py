@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 firmware/README.md held to the code it describes, in its own terms.
 

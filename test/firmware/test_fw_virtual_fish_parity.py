@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 One set of firmware rules: the virtual fish (wirefish_sim) and the C core must not drift.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fixtures of the in-the-loop tests: the firmware's ARM build on an emulated board (QEMU).
 

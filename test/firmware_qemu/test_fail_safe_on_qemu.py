@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The firmware failing on purpose on the emulated board (QEMU), and what it reports after.
 

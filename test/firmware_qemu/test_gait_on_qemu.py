@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Gait mode on the emulated STM32F405 (QEMU): the telemetry angles are wirefish_cpg's oscillator.
 

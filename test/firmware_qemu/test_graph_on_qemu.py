@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The whole graph on the emulated board: `wirefish up --fish qemu`, as a user starts it.
 

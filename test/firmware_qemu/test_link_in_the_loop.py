@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 bridge_node and the firmware's ARM build on an emulated STM32F405 (QEMU), end to end.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fleet's acceptance: `wirefish up --fleet 3` on one machine, recorded in one bag.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the kinematics node's cross-process tests (helpers in kinematics_probe.py)."""
 
 from collections.abc import Iterator

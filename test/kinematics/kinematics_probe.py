@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Helpers of the kinematics node's cross-process tests: a probe node, sample generators."""
 
 from collections.abc import Callable

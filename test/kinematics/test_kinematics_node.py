@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """kinematics_node as a separate process: servo samples in, body wave and speed estimate out."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """kinematics_node publishes body_wave_markers with every n-th body_wave."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fixtures of the planner's cross-process tests: one graph per module, a driver probe in-process.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A CPG killed and restarted mid-drive: the planner drives the new one, nothing wedges.
 

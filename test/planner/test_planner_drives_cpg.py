@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 planner_node drives cpg_node by its control topic (in-process, one context of the test's own).
 

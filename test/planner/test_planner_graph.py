@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The planner's acceptance on the virtual fish, across processes, measured on sim/ground_truth.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The square mission through `wirefish mission` on the virtual fish: recorded, reported, plotted.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """planner_node in-process: parameter updates are judged whole, cmd_vel is judged, state flows."""
 
 import time

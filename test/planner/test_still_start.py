@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish starts still until its first command, then the planner starts the CPG.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The radio relay process: bytes cross it both ways, late by their air time, and a cut cuts."""
 
 from collections.abc import Iterator

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up --radio`: the relay between the fish and the bridge, the drive mode per road."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The same scenarios with the ARM build in QEMU behind the rf433 radio model, in gait mode.
 

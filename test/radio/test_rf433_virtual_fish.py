@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The paper's build over a narrow radio: rf433, the virtual fish, gait mode, driven by cmd_vel.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """fish_sim's firmware over its pty, driven by this test with pyserial (no bridge, no ROS)."""
 
 from pathlib import Path

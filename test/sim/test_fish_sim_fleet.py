@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 fish_sim with three links: three virtual fish in one process, each on its own pty.
 

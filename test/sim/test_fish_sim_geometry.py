@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """fish_sim swims with the geometry of the graph's params file, and refuses an invalid one."""
 
 from pathlib import Path

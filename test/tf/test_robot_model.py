@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish's robot model: a URDF whose links are the TF tree's frames, latched on robot_description.
 

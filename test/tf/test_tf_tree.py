@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The TF tree of `wirefish up --sim`, rebuilt by an independent subscriber from /tf and /tf_static.
 

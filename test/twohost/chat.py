@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A one-topic DDS probe for the pair tests: ``python chat.py talk|listen SECONDS``.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fixtures of the two-host tests: a fish host and a shore host in two network namespaces.
 

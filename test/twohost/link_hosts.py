@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The two-host tests' helpers: probe processes on one host, the pair's processes, waiting.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A probe process for one side of the two-host tests: it runs inside that side's namespace.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The two-host pair itself: DDS crosses the veth, before and after the link is cut.
 

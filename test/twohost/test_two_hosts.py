@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Acceptance across two hosts, a fish and a shore, over a radio that fails.
 

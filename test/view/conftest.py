@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the view tests: one `wirefish up --sim --view` per module, on free ports."""
 
 from collections.abc import Iterator

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The dashboard's link, gait and health panels in a real browser (headless chromium, Selenium).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The dashboard in a real browser: headless chromium (Debian's) driven by Selenium.
 

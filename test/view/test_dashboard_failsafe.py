@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The dashboard's stream-mode failsafe in a real browser (headless chromium, Selenium).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The dashboard through a radio cut, in a real browser (headless chromium, Selenium).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish up --sim --view` seen by the clients a ROS user brings, and clients kept apart.
 

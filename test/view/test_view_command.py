@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish view` on its own: it binds this machine only unless told, and says so when told."""
 
 import json

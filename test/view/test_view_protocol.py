@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish up --sim --view` seen by a Foxglove WebSocket client of our own (foxglove.sdk.v1).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Foxglove's own client library against the view: @foxglove/ws-protocol's FoxgloveClient on a
 // WebSocket that offers the client's default subprotocol (FoxgloveClient.SUPPORTED_SUBPROTOCOL),
 // every advertised channel subscribed, each message decoded as a viewer does (CDR with

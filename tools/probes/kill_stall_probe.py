@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """
 Does a SIGKILLed subscriber stall its publisher? A 100 Hz publisher, a victim killed N times.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """
 Count the answers fresh clients never get, the way the standard tools make them.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 SIGINT a whole `wirefish up` graph many times in a row; say how fast every process stopped.
 

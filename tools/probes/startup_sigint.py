@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 SIGINT (once or twice) each node executable at a random moment of its start-up; count the clean.
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The firmware application: the one entry point a port's main loop (or an RTOS task) calls.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The application's state and configuration (see wf/app.h). Everything the firmware keeps is
  * in wf_app_t: no heap, no hidden statics in the core, so a test can run several boards.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * Attitude filter: roll, pitch, yaw as PROTOCOL.md defines them (ZYX intrinsic Euler angles of
  * imu_link relative to ENU, R = Rz(yaw) Ry(pitch) Rx(roll)). A complementary filter: the gyro

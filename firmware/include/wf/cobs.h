@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Consistent Overhead Byte Stuffing: removes every 0x00 from a body so 0x00 delimits frames. */
 #ifndef WF_COBS_H
 #define WF_COBS_H

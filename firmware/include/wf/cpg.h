@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The fish's central pattern generator on the board: eq 1 of the paper (two coupled phase
  * oscillators) with the rules of wirefish_cpg.oscillator.CpgIntegrator, in binary32.

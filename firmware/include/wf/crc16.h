@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* CRC-16/CCITT-FALSE: poly 0x1021, init 0xFFFF, no reflection, xorout 0 (PROTOCOL.md). */
 #ifndef WF_CRC16_H
 #define WF_CRC16_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The record a port's fault handler leaves for the next boot, and the reset cause read from it
  * and from the reset flags. Portable: the stm32f4 port keeps the record in RAM that no start-up

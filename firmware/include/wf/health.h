@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * What the board knows about its own health, reported to the host in a HEALTH message (see
  * PROTOCOL.md). The port fills what only it can know (reset cause, fault record, clock source,

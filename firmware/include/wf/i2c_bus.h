@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * I2C bus recovery, portable: the ports drive the two lines as open-drain GPIO through these
  * callbacks (the stm32f4 port its PB8/PB9 registers, the host port the register-level sensor

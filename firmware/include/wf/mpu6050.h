@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * MPU6050 driver over wf_hal_i2c_transfer (register map: InvenSense RM-MPU-6000A-00 rev 4.2).
  * Configures +-500 deg/s and +-4 g, reads the 14 data bytes from ACCEL_XOUT_H (0x3B) in one

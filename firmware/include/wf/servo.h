@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Servo output: angle (rad) -> pulse width (us) -> timer compare (ticks), per-servo calibration. */
 #ifndef WF_SERVO_H
 #define WF_SERVO_H

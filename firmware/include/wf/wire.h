@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The message table of PROTOCOL.md: payload layouts, frame encoding, the body checks and the
  * streaming decoder. Little-endian on the wire whatever the CPU; floats IEEE-754 binary32.

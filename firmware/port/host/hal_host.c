@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The POSIX port of wf/hal.h: a settable clock, byte queues for the UART, recorded PWM
  * compares, I2C routed to a pluggable device model, a settable ADC reading, and a model of the
  * stm32f4 port's reset path (reset flags, the fault record that survives a reset, the fault

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The one board of a host process and the batch codec: the C API the Python tests call. */
 #include <string.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * wirefish-fw-host: the firmware core as a virtual board on a pseudo-terminal (or on stdin and
  * stdout), with the wall clock as its millisecond clock. No servos move and no IMU is wired:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The host port's controls: what a test (C, or Python through ctypes) or the wirefish-fw-host
  * program sets and reads around the core. One board per process (the HAL is global, as a

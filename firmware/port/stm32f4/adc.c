@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The battery divider on ADC1 channel 1 = PA1 (RM0090 13), 12 bits, 480-cycle sampling (the
  * divider's source impedance is high). Never blocks: each call takes the conversion that has

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The stm32f4 port's own set-up calls (what main runs before the core starts), its clock tree
  * and its fail-safe parts: HSE 8 MHz -> PLL -> SYSCLK 168 MHz, APB1 42 MHz (timers 84 MHz),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * Clock tree and the millisecond clock. HSE 8 MHz (the crystal of the STM32F4DISCOVERY and of
  * most F407 boards) -> PLL (M 8, N 336, P 2, Q 7) -> SYSCLK 168 MHz, USB/SDIO 48 MHz;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The QEMU build's debug console on USART2 (see debug_console.h); linked only into that build. */
 #include "debug_console.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The QEMU build's debug console on USART2 (QEMU's second -serial): one text line per event,
  * read by the in-the-loop tests, unseen by the core.

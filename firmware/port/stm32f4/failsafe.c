@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * What the board does when the firmware fails, and what it tells the host about it afterwards.
  *

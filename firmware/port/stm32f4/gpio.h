@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Pin set-up of the real board (QEMU models no GPIO: the writes are harmless there). */
 #ifndef WF_STM32F4_GPIO_H
 #define WF_STM32F4_GPIO_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * I2C1 master for the MPU6050 (RM0090 27), 400 kHz fast mode, polled with a deadline: PB8 SCL,
  * PB9 SDA (AF4, open drain; the MPU6050 breakout boards carry the pull-ups, the internal ones

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The board's main: the reset cause and the stack guard, the brown-out level, the watchdog,
  * the clocks, the millisecond clock, the link UART, I2C1 and the ADC; then the portable core

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The stm32f4 port's ARM images; included by firmware/Makefile and run from firmware/.
 #   make -C firmware arm    real STM32F407 board image: build/arm/wirefish.{elf,bin}
 #   make -C firmware qemu   emulator image (-M netduinoplus2): build/qemu/wirefish.elf

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * Servo PWM on TIM3 (RM0090 18): channel 1 = servo 0 on PC6, channel 2 = servo 1 on PC7
  * (AF2). The timer counts at 1 MHz (PSC 83 from the 84 MHz APB1 timer clock; 15 from the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The servo PWM timer's period in ticks (0 before wf_hal_pwm_init succeeded). */
 #ifndef WF_STM32F4_PWM_H
 #define WF_STM32F4_PWM_H

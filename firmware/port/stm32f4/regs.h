@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * The STM32F405/407 registers this port uses, from RM0090 (Rev 19) and the Cortex-M4 generic
  * user guide: nothing else. Addresses are the memory map of RM0090 section 2.3.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * A single-producer, single-consumer byte ring shared between an interrupt handler and the
  * main loop, without locks: the producer only writes `head`, the consumer only writes `tail`,

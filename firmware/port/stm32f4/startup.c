@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * Vector table and reset handler of the STM32F405/407: copy .data from flash, zero .bss, paint
  * the stack, give the FPU (CP10, CP11) full access, then main. The table lists the 16 core

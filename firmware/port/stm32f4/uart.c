@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * USART1, the link to the host (115200 8N1, RM0090 30.6), interrupt driven: the RX interrupt
  * fills rx_ring (256 bytes: 22 ms at 115200 baud), the main loop empties it (wf_hal_uart_read);

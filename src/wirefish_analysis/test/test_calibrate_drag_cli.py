@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """calibrate_drag's command: progress of the virtual fish's runs, and Ctrl-C in one line."""
 
 import pytest

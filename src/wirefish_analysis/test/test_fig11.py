@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fig 11 and Table 1 on the virtual fish: steady runs over frequency (no ROS, no pty)."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """plot_body_wave writes the Fig 7(b-d) PNGs and the swing-angle RMSEs."""
 
 import pytest

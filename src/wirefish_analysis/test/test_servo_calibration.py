@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The servo slew limit is read from the paper's 3 Hz cap (servo_calibration)."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Calibrate the effective drag coefficient C_D of eq 17 on the paper, and check it.
 

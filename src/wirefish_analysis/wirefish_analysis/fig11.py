@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Speed of the virtual fish against tail-beat frequency at 5 cm tail-tip amplitude (paper Fig 11).
 

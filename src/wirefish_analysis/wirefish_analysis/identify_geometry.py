@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Recover the fish's unpublished geometry from the paper's indirect evidence.
 

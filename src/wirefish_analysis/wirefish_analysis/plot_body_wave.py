@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Plot the paper's Fig 7(b-d) for a locked pair of servo sinusoids.
 

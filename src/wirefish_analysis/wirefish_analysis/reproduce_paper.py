@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Reproduce the paper's section 5.2 point optimisation in both fit modes, side by side.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The virtual fish's servo slew limit, read from the paper's frequency cap (section 5.4).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish sweep`: model and virtual-fish swimming speed over the paper's grid (Figs 9-11).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the bringup package tests: small bags written as the recorder writes them."""
 
 from dataclasses import dataclass, field

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Bags as the recorder writes them: finished ones read back whole, killed ones after a reindex.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The report's figures: legends beside the curves, one axis per angle, the speed's mean."""
 
 from types import SimpleNamespace

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """SequenceGaps counts the samples absent from a publisher's sequence numbers; a run says so."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish bag reindex|info BAG`: repair and inspect bags, as `ros2 bag reindex` / `ros2 bag info`.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A rosbag2 bag directory: its MCAP files and the metadata.yaml that rosbag2 Jazzy writes.
 

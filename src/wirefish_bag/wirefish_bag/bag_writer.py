@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A rosbag2 MCAP storage file written so that a killed writer loses at most one flush period.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """rosbag2 files through `rosbags` (pure Python): the type store that knows wirefish_msgs."""
 
 from dataclasses import dataclass

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The QoS a topic's publishers offer, as rosbag2 Jazzy's metadata stores it."""
 
 from rclpy.node import Node

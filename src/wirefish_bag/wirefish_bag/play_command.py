@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish play BAG`: publish a recorded bag's messages again, at the pace they were recorded.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish record`: record every wirefish topic and /diagnostics into a rosbag2 (MCAP) bag."""
 
 import argparse

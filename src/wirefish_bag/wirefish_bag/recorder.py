@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Record the graph's topics into a rosbag2 bag (MCAP storage), like `ros2 bag record`.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Make a bag whose recorder was killed readable again, like `ros2 bag reindex`.
 

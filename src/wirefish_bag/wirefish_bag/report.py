@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish report BAG`: plots and a summary table from a recorded run.
 

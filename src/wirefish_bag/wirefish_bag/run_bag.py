@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The end of a recorded run (`wirefish up --duration`): repair, report, and the loss account.
 

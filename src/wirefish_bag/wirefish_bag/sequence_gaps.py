@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Count the messages a subscriber never received, from the publisher's sequence numbers.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The node executables the benchmarks start are where the packages install them."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The firmware's BENCHMARKS.md row: its verdict follows the flash and RAM budget."""
 
 import pytest

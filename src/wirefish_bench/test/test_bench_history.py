@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A whole `make bench` rewrites BENCHMARKS.md's tables and keeps its History section as it was."""
 
 from wirefish_bench.bench_report import kept_history, render_markdown

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """BENCHMARKS.md rows of the gait library: its answer and `wirefish gaits build`."""
 
 import pytest

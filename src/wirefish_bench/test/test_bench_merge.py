@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`bench --only`: the named sections' rows replaced, every other row kept byte for byte."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """bench_old_new's BENCHMARKS.md rows from given figures (pure: no processes)."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The 1-fish rows of `make bench`: the median of alternated runs, every run's figure kept."""
 
 from wirefish_bench import bench, bench_graph

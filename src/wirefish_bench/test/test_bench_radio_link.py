@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The radio-link benchmark's BENCHMARKS.md row."""
 
 from wirefish_bench.bench_radio_link import row

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The recorder benchmark's row: its verdict follows the CPU ratio and the loss."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The sim-clock section's rows: the sweep old vs new, --speed max against the wall clock."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `make bench`: run every benchmark once and rewrite BENCHMARKS.md (+ out/bench/results.json).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The firmware's cost: CPU cycles per received frame, telemetry frame and CPG step; flash, RAM.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Benchmarks of the running graph: publish-rate jitter, node CPU, recording loss, many fish.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Latency of the bridge's two paths, over a real pty and real DDS (a benchmark, not a test).
 

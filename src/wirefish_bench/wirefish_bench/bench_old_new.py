@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Four levers of the fish's CPU and timing, the old source against today's in one run.
 

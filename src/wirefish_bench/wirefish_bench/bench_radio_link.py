@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Benchmark: bytes per second crossing the fish-shore radio link, per discovery mode.
 

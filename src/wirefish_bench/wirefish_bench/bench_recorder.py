@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The recorder's CPU for one fish's full graph, the recorder before the move to ``mcap`` and now.
 

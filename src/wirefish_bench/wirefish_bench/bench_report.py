@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Render benchmark results (the dict of `wirefish_bench.bench`) as BENCHMARKS.md."""
 
 from collections.abc import Callable

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Benchmark: one retune of the section 5.2 case, ours against the obvious implementation.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The virtual fish's clock, measured: the sweep old against new, and simulated time's cost.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The live view's cost: CPU of the view server with one browser on the dashboard, and the rates.
 

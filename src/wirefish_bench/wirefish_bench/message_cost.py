@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What one ROS message, timer tick or publish costs a Python process here (not a test).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Pure parts of the bridge: command gate, conversions, parameters, transport with a fake port."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Codec: round trips, streaming, resynchronisation and error counters."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fuzz: 100,000 random and mutated frames in one stream, fed in random chunks."""
 
 from dataclasses import fields

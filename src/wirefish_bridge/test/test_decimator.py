@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The battery's decimation: one sample per period, and every change of state at once."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Gait mode's pure parts: GAIT and LINK_CONFIG until acknowledged, the oscillator watch."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The bridge's graph time: a simulated clock drives the gate and link health, never back."""
 
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL

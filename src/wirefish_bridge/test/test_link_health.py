@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Link health: the diagnostic level's rules and the /diagnostics values, without ROS."""
 
 from dataclasses import fields

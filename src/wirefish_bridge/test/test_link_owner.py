@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Owner records of virtual-fish links: a live owner's link opens, a stale one does not."""
 
 import json

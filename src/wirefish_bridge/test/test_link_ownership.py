@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The serial link opens its device exclusively and writes only to a peer that identified."""
 
 import os

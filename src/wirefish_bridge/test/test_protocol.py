@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The message registry of protocol.py: one class per type byte, nothing falls through."""
 
 from dataclasses import dataclass

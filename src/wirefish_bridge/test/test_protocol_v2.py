@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Protocol version 2: PROTOCOL.md's example frames, the fish's ranges, the compact telemetry."""
 
 import dataclasses

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ROS messages of the bridge from either telemetry form, and of HEALTH."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The telemetry limits table: each field judged against its physical range."""
 
 import dataclasses

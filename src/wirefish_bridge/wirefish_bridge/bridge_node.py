@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 bridge_node: the serial link to the fish's board (STM32F407, §2.1), see PROTOCOL.md.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Parameters of bridge_node: one table and the rules of their combination.
 

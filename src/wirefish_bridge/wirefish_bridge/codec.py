@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Framing of the wirefish serial protocol: COBS + 0x00 delimiter, CRC-16/CCITT-FALSE.
 

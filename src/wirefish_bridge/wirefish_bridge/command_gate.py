@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Servo command gating of the bridge: rate limit and failsafe (pure, no I/O, no rclpy).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Pure conversions of telemetry to ROS conventions (REP-103, REP-145); no rclpy.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Publish a stream slower than its source, but a change of state at once (pure, no rclpy).
 

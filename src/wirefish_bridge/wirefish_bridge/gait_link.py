@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The bridge's gait mode, pure: GAIT and LINK_CONFIG until acknowledged, the oscillator watch.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The graph's time as the bridge's gate, link health, decimation and gait link count it (pure).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Health of the bridge's link to the fish (pure: no rclpy, no I/O).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Owner record of a virtual fish's symlink, so a bridge can tell a live link from a stale one.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Messages of the wirefish serial protocol (see PROTOCOL.md) and their payload layouts.
 

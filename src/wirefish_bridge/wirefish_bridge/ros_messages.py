@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 ROS messages of the bridge built from protocol messages (message types only, no rclpy).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What the fish's board can physically report: one table of limits, one check (pure, no rclpy).
 

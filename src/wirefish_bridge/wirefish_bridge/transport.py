@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Serial transport of the bridge: pyserial, a reader thread, reconnection with backoff.
 

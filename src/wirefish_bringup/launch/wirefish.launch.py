@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Start one fish's graph on a full ROS 2 Jazzy install.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ament_flake8 over this package (ament_lint's configuration: 99 columns, single quotes)."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ament_pep257 docstring conventions over this package."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The graph's Fast DDS profile: the installed file, a graph's own, and who wins."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The node registry: the one description of a fish's processes, and their restart policy."""
 
 import ast

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Roles (fish / shore), frame prefixes and fleets, pure."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The virtual fish's graph on simulated time: who owns the clock, who follows it (pure)."""
 
 import pytest

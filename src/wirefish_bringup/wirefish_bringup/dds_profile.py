@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The workspace's Fast DDS profile (config/fastdds.xml), its transports, and the environment.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A fleet: several fish on one machine, each in a namespace of its own.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The wirefish node graph as data: the one registry of a fish's processes (``NODES``).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """--duration: a finite number of seconds > 0, refused otherwise before anything starts."""
 
 import argparse

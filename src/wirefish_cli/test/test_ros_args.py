@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`ros2 run` passes ROS arguments through: the commands drop them before parsing."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What the verbs of the `wirefish` command share: option types, exit codes, the verb registry.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The `wirefish` command: run, retune, record and inspect the fish without ros2cli.
 

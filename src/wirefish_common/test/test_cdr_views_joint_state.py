@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The JointState CDR reader against rclpy's own serialization, and on bytes that are not one."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The executor choice (WIREFISH_EXECUTOR) and the one spin loop, without ROS."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """frame_prefix: frame ids that carry the fish's name."""
 
 import pytest

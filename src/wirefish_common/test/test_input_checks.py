@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The checks of a serial port, a parameter file and a bag directory (pure: files, no ROS)."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Pure validation of parameter values against their specs."""
 
 import math

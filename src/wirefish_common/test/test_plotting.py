@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Legends beside the data and the moving mean (pure; matplotlib without a display)."""
 
 import matplotlib

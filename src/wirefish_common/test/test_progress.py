@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Progress lines and bars of long commands (pure: a fake clock and a text stream)."""
 
 import io

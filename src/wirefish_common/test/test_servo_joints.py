@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The one JointState <-> servo-pair conversion: names, sizes, finite values, round trip."""
 
 import math

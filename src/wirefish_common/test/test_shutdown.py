@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A process that hangs in its stop writes its threads' stacks; one that stops in time, nothing."""
 
 import signal

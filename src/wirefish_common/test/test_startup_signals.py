@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A process started through the held-start prefix has its stop signals blocked, not ignored."""
 
 import shlex

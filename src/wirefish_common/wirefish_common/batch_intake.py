@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A subscription the executor never wakes for: its messages wait in the reader's queue.
 

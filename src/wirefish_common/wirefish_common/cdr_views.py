@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Serialized messages read in place (plain CDR): the few fields a hot intake needs, no message.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Which rclpy executor spins a wirefish process, and the one loop that spins it.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Frame ids that carry the fish's name: the ``frame_prefix`` parameter.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Checks of what a user names on the command line: a port, a parameter file, a bag, a speed.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The one ``main()`` of every wirefish node: signals, rclpy, the node, its executor, a clean stop.
 

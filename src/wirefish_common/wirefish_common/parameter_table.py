@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 ROS parameters from one table: declaration with descriptors, and pure validation.
 

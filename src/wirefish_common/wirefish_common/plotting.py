@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What every plot of the project shares: legends beside the data, and a moving mean.
 

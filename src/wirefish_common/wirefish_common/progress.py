@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Progress of a long command: a bar on a terminal, a line per step otherwise, with an estimate.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The QoS profiles of every wirefish topic and service client, defined once.
 

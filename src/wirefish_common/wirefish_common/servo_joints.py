@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish's two servos as a sensor_msgs/JointState: one set of joint names, one conversion each way.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Ctrl-C and SIGTERM stop a process between two callbacks, never in the middle of one.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A Ctrl-C while a node's process is still importing ends it with exit 0, not with a trace.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Discovering the graph's topics and subscribing to them without knowing their types ahead."""
 
 import importlib

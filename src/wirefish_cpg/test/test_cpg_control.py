@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Who sets the CPG's targets (cpg_control): commands judged as parameters, the manual rule."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The CPG's flat ROS parameters: their one mapping to CpgParameters and their validation."""
 
 import math

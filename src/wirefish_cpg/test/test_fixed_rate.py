@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """FixedRateLoop: calls at a fixed rate on its own thread, skips (never bursts) when late."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The gait library: records, look-up by wave and geometry, the YAML file written atomically."""
 
 import math

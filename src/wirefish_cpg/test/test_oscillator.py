@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Eq 1 network: convergence, smooth parameter changes, batch form, fixed step."""
 
 import numpy as np

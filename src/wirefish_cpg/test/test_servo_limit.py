@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The servo limit on the CPG's output: clipped angles hold still at the limit."""
 
 import numpy as np

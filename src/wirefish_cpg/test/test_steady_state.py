@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Closed-form steady state of eq 1 against independent root finding and simulation."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Which gait library a graph's tuner uses, as `wirefish up` says at start-up (pure: files)."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Who sets the CPG's targets: the control topic or the node's parameters (pure; no rclpy).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The CPG's parameters as a wirefish_msgs/CpgParams (message types only, no rclpy)."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 cpg_node: the fish's two-oscillator CPG (paper eq 1) driving the servos.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The cpg node's parameters as one table (no rclpy import), and their one mapping to eq 1.
 

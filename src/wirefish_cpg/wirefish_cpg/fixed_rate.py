@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A fixed-rate loop on its own thread: calls a function at absolute deadlines (pure, no rclpy).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Eq 1 for the fish's two oscillators started from rest, solved in closed form.
 

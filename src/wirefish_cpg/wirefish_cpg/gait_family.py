@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A family of gaits over (tail-beat frequency, amplitude scale) of a reference wave, for planners.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The gait library: every successful fit kept with its wave, geometry, figures and time.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Ijspeert's coupled phase oscillators (paper eq 1), integrated with a fixed-step RK4.
 

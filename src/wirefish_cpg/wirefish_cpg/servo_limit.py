@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The servo limit applied to the CPG's output before it becomes a command."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Closed-form steady state of the two-oscillator network of eq 1.
 

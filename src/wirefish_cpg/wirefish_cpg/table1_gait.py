@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Table 1's gait at any tail-beat frequency and tail-tip amplitude (paper sections 5.3-5.4).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Body wave, eqs 7-15 and 19-20: exactness, stability at beta -> 0, continuity, symmetry."""
 
 import math

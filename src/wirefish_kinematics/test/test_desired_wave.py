@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Desired wave, eq 23, and the expected swing angles of section 5.2."""
 
 import math

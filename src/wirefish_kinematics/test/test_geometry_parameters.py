@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The graph's one geometry block: FishGeometry's fields as ROS parameters."""
 
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The kinematics node's messages: body wave, speed estimate and RViz markers, in tail_base."""
 
 from builtin_interfaces.msg import Time

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Lighthill speed estimate, eqs 16-22."""
 
 import math

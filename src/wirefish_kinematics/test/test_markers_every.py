@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """markers_every: body_wave_markers go out with every n-th body_wave."""
 
 import pytest

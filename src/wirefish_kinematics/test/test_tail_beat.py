@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Tail-beat window and estimate from unevenly stamped samples."""
 
 import math

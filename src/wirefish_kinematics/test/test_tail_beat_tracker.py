@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Tail-beat tracking over a live stream: one estimate per beat, rest, rate limit, phase."""
 
 import math

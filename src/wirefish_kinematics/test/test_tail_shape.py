@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tail's shape at one pair of servo angles: eqs 2-4 then 7-15 on evenly spaced stations."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The one wave type of eq 23 and its message converters."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Wire coupling, eqs 2-4 and 21-22."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Body wave of the wire-driven tail in frame C0 (paper eqs 5-15, 19-20) and swing angles (5.2).
 

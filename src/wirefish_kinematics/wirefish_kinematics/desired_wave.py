@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Lighthill's desired travelling body wave (paper eq 23) and the expected swing angles (5.2).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish's dimensions (SI) used by every equation of paper section 3.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish's geometry as ROS parameters: the graph's one geometry block (no rclpy import).
 

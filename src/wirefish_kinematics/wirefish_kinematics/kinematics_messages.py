@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The kinematics node's output messages (message types only, no rclpy).
 

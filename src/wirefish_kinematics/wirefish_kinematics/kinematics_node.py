@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 kinematics_node: the tail's body wave and swimming-speed estimate from the servo angles.
 

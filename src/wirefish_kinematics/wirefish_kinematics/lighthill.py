@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Lighthill's elongated-body speed estimate (paper eqs 16-22).
 

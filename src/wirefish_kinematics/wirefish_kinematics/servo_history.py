@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A bounded, time-ordered history of servo samples (angles, rates) for the tail-beat window."""
 
 from __future__ import annotations

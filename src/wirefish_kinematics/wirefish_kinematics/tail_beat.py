@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The last full tail-beat period in a stream of timestamped servo samples, and its estimate.
 

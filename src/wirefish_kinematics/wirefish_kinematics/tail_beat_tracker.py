@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Tail-beat tracking over a live servo stream: when a speed estimate is due, and the tail's phase.
 

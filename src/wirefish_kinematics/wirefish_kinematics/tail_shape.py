@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The tail's shape at one pair of servo angles: what one body_wave message shows.
 

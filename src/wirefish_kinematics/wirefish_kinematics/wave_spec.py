@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The desired body wave of eq 23 as one type, and its wirefish_msgs/BodyWaveSpec converters.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Mechanical coupling of the two wire pairs (paper eqs 2-4 and 21-22).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The launcher's view of a fleet's nodes, pure."""
 
 from wirefish_bringup.fleet import fleet_graph

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The run's parameter file: a partial file on top of the defaults, and what matches no node."""
 
 from pathlib import Path

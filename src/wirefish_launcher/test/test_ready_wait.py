@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up` waiting for its nodes says how far start-up has got, then gives up in time."""
 
 from dataclasses import dataclass, field

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up --speed`: the virtual fish's pace, refused where the wall clock is the claim."""
 
 import argparse

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The pty link a killed virtual fish leaves behind is removed before a new one starts."""
 
 import os

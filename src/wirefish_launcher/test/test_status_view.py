@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish up`'s status view: the columns and the header it shows (pure: no ROS)."""
 
 import io

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The two-host harness without root: names, addresses, each side's start, the root check."""
 
 import pytest

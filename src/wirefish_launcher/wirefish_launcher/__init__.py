@@ -1,1 +1,2 @@
+# SPDX-License-Identifier: Apache-2.0
 """Process management: wirefish up, its supervisor and status, the emulated board, two hosts."""

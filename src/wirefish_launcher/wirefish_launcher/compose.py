@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish compose`: all of one fish's ROS nodes in one process.
 

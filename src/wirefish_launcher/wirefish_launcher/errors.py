@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The errors of wirefish_launcher that a caller may catch and report in one line."""
 
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The entry points of ``compose`` and ``qemu_board``: stop signals held, then imported and run."""
 
 from wirefish_common.startup_signals import hold_stop_signals

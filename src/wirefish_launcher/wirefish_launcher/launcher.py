@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish up`: start one fish's whole graph, show its status, run until Ctrl-C, stop cleanly.
 

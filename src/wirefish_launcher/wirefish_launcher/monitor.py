@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Watch the ROS graph: which nodes run, and every topic's rate (`ros2 topic hz` for all)."""
 
 from collections.abc import Callable

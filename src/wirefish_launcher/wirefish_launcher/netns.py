@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Two hosts on one machine: two network namespaces joined by a veth pair.
 

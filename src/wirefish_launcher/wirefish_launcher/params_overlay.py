@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The parameter file `wirefish up` gives its nodes: the defaults, the user's file on top of them.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish's board in an emulator: the firmware's ARM build on ``qemu-system-arm``.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish up --radio PRESET` and the bridge's drive mode on each road (pure: no ROS).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish up`'s status: every topic's rate, the link, the battery and the planner's mode.
 

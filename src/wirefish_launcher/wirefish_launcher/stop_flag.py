@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A stop asked for by SIGINT or SIGTERM, acted on by the process's own loop between two steps.
 

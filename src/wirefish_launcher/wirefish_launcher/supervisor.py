@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Start the graph's processes, watch them, and stop every one of them cleanly.
 

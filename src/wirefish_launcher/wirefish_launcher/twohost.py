@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish twohost`: the fish and the shore on two hosts made of network namespaces (root).
 

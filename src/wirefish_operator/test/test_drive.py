@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish drive`: keys to cmd_vel, and the status line."""
 
 import math

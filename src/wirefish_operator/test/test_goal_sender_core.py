@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The decision of GoalSender: what the answers and the server's active goals say."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`wirefish hand-back` refuses a timeout it could not wait for, before it touches ROS."""
 
 import argparse

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Mission files: parsing, refusals, the leg timeline, the shipped square."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The mission report: closure error, per-leg means, the PNG."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What the operator's verbs write on a terminal, read as a terminal shows it."""
 
 import argparse

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish drive`: a terminal teleop; the planner's state live on one line.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish gaits`: build, list and plot the gait library (the tuner's YAML file).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Send an action goal and get its handle even when the server's answer to it is lost.
 

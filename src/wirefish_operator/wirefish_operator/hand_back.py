@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish hand-back`: give the gait back to the planner after a manual override of the CPG.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish mission FILE`: drive the planner through timed cmd_vel legs, record, plot the path.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Missions: timed cmd_vel legs read from YAML (pure; no rclpy).
 

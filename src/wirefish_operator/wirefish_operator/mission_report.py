@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A mission's report from its ground truth (pure; matplotlib without a display).
 

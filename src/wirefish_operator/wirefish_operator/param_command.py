@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish param list|get|set`: the ``ros2 param`` verbs for machines without ros2cli.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish retune`: fit the CPG to a desired body wave through the tuner's retune_gait action.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish topic list|echo|hz`: the ``ros2 topic`` verbs for machines without ros2cli.
 

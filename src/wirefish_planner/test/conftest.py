@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fixtures of the planner's pure tests: the planner, CPG and virtual fish in one process.
 

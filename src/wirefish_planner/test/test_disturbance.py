@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The virtual fish's disturbances (wirefish_sim.faults, fish_sim flags) for the planner."""
 
 import math

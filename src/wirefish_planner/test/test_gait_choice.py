@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The speed -> gait inversion (eq 18 over the Table 1 family) and its policy."""
 
 import math

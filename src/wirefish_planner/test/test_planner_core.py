@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The planner's rules (modes, timeouts, refusals) and its loops on an in-process fish."""
 
 import math

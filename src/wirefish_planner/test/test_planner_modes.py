@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Every planner mode is documented where PlannerState.mode is read: the message, the README."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The yaw-rate PI, heading reference, feed-forward and filters."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Forward speed -> gait: eq 18 inverted over a family of gaits (pure; no rclpy).
 

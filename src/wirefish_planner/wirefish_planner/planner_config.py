@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What the planner node builds from its parameters (pure; no rclpy at import).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The planner's rules (pure; no rclpy): cmd_vel in, gait and turning offset out.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 planner_node: drive the fish with cmd_vel (forward speed and yaw rate).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Turning by the CPG offsets b_1 = b_2 = b (paper eq 1's b_i): yaw-rate PI and heading hold (pure).
 

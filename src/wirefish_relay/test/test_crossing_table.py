@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The crossing table of the fish-shore radio link and the relay's hold, pure."""
 
 from pathlib import Path

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What crosses the fish-shore radio link: the table of config/crossing.yaml (pure, no rclpy).
 

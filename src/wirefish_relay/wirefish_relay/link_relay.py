@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 link_relay: the fish's side of the radio link, the decimated copies the shore sees.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """fish_sim's loop behind real time: it integrates at most MAX_STEP_S a pass, drops the rest."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The virtual fish's clock: lockstep with the host's commands, a pace, never a dropped step."""
 
 import math

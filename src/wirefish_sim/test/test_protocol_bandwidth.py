@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """PROTOCOL.md's bandwidth table, recomputed from the message sizes and the radio presets."""
 
 from pathlib import Path

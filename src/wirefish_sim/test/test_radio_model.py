@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The radio link model: air time, duplex, gathering, latency, burst loss, corruption, cuts."""
 
 from dataclasses import replace

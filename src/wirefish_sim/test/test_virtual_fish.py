@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The virtual fish's physics and firmware, faster than real time (no ROS, no pty)."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The virtual fish's firmware rules of protocol version 2 (no ROS, no pty, simulated time)."""
 
 import dataclasses

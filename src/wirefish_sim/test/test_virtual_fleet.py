@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A fleet of virtual fish on one clock: each fish swims as it would alone (no ROS, no pty)."""
 
 import numpy as np

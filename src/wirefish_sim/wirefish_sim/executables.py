@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The entry points of ``fish_sim`` and ``radio_relay``: stop signals held, then run."""
 
 from typing import NoReturn

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Fault injection of the virtual fish's serial output (pure; randomness from a Generator).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Surge and yaw dynamics of the virtual fish (pure functions; SI units).
 

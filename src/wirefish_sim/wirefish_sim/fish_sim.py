@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 fish_sim: virtual fish on pseudo-terminals, playing the boards' firmware in real time.
 

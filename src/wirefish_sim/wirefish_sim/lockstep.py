@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 When the virtual fish may take its next step of simulated time (pure: no ROS, no I/O).
 

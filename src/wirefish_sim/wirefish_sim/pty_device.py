@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The virtual fish's end of a pseudo-terminal pair, with a stable symlink to the device.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A serial radio between the bridge and the fish's board: the pure, clock-agnostic link model.
 

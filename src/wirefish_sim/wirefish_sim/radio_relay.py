@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 radio_relay: a serial radio (``radio_model``) between the bridge and a fish's pseudo-terminal.
 

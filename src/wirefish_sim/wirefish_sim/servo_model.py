@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Servo model of the virtual fish.
 

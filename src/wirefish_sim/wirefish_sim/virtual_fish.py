@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The virtual fish: firmware, servos, tail kinematics, Lighthill surge and a yaw model.
 

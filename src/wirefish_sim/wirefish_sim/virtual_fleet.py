@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 A school of virtual fish on one clock: each fish's firmware of its own, one physics for all.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The frames' pure core: mounts, the moving tail frames and dead reckoning."""
 
 import math

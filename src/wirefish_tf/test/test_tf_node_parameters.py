@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tf node's parameter table and the rule of their combination (pure)."""
 
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The entry point of ``tf_node``: stop signals held, then the node imported and run."""
 
 from wirefish_common.startup_signals import hold_stop_signals

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish's frames and where they sit (pure: no rclpy), REP-103 and REP-105.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish as a URDF (pure: no rclpy): the robot model RViz and Foxglove draw on the TF tree.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The TF messages of the fish's frames (message types only, no rclpy)."""
 
 from __future__ import annotations

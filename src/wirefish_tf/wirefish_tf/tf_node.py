@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 tf_node: the fish's TF tree (REP-105) on ``/tf`` and ``/tf_static``; frames in ``frames``.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The tf node's parameters as one table (no rclpy import), and the rule of their combination.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The answer pacer: slots at least one interval apart, the work outside the pacing."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Feasibility of a wave and acceptance of a fit (wirefish_tuner.feasibility)."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Gait families over (frequency, amplitude scale): membership, nearest, interpolation."""
 
 import numpy as np

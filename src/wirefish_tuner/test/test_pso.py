@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """PSO (eqs 26-27) on known test functions."""
 
 import numpy as np

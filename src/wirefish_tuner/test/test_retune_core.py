@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The one fitting core of the retune service and action (wirefish_tuner.retune_core)."""
 
 from dataclasses import replace

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tuner node's parameter table: valid defaults, the body wave's geometry, no rclpy."""
 
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The loss of eqs 24-25 on the closed-form steady state, and the section 5.2 fit."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tuner fits the one wave type of the project (eq 23), not a copy of it."""
 
 from wirefish_kinematics.wave_spec import WaveSpec

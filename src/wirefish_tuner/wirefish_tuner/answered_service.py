@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Service answers paced so that a burst of requests is answered every one (ROS 2 Jazzy, DDS).
 

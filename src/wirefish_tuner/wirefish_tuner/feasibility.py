@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Whether the tail can follow a desired wave, and a fit is good enough to run (eqs 2-4, 23).
 

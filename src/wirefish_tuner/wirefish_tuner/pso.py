@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 Global-best particle swarm optimisation, paper eqs 26-27, over a box.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The loss of eqs 24-25 computed the obvious way: integrate eq 1 for one particle at a time.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The one fitting core behind the ``retune_gait`` service and the ``retune_gait`` action.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 tuner_node: fits the CPG to a desired body wave on request (paper section 4, eqs 23-27).
 

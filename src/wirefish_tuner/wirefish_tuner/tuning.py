@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fit the CPG to a desired body wave: PSO (eqs 26-27) on the exact loss of eqs 24-25."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The point-optimisation loss of paper eqs 24-25, evaluated exactly on the locked steady state.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A client's cmd_vel is accepted within the drive limits; everything else is refused."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The front door's pure parts: which subprotocol a handshake gets, and the status rate limit."""
 
 import json

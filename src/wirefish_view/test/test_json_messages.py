@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """JSON Schema from ROS types, and requests filled strictly from JSON."""
 
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The Foxglove/Lichtblick layout shows the dashboard's panels, on topics the view offers."""
 
 import json

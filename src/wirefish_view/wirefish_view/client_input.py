@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 What a view client may send: cmd_vel only, validated (pure: no rclpy but its serializer).
 

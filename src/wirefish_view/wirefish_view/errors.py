@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The errors of wirefish_view."""
 
 from __future__ import annotations

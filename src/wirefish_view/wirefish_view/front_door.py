@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The view's WebSocket front door: either Foxglove subprotocol name, client publishing, statuses.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 ROS message types as JSON: their JSON Schema, and a message filled strictly from JSON.
 

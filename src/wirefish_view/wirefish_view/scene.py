@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The fish as a Foxglove scene (foxglove.SceneUpdate): head, the tail's two arcs, fin, trail.
 

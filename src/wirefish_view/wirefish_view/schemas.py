@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The ``ros2msg`` schemas of the graph's message types, for Foxglove channels (pure but for files).
 

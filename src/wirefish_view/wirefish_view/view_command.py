@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 `wirefish view`: the live view of a running fish, Foxglove WebSocket server and dashboard.
 

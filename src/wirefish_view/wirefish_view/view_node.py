@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 view_node: a Foxglove WebSocket server over the fish's graph, and the dashboard's web server.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """
 The dashboard's web server: the page bundled at setup time, and its configuration.
 

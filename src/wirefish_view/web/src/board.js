@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The fish's link, gait and health as the bridge reports them in /diagnostics (its status
 // `<namespace>/bridge_node: serial link <port>`, values as text): pure functions from those
 // key-values to what the page shows. A value the bridge does not know ('nan', 'inf', 'none

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The wirefish dashboard: a Foxglove WebSocket client (foxglove.sdk.v1) of `wirefish view`.
 // Topics arrive as CDR with their ros2msg schemas and are decoded here; cmd_vel goes out as
 // JSON on the one client channel the server accepts; start, stop and retune_gait are the
