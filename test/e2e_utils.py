@@ -153,11 +153,10 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     return {topic: (topics[topic], counts[topic] / window_s) for topic in sorted(topics)}
 
 
-# Streams a node decimates on the wall clock, not its node clock: bridge_node's battery
-# (its Decimator is given time.monotonic()). At --speed 1 simulated time runs at most at real
-# time, so per simulated second such a stream comes at least at its nominal rate (more when
-# the machine slows the clock down).
-WALL_DECIMATED = frozenset({'battery'})
+# Streams a node decimates on the wall clock, not its node clock: judged as at least their
+# nominal rate per simulated second (at --speed 1 simulated time runs at most at real time).
+# None now: bridge_node's battery Decimator counts the node clock (graph_clock.GraphTime).
+WALL_DECIMATED: frozenset[str] = frozenset()
 
 
 def rate_problem(topic: str, measured: float, nominal: float, tolerance: float) -> str | None:
