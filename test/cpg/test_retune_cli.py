@@ -111,6 +111,7 @@ def test_on_a_terminal_the_progress_is_one_live_bar(tuner, python, ros_env):
         os.close(controller)
     assert done.returncode == 0
     text = shown.decode()
-    assert text.count('\r[') == 21  # redrawn in place once per iteration
+    # Redrawn in place once per iteration: back to the line's start, clear it, draw.
+    assert text.count('\r\x1b[K[') == 21
     assert '[##############################] iteration 20/20  best loss ' in text
     assert 'RMSE theta' not in text  # the plain lines are for non-terminals
