@@ -125,6 +125,9 @@ def test_a_stopped_cpg_gives_a_gait_mode_board_no_gait_to_swim(ros_domain_id, ro
         heard = len(board)
         assert spin_until(executor, lambda: len(board) > heard + 20 * STILL_WINDOW_S,
                           timeout_s=6 * STILL_WINDOW_S), len(board)
+        # cpg_params is latched: it arrives when this reader matches its writer, which on a
+        # loaded machine can come after the sensor streams matched.
+        assert spin_until(executor, lambda: bool(params), timeout_s=15.0), 'no cpg_params heard'
         print(f'gait mode, CPG stopped: {len(board)} servo_state samples, largest '
               f'{max(abs(a) for s in board for a in s):.4f} rad; {len(params)} cpg_params, '
               f'amplitudes {[[float(a) for a in p.amplitude] for p in params]}; bridge gait '

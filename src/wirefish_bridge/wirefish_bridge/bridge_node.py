@@ -322,7 +322,11 @@ class BridgeNode(Node):
             with self._gait_lock:
                 self._watch.add_host(self._now_s(), angles)
             return
-        to_send = self._gate.on_command(angles, self._now_s())
+        # The gate counts the wire's time, not the graph's: its rate limit is about the serial
+        # link, and on the lockstep road a command that came before this node heard its step's
+        # /clock found no credit on the graph's clock and was held for the next tick, which
+        # waits on simulated time, which waits on that very command.
+        to_send = self._gate.on_command(angles, time.monotonic())
         if to_send is not None:
             self._send(ServoCommand(*to_send))
 
@@ -394,7 +398,7 @@ class BridgeNode(Node):
         if self._gait_mode:
             return   # no SERVO_CMD: one would put the board back in stream mode
         was_failsafe = self._gate.failsafe
-        to_send = self._gate.on_tick(self._now_s())
+        to_send = self._gate.on_tick(time.monotonic())
         if self._gate.failsafe and not was_failsafe:
             self.get_logger().warn(f'no servo_cmd for {self._gate.timeout_s:g} s: '
                                    'commanding neutral')
