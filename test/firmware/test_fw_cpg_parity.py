@@ -18,7 +18,7 @@ from __future__ import annotations
 import ctypes
 import math
 
-from firmware_host import LIBRARY
+from firmware_host import CpgParams, GaitSnapshot as GaitView, LIBRARY
 import numpy as np
 import pytest
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
@@ -29,33 +29,6 @@ CHANGES = 10
 TOLERANCE_RAD = 1e-4
 LIMIT = float(np.float32(1.57079625))  # the board's default servo limit (binary32 below pi/2)
 GAIT, HEARTBEAT = 0x11, 0x01
-
-
-class CpgParams(ctypes.Structure):
-    """wf_cpg_params_t (firmware/include/wf/cpg.h)."""
-
-    _fields_ = [('frequency_hz', ctypes.c_float), ('amplitude', ctypes.c_float * 2),
-                ('offset', ctypes.c_float * 2), ('w12', ctypes.c_float),
-                ('w21', ctypes.c_float), ('phi12', ctypes.c_float), ('phi21', ctypes.c_float),
-                ('alpha', ctypes.c_float)]
-
-
-class GaitView(ctypes.Structure):
-    """wf_host_gait_snapshot_t (firmware/port/host/wf_host.h)."""
-
-    _fields_ = [('gait_mode', ctypes.c_uint8), ('gap', ctypes.c_uint8),
-                ('gait_id', ctypes.c_uint16), ('cpg_time_ms', ctypes.c_uint32),
-                ('cpg_steps', ctypes.c_uint32), ('phase', ctypes.c_float * 2),
-                ('r', ctypes.c_float * 2), ('dr', ctypes.c_float * 2),
-                ('b', ctypes.c_float * 2), ('db', ctypes.c_float * 2),
-                ('output', ctypes.c_float * 2), ('rate', ctypes.c_float * 2),
-                ('target', ctypes.c_float * 2), ('compare', ctypes.c_uint32 * 2),
-                ('status', ctypes.c_uint16), ('ack_count', ctypes.c_uint8),
-                ('telemetry_form', ctypes.c_uint8), ('acks_dropped', ctypes.c_uint32),
-                ('gaits_accepted', ctypes.c_uint32), ('gaits_refused', ctypes.c_uint32),
-                ('telemetry_period_ms', ctypes.c_uint32), ('health_period_ms', ctypes.c_uint32),
-                ('link_timeout_ms', ctypes.c_uint32), ('coast_ms', ctypes.c_uint32),
-                ('params', CpgParams)]
 
 
 class HostMsg(ctypes.Structure):
