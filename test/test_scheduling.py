@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """`make test` deals the longest modules first and shares the machine by slots."""
 
+import fcntl
 from pathlib import Path
 import subprocess
 import threading
@@ -55,6 +56,24 @@ def _most_slots_held(events: list) -> int:
     return most
 
 
+def _wait_for(condition, timeout_s: float = 30.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        assert time.monotonic() < deadline, 'the holders did not get there in 30 s'
+        time.sleep(0.01)
+
+
+def _turnstile_held(directory: Path) -> bool:
+    """Return whether a holder is inside the turnstile (flock: per open file, so seen here)."""
+    with open(directory / 'turnstile.lock', 'a') as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return True
+        fcntl.flock(lock, fcntl.LOCK_UN)
+        return False
+
+
 @pytest.mark.parametrize('workers', [1, 2, 3])
 def test_modules_never_hold_more_slots_than_the_machine_has(tmp_path, workers):
     events: list = []
@@ -71,9 +90,10 @@ def test_a_module_that_loads_the_machine_waits_for_two_free_slots(tmp_path):
     events: list = []
     first = _hold(tmp_path, 3, 1, events, 'a', 0.6)
     second = _hold(tmp_path, 3, 1, events, 'b', 0.6)
-    time.sleep(0.2)  # both hold their slot: one of three is free
+    # Wait on what happened, not on a sleep: a loaded machine starts threads late.
+    _wait_for(lambda: len(events) == 2)  # both hold their slot: one of three is free
     heavy = _hold(tmp_path, 3, 2, events, 'heavy', 0.05)
-    time.sleep(0.2)
+    _wait_for(lambda: _turnstile_held(tmp_path))  # the heavy one waits in the turnstile
     late = _hold(tmp_path, 3, 1, events, 'late', 0.05)  # queues behind the heavy one
     for thread in (first, second, heavy, late):
         thread.join(timeout=30.0)

@@ -39,6 +39,11 @@ FRAMES = {'odom', 'base_link', 'imu_link', 'tail_base', 'tail_plate_ii', 'tail_p
           'caudal_fin'}
 TF_NODE = Path(get_package_prefix('wirefish_tf'), 'lib', 'wirefish_tf', 'tf_node')
 MATCHED_AT_LEAST = 50  # truths a transform is checked against, for each of the two checks
+# Of the truths in the span, the share that must have their transform heard. Every hop keeps
+# the last samples only (the /tf writer 100, tf_node's ground-truth reader 50), so a listener
+# starved for a second on a loaded machine loses some: the claim is the values, and that the
+# transforms follow the truths, not that no sample is ever dropped.
+MATCHED_SHARE = 0.75
 SPANNED = 2 * MATCHED_AT_LEAST  # truths the transforms span before the checks start
 SEND_PERIOD_S = 0.05  # how often the fleet test feeds its two tf_nodes
 
@@ -157,7 +162,7 @@ def test_odom_to_base_link_is_the_ground_truth_within_a_millimetre(heard):
     print(f'odom -> base_link: {matched} of {len(truths)} ground truths matched, '
           f'largest distance {error:.3g} m')
     assert error <= 1e-3
-    assert matched >= max(MATCHED_AT_LEAST, 0.9 * len(truths))
+    assert matched >= max(MATCHED_AT_LEAST, MATCHED_SHARE * len(truths))
 
 
 def test_the_fin_frame_is_on_the_body_wave(heard):
@@ -181,7 +186,7 @@ def test_the_fin_frame_is_on_the_body_wave(heard):
     print(f'caudal_fin: {matched} of {len(waves)} body waves matched, lateral error '
           f'{fin_error:.3g} m at plate V, {tip_error:.3g} m at the tip')
     assert fin_error <= 1e-6 and tip_error <= 1e-6
-    assert matched >= max(MATCHED_AT_LEAST, 0.9 * len(waves))
+    assert matched >= max(MATCHED_AT_LEAST, MATCHED_SHARE * len(waves))
     assert np.ptp(lateral) > 0.01  # the tail beats: the frame moves
 
 

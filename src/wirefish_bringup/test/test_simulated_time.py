@@ -22,6 +22,12 @@ def test_fish_sim_owns_the_clock_and_every_other_node_follows_it():
     assert by_name['bridge_node'].parameters['max_command_rate_hz'] == SIM_TIME_COMMAND_RATE_HZ
 
 
+def test_on_simulated_time_odom_is_the_ground_truth_from_the_first_transform():
+    specs = on_simulated_time(fish_graph('/tank', sim=True), '1')
+    tf_node = next(spec for spec in specs if spec.executable == 'tf_node')
+    assert tf_node.parameters['odom_source'] == 'ground_truth'
+
+
 def test_the_single_process_host_is_told_the_clock():
     specs = on_simulated_time(fish_graph('/tank', sim=True, single_process=True), '1')
     composed = next(spec for spec in specs if spec.name == COMPOSED_NAME)

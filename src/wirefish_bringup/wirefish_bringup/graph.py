@@ -487,13 +487,28 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
         elif spec.name == COMPOSED_NAME:
             spec = replace(spec, arguments=(*spec.arguments, '--sim-time', '--clock', clock))
         elif spec.namespace is not None:
-            extra = {'use_sim_time': 'true'}
-            if spec.executable == 'bridge_node':
-                extra['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
-            spec = replace(spec, parameters={**spec.parameters, **extra},
+            spec = replace(spec, parameters={**spec.parameters,
+                                             **simulated_time_parameters(spec.executable)},
                            remaps={**spec.remaps, '/clock': clock})
         timed.append(spec)
     return timed
+
+
+def simulated_time_parameters(executable: str) -> dict[str, str]:
+    """
+    Return the parameters node ``executable`` gets on the virtual fish's clock.
+
+    Every node: ``use_sim_time``. The bridge: its command rate limit lifted
+    (``SIM_TIME_COMMAND_RATE_HZ``). The tf_node: odom -> base_link from the virtual fish's
+    ground truth from the first transform; its ``auto`` would dead-reckon until the truth is
+    heard, stamped on the same simulated instants as the truths, then jump to them.
+    """
+    extra = {'use_sim_time': 'true'}
+    if executable == 'bridge_node':
+        extra['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
+    if executable == 'tf_node':
+        extra['odom_source'] = 'ground_truth'
+    return extra
 
 
 def clock_topic(namespace: str) -> str:

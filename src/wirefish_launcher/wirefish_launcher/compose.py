@@ -17,7 +17,7 @@ import sys
 import threading
 
 from wirefish_bringup.graph import (composable_entries, DEFAULT_NAMESPACE, default_params_file,
-                                    resolve, ros_arguments, SIM_TIME_COMMAND_RATE_HZ,
+                                    resolve, ros_arguments, simulated_time_parameters,
                                     validate_namespace)
 from wirefish_common.executors import ExecutorKind
 
@@ -89,9 +89,7 @@ def run(args: argparse.Namespace) -> int:
             parameters = {k: resolve(v, device=args.port, namespace=namespace)
                           for k, v in entry.parameters.items()}
             if args.sim_time:  # as on_simulated_time sets them for one process per node
-                parameters['use_sim_time'] = 'true'
-                if entry.name == 'bridge_node':
-                    parameters['max_command_rate_hz'] = SIM_TIME_COMMAND_RATE_HZ
+                parameters.update(simulated_time_parameters(entry.name))
             cli_args = list(ros_arguments(entry.name, namespace, params, parameters,
                                           {'/clock': args.clock} if args.sim_time else None))
             node = node_class(entry.node_class)(cli_args=cli_args)
