@@ -178,8 +178,10 @@ def drive(out: Path, preset: str, *, drive_mode: str | None = None, drive_s: flo
     probe = _Probe(context, namespace, record)
     try:
         source = record.servo if qemu else record.truth
-        assert probe.spin_until(lambda: bool(source) and bool(record.diagnostics), 60.0), \
-            'no ground truth (servo_state on QEMU) or bridge diagnostics within 60 s'
+        # The drive starts on a configured link: until LINK_CONFIG reaches it, a board floods
+        # a narrow radio with its boot defaults (100 Hz of full telemetry).
+        assert probe.spin_until(lambda: bool(source) and _configured(record), 60.0), \
+            'no ground truth (servo_state on QEMU) or no configured link within 60 s'
         record.started = time.monotonic()
         next_cmd = record.started
         total = drive_s + cut_s + after_cut_s
@@ -206,6 +208,12 @@ def drive(out: Path, preset: str, *, drive_mode: str | None = None, drive_s: flo
     record.radio = json.loads(radio.read_text())
     record.cuts = [tuple(cut) for cut in record.radio['cuts']]
     return record
+
+
+def _configured(record: Drive) -> bool:
+    """Return whether the bridge's newest diagnostics say the fish runs the wanted link."""
+    configured = record.bridge_values('link_configured')
+    return bool(configured) and configured[-1][1] == 'True'
 
 
 def describe_link(record: Drive) -> str:

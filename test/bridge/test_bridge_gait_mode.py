@@ -3,7 +3,8 @@
 bridge_node in gait mode, against a fish the test plays on a pty.
 
 cpg_params becomes a GAIT (and never a SERVO_CMD), LINK_CONFIG goes out at link-up until an ACK
-accepts it, a GAIT is resent until acknowledged, COASTING shows in /diagnostics, compact
+accepts it, then the GAIT (not before: the fish must run the configured link), resent until
+acknowledged, COASTING shows in /diagnostics, compact
 telemetry is published in SI units.
 """
 
@@ -49,20 +50,23 @@ def test_gait_mode_sends_gaits_and_its_link_config_until_acknowledged(fake_devic
                  'telemetry_form:=compact', 'gait_resend_s:=0.3')
     publisher = probe.node.create_publisher(CpgParams, 'cpg_params', LATCHED)
     publisher.publish(_cpg_params())
+    # LINK_CONFIG first, resent while unacknowledged; no GAIT before the fish runs that link.
     sent = _until(probe, fake_device,
-                  lambda s: sum(isinstance(m, Gait) for m in s) >= 2
-                  and sum(isinstance(m, LinkConfig) for m in s) >= 2, 20.0)
-    gaits = [m for m in sent if isinstance(m, Gait)]
+                  lambda s: sum(isinstance(m, LinkConfig) for m in s) >= 2, 20.0)
     configs = [m for m in sent if isinstance(m, LinkConfig)]
-    assert len(gaits) >= 2 and len(configs) >= 2, sent   # resent while unacknowledged
+    assert len(configs) >= 2 and not any(isinstance(m, Gait) for m in sent), sent
+    assert configs[0] == LinkConfig(100, TelemetryForm.COMPACT, 2000, 1500, 3000)
+    fake_device.send(Ack(MsgType.LINK_CONFIG, _last_seq(fake_device, LinkConfig)))
+    # Then the GAIT, resent while unacknowledged.
+    sent = _until(probe, fake_device, lambda s: sum(isinstance(m, Gait) for m in s) >= 2, 20.0)
+    gaits = [m for m in sent if isinstance(m, Gait)]
+    assert len(gaits) >= 2 and not any(isinstance(m, LinkConfig) for m in sent), sent
     assert gaits[0].gait_id == 1   # float32 on the wire:
     assert gaits[0].to_wire()[1:] == pytest.approx(PARAMS.message(1).to_wire()[1:], abs=1e-6)
-    assert configs[0] == LinkConfig(100, TelemetryForm.COMPACT, 2000, 1500, 3000)
     assert not any(isinstance(m, ServoCommand) for m in sent)
 
-    # The fish answers both: the resends stop, the gait is acknowledged.
-    fake_device.send(Ack(MsgType.LINK_CONFIG, _last_seq(fake_device, LinkConfig)),
-                     Ack(MsgType.GAIT, _last_seq(fake_device, Gait)))
+    # The fish answers: the resends stop, the gait is acknowledged.
+    fake_device.send(Ack(MsgType.GAIT, _last_seq(fake_device, Gait)))
     compact = TelemetryCompact.from_telemetry(TELEMETRY)
     for _ in range(20):
         fake_device.send_fish_heartbeat()

@@ -184,3 +184,39 @@ def test_percentile_is_the_nearest_rank():
     assert percentile([1.0, 2.0, 3.0, 4.0], 0.5) == 2.0
     assert percentile([1.0, 2.0, 3.0, 4.0], 0.99) == 4.0
     assert math.isnan(percentile([], 0.5))
+
+
+def test_a_new_gait_goes_twice_then_every_resend_period():
+    link = GaitLink(resend_s=0.5, repeat_s=0.15)
+    link.set_gait(STRAIGHT, 0.0)
+    link.sent(1, 0.0)
+    assert link.due(0.14) is None and link.due(0.15).gait_id == 1
+    link.sent(2, 0.15)
+    assert link.due(0.6) is None and link.due(0.65).gait_id == 1
+
+
+def test_the_ack_of_either_copy_acknowledges_the_gait_and_stops_the_copies():
+    link = GaitLink(resend_s=0.5, repeat_s=0.15)
+    link.set_gait(STRAIGHT, 0.0)
+    link.sent(1, 0.0)
+    link.sent(2, 0.15)
+    link.on_ack(Ack(MsgType.GAIT, 2), 0.3)   # the first copy was lost
+    assert link.acknowledged and link.due(1.0) is None
+    assert list(link.ack_latencies_s) == [pytest.approx(0.3)]
+
+
+def test_an_acknowledged_first_copy_sends_no_second():
+    link = GaitLink(resend_s=0.5, repeat_s=0.15)
+    link.set_gait(STRAIGHT, 0.0)
+    link.sent(1, 0.0)
+    link.on_ack(Ack(MsgType.GAIT, 1), 0.1)
+    assert link.due(0.15) is None
+
+
+def test_a_gait_taken_before_the_link_was_configured_waits_from_then():
+    link = GaitLink(resend_s=0.5)
+    link.set_gait(STRAIGHT, 1.0)
+    link.waits_from(3.0)
+    link.sent(1, 3.0)
+    link.on_ack(Ack(MsgType.GAIT, 1), 3.2)
+    assert list(link.ack_latencies_s) == [pytest.approx(0.2)]

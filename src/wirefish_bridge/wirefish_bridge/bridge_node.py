@@ -115,7 +115,8 @@ class BridgeNode(Node):
         # Gait mode's state: the executor sets and sends, the reader thread reports what the
         # board runs; one lock between them.
         self._gait_lock = threading.Lock()
-        self._gait = GaitLink(self._values['gait_resend_s'], self._values['gait_min_interval_s'])
+        self._gait = GaitLink(self._values['gait_resend_s'], self._values['gait_min_interval_s'],
+                              self._values['gait_repeat_s'])
         self._config = ConfigLink(link_config(self._values), self._values['gait_resend_s'])
         self._watch = OscillatorWatch(self._values['divergence_window_s'],
                                       self._values['divergence_bound_rad'])
@@ -155,6 +156,7 @@ class BridgeNode(Node):
         with self._gait_lock:
             self._gait.resend_s = self._values['gait_resend_s']
             self._gait.min_interval_s = self._values['gait_min_interval_s']
+            self._gait.repeat_s = self._values['gait_repeat_s']
             self._config.resend_s = self._values['gait_resend_s']
             self._watch.window_s = self._values['divergence_window_s']
             self._watch.bound_rad = self._values['divergence_bound_rad']
@@ -271,7 +273,11 @@ class BridgeNode(Node):
             elif isinstance(message, Ack):
                 with self._gait_lock:
                     self._gait.on_ack(message, self._now_s())
-                    self._config.on_ack(message)
+                    configured = self._config.on_ack(message)
+                    if configured:
+                        self._gait.waits_from(self._now_s())
+                if configured:
+                    self._send_gait_mode_frames()   # the gait it held back
             elif isinstance(message, Health):
                 line = self._health.on_health(message)
                 if line is not None:
@@ -352,7 +358,9 @@ class BridgeNode(Node):
         now = self._now_s()
         with self._gait_lock:
             config = self._config.due(now) if self._configures_fish() else None
-            gait = self._gait.due(now) if self._gait_mode else None
+            # GAIT once the fish runs the configured link: at its boot defaults (100 Hz of
+            # full telemetry) a board floods a narrow radio, and an ACK finds no room.
+            gait = self._gait.due(now) if self._gait_mode and self._link_configured() else None
         if config is not None:
             seq = self._send(config)
             if seq is not None:
@@ -363,6 +371,10 @@ class BridgeNode(Node):
             if seq is not None:
                 with self._gait_lock:
                     self._gait.sent(seq, now)
+
+    def _link_configured(self) -> bool:
+        """Return True when the fish runs the link the bridge wants (the gait lock held)."""
+        return self._config.acknowledged or not self._configures_fish()
 
     def _configures_fish(self) -> bool:
         """Return True when LINK_CONFIG must go out: gait mode, or not the boot defaults."""
@@ -385,7 +397,8 @@ class BridgeNode(Node):
     def _mode_values(self) -> dict[str, object]:
         """Return the /diagnostics values of the drive mode (the gait lock held)."""
         values: dict[str, object] = {'drive_mode': self._values['drive_mode'],
-                                     'link_config_acknowledged': self._config.acknowledged}
+                                     'link_config_acknowledged': self._config.acknowledged,
+                                     'link_configured': self._link_configured()}
         if self._gait_mode:
             values.update(self._gait.values())
             divergence = self._watch.divergence(self._now_s())

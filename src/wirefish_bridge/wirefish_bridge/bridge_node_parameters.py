@@ -100,6 +100,10 @@ PARAMETERS = (
     ParameterSpec('gait_resend_s', 0.4,
                   'Gait mode: an unacknowledged GAIT or LINK_CONFIG is sent again this often (s)',
                   0.05, 10.0),
+    ParameterSpec('gait_repeat_s', 0.15,
+                  'Gait mode: a new GAIT goes a second time this long after its first copy '
+                  'unless acknowledged by then, so that one lost copy or ACK on a lossy radio '
+                  'costs no resend wait; 0 sends one copy (s)', 0.0, 10.0),
     ParameterSpec('gait_min_interval_s', 0.1,
                   'Gait mode: a new GAIT goes out no sooner than this after the last one; '
                   'changes in between are coalesced, the newest goes (s)', 0.0, 10.0),

@@ -12,8 +12,11 @@ should run:
   gets the next gait id and is due at once.
 - A gait is acknowledged by an ACK of its GAIT frame (result 0) or by telemetry reporting its
   gait id. Until then it is due again every ``resend_s`` (a lost GAIT or a lost ACK both end
-  in a resend; the fish takes a repeated GAIT as the same targets: no step). An ACK with a
-  refusal stops the resends (the board said why: ``refusal``) until the next change.
+  in a resend; the fish takes a repeated GAIT as the same targets: no step). With
+  ``repeat_s`` > 0 a new gait's first copy is followed by a second ``repeat_s`` later, before
+  its acknowledgement could be back: on a lossy radio one lost copy (or one lost ACK) then
+  costs nothing, where it would cost the wait for a resend. An ACK with a refusal stops the
+  resends (the board said why: ``refusal``) until the next change.
 - Telemetry that reports another gait id after the acknowledgement (the board reset, or a
   SERVO_CMD put it back to stream mode) makes the gait due again.
 - The time from a change to its acknowledgement is kept (``ack_latencies_s``).
@@ -119,16 +122,19 @@ class _Acknowledged:
 class GaitLink:
     """What the board should run in gait mode, and whether it does (see the module doc)."""
 
-    def __init__(self, resend_s: float, min_interval_s: float = 0.0) -> None:
+    def __init__(self, resend_s: float, min_interval_s: float = 0.0,
+                 repeat_s: float = 0.0) -> None:
         """
         Nothing to send yet.
 
         An unacknowledged GAIT goes again every ``resend_s``; a new gait goes out no sooner
         than ``min_interval_s`` after the last GAIT (changes in between are coalesced: the
-        newest goes).
+        newest goes); with ``repeat_s`` > 0 its second copy goes ``repeat_s`` after the first
+        unless it was acknowledged by then.
         """
         self.resend_s = resend_s
         self.min_interval_s = min_interval_s
+        self.repeat_s = repeat_s
         self.parameters: GaitParameters | None = None
         self.gait_id = 0
         self.board_gait_id = 0   # as the newest telemetry says
@@ -141,6 +147,7 @@ class GaitLink:
         self._pending: OrderedDict[int, float] = OrderedDict()
         self._seq_gait: dict[int, int] = {}   # seq of a GAIT frame -> its gait id
         self._last_sent_s: float | None = None    # the current gait's last send
+        self._copies_sent = 0                     # of the current gait
         self._last_any_s = -math.inf              # any GAIT's last send
 
     @property
@@ -166,6 +173,7 @@ class GaitLink:
         self.changes += 1
         self.refusal = None
         self._last_sent_s = None
+        self._copies_sent = 0
         return True
 
     def due(self, now: float) -> Gait | None:
@@ -175,9 +183,15 @@ class GaitLink:
         if self._last_sent_s is None:
             if now - self._last_any_s < self.min_interval_s:
                 return None
-        elif now - self._last_sent_s < self.resend_s:
+        elif now - self._last_sent_s < self._next_copy_after_s():
             return None
         return self.parameters.message(self.gait_id)
+
+    def _next_copy_after_s(self) -> float:
+        """Return how long after the current gait's last copy the next one is due."""
+        if self._copies_sent == 1 and 0.0 < self.repeat_s < self.resend_s:
+            return self.repeat_s
+        return self.resend_s
 
     def sent(self, seq: int, now: float) -> None:
         """Note that the due GAIT went out with sequence number ``seq``."""
@@ -185,6 +199,7 @@ class GaitLink:
             self._seq_gait.clear()
         self._seq_gait[seq] = self.gait_id
         self._last_sent_s = self._last_any_s = now
+        self._copies_sent += 1
         self.sends += 1
 
     def on_ack(self, ack: Ack, now: float) -> None:
@@ -218,6 +233,18 @@ class GaitLink:
             if taken_id == gait_id:
                 break
 
+    def waits_from(self, now: float) -> None:
+        """
+        Count the waits of the gaits not yet acknowledged from ``now`` at the earliest.
+
+        The bridge holds GAIT until the fish runs the link it configured (a board at its boot
+        defaults floods a narrow radio, and an ACK has no room): a gait taken before then
+        could not have been acknowledged sooner, and its latency is the link's from then.
+        """
+        for gait_id, taken_s in self._pending.items():
+            if not math.isnan(taken_s):
+                self._pending[gait_id] = max(taken_s, now)
+
     def resting_gait(self) -> Gait | None:
         """
         Return a GAIT that brings the tail to rest through the oscillator, or None.
@@ -240,6 +267,7 @@ class GaitLink:
             # Due again, but not a change: its acknowledgement adds no gait change's latency.
             self._pending[self.gait_id] = math.nan
         self._last_sent_s = None   # due at once
+        self._copies_sent = 0
 
     def values(self) -> dict[str, object]:
         """Return the /diagnostics values of the gait link."""
@@ -301,9 +329,9 @@ class ConfigLink:
         """Note that LINK_CONFIG went out with sequence number ``seq``."""
         self._state.sent(seq, now)
 
-    def on_ack(self, ack: Ack) -> None:
-        """Take an ACK from the fish."""
-        self._state.on_ack(ack)
+    def on_ack(self, ack: Ack) -> bool:
+        """Take an ACK from the fish; return True when it newly acknowledges LINK_CONFIG."""
+        return self._state.on_ack(ack)
 
 
 def percentile(sorted_values: list[float], share: float) -> float:
