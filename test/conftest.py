@@ -9,10 +9,12 @@ group and torn down (SIGINT, then SIGKILL) when the test ends, so none is left b
 
 from collections.abc import Callable, Iterator
 import itertools
+import json
 import os
 from pathlib import Path
 import subprocess
 import sys
+import time
 
 from machine_share import machine_share, slot_count
 from module_order import module_rank
@@ -123,8 +125,17 @@ def machine_slots(request: pytest.FixtureRequest,
     run_directory = tmp_path_factory.getbasetemp()  # a worker's is popen-gwK in the run's
     if _WORKER:
         run_directory = run_directory.parent
+    asked = time.monotonic()
     with machine_share(run_directory, slots, weight):
-        yield
+        started = time.monotonic()
+        try:
+            yield
+        finally:
+            # One line per module: what `make test`'s time is made of (waits and holds).
+            with open(run_directory / 'machine_share.jsonl', 'a') as log:
+                log.write(json.dumps({'module': request.node.nodeid, 'weight': weight,
+                                      'waited_s': round(started - asked, 2),
+                                      'held_s': round(time.monotonic() - started, 2)}) + '\n')
 
 
 @pytest.fixture
