@@ -97,9 +97,14 @@ def is_loopback(address: str) -> bool:
 
 
 def _qos_of(publishers: list) -> QoSProfile:
-    """Return a subscription QoS that matches every publisher of a topic."""
-    best_effort = any(p.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
-                      for p in publishers)
+    """
+    Return a subscription QoS that matches every publisher of a topic.
+
+    None discovered yet: best effort, which matches a publisher of either reliability (a
+    reliable reader would get nothing from a best-effort stream discovered a moment later).
+    """
+    best_effort = not publishers or any(
+        p.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT for p in publishers)
     latched = publishers and all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
                                  for p in publishers)
     if best_effort:
