@@ -35,8 +35,7 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # Most of test/ waits on real-time graphs (a fish swims in real time), so it runs on more workers
 # than cores. A module that loads the machine itself (the loaded recording, QEMU, the dashboard)
 # would starve the real-time streams of the modules beside it, so it holds two of the machine's
-# three slots and such modules run one at a time; a module whose claim is a wall-clock latency of
-# the emulated board keeps the machine to itself (test/machine_share.py).
+# three slots and such modules run one at a time (test/machine_share.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
 	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder test \

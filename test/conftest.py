@@ -115,13 +115,11 @@ def machine_slots(request: pytest.FixtureRequest,
     Run each module on its share of the machine (machine_share.py): two slots if it loads it.
 
     The slots are shared by the run's workers (lock files in the run's base temp); mark a
-    module that loads the machine itself ``pytest.mark.loads_machine``, one whose claim is a
-    wall-clock latency of an emulated board ``pytest.mark.keeps_machine`` (every slot).
+    module that loads the machine itself ``pytest.mark.loads_machine``.
     """
     workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
     slots = slot_count(workers)
-    weight = (slots if request.node.get_closest_marker('keeps_machine')
-              else 2 if request.node.get_closest_marker('loads_machine') else 1)
+    weight = 2 if request.node.get_closest_marker('loads_machine') else 1
     run_directory = tmp_path_factory.getbasetemp()  # a worker's is popen-gwK in the run's
     if _WORKER:
         run_directory = run_directory.parent

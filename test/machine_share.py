@@ -8,10 +8,8 @@ emulated STM32, a browser), and beside two other modules their real-time streams
 with three workers: a failsafe of the QEMU board, a recording 1.8 s behind, a dashboard that
 never plotted). So the machine has as many slots as workers (at least two): a module holds one
 slot while it runs, a module that loads the machine holds two, and those modules run one at a
-time. A module whose claim is a wall-clock latency of an emulated board (QEMU behind the radio
-model) keeps the machine to itself: it holds every slot. Slots are lock files shared by the
-run's workers; a module takes its slots through a turnstile lock, so a module that needs more
-than one is not overtaken by ones that need one.
+time. Slots are lock files shared by the run's workers; a module takes its slots through a
+turnstile lock, so a module that needs two is not overtaken by ones that need one.
 """
 
 from __future__ import annotations
@@ -56,9 +54,9 @@ def _try_slot(path: Path, stack: ExitStack) -> bool:
 
 @contextmanager
 def machine_share(directory: Path, slots: int, weight: int) -> Iterator[None]:
-    """Hold ``weight`` (1 to ``slots``) of the ``slots`` slots kept in ``directory`` inside."""
-    if not 1 <= weight <= slots:
-        raise ValueError(f'a module holds 1 to {slots} of {slots} slots, not {weight}')
+    """Hold ``weight`` (1 or 2) of the ``slots`` slots kept in ``directory`` while inside."""
+    if not 1 <= weight <= min(2, slots):
+        raise ValueError(f'a module holds 1 or 2 of {slots} slots, not {weight}')
     with ExitStack() as stack:
         if weight > 1:  # the modules that load the machine take turns
             stack.enter_context(_locked(directory / 'loads_machine.lock'))
