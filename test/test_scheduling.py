@@ -89,8 +89,10 @@ def test_modules_never_hold_more_slots_than_the_machine_has(tmp_path, workers):
 
 def test_a_module_that_loads_the_machine_waits_for_two_free_slots(tmp_path):
     events: list = []
+    # 'b' ends well after 'a': the slot 'a' frees is the only one the heavy module can take,
+    # and none is left for the late one until the heavy one is done.
     first = _hold(tmp_path, 3, 1, events, 'a', 0.6)
-    second = _hold(tmp_path, 3, 1, events, 'b', 0.6)
+    second = _hold(tmp_path, 3, 1, events, 'b', 1.5)
     # Wait on what happened, not on a sleep: a loaded machine starts threads late.
     _wait_for(lambda: len(events) == 2)  # both hold their slot: one of three is free
     heavy = _hold(tmp_path, 3, 2, events, 'heavy', 0.05)
