@@ -17,7 +17,7 @@ import types
 
 from declared_parameters import declared_specs
 import pytest
-from wirefish_bringup.graph import entry
+from wirefish_bringup.graph import default_params_file, entry
 from wirefish_common.frames import FRAME_PREFIX
 from wirefish_common.parameter_table import ParameterSpec
 from wirefish_common.startup_signals import held_start_prefix
@@ -262,3 +262,16 @@ def test_a_real_fish_and_two_hosts_run_on_the_wall_clock(monkeypatch):
             assert '--speed' not in node['arguments'] and not node['remappings'], launch
             assert all('use_sim_time' not in values for values in node['parameters']
                        if isinstance(values, dict)), launch
+
+
+def test_a_params_file_goes_over_the_defaults_not_instead_of_them(monkeypatch, tmp_path):
+    mine = tmp_path / 'my_fish.yaml'
+    mine.write_text('/**/fish_sim:\n  ros__parameters:\n    l1: 0.09\n')
+    for node in launched_nodes(monkeypatch, **LAUNCHES['sim'], params_file=str(mine)):
+        assert node['parameters'][:2] == [str(default_params_file()), str(mine)], node['name']
+
+
+def test_without_a_params_file_the_nodes_read_the_defaults_once(monkeypatch):
+    for node in launched_nodes(monkeypatch, **LAUNCHES['sim']):
+        files = [f for f in node['parameters'] if not isinstance(f, dict)]
+        assert files.count(str(default_params_file())) == 1, node['name']

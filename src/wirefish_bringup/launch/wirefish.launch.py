@@ -29,7 +29,8 @@ from launch.substitutions import EnvironmentVariable, LaunchConfiguration
 from launch_ros.actions import Node
 from wirefish_bringup.dds_profile import (profile_path, PROFILES_VARIABLE, TRANSPORTS,
                                           TRANSPORTS_VARIABLE)
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, fish_graph, on_simulated_time, Role
+from wirefish_bringup.graph import (DEFAULT_NAMESPACE, default_params_file, fish_graph,
+                                    on_simulated_time, Role)
 from wirefish_common.input_checks import parse_speed
 from wirefish_common.startup_signals import held_start_prefix
 
@@ -93,6 +94,18 @@ def _simulated_time_overrides():
     return file.name
 
 
+def _parameter_files(params_file: str) -> list[str]:
+    """
+    Return a node's parameter files: the installed defaults, then the user's over them.
+
+    A user's params_file names only what it changes (the fish's geometry, one gain), as under
+    `wirefish up --params-file`: ROS applies the files in order, value by value, so what it does
+    not name keeps the installed default.
+    """
+    defaults = str(default_params_file())
+    return [defaults] if params_file == defaults else [defaults, params_file]
+
+
 def _nodes(context):
     sim = LaunchConfiguration('sim').perform(context).lower() in ('true', '1', 'yes')
     port = LaunchConfiguration('port').perform(context) or None
@@ -123,7 +136,7 @@ def _nodes(context):
             package=spec.package, executable=spec.executable, name=spec.name,
             exec_name=spec.name,
             namespace=spec.namespace, arguments=list(spec.arguments),
-            parameters=[spec.params_file,
+            parameters=[*_parameter_files(spec.params_file),
                         *([_simulated_time_overrides()] if simulated else []),
                         spec.typed_parameters()],
             remappings=list(spec.remaps.items()),
@@ -151,7 +164,8 @@ def generate_launch_description():
         DeclareLaunchArgument('namespace', default_value=DEFAULT_NAMESPACE,
                               description='ROS namespace of every node and topic of the fish'),
         DeclareLaunchArgument('params_file', default_value='',
-                              description='parameter YAML (default: config/wirefish.yaml)'),
+                              description='parameter YAML over the defaults (config/'
+                              'wirefish.yaml): it names only what it changes'),
         DeclareLaunchArgument('role', default_value=Role.ALL.value,
                               choices=[role.value for role in Role],
                               description='fish: the nodes that keep the fish swimming (and '
