@@ -74,6 +74,12 @@ class Drive:
         values = [v for t, v in self.truth if start_s <= t - self.started < end_s]
         return float(np.mean(values)) if values else math.nan
 
+    def at_end_of_drive(self, key: str) -> str:
+        """Return the bridge's last /diagnostics value ``key`` of the drive (before any cut)."""
+        values = [v for t, v in self.bridge_values(key) if t <= self.started + DRIVE_S]
+        assert values, f'no {key} in the bridge diagnostics'
+        return values[-1]
+
     def bridge_values(self, key: str) -> list[tuple[float, str]]:
         """Return (t, value) of one /diagnostics value of the bridge, in order."""
         return [(t, values[key]) for t, _, _, values in self.diagnostics if key in values]

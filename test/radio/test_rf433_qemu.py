@@ -10,7 +10,7 @@ of driving, a start-up, and the emulator (two machine slots).
 
 import pytest
 from radio_run import (board_frames, BoardFrame, cut_figures, describe_link, Drive, drive,
-                       DRIVE_S, SCHEDULE, smooth_bound, worst_step)
+                       SCHEDULE, smooth_bound, worst_step)
 from wirefish_bridge.protocol import Status
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
@@ -38,27 +38,21 @@ def board(rf433, out) -> list[BoardFrame]:
     return board_frames(out)
 
 
-def _at_end_of_drive(record: Drive, key: str) -> str:
-    values = [v for t, v in record.bridge_values(key) if t <= record.started + DRIVE_S]
-    assert values, f'no {key} in the bridge diagnostics'
-    return values[-1]
-
-
 def test_qemu_rf433_link_use_stays_under_80_percent_each_way(rf433):
     load = (rf433.radio['load_to_fish'], rf433.radio['load_to_host'])
     print(f"QEMU rf433 gait: {load[0]:.1%} of the preset's rate to the fish, {load[1]:.1%} "
           f'to the host; air time {rf433.radio["use_to_fish"]:.1%} and '
           f'{rf433.radio["use_to_host"]:.1%}')
-    assert _at_end_of_drive(rf433, 'drive_mode') == 'gait'
+    assert rf433.at_end_of_drive('drive_mode') == 'gait'
     assert load[0] <= 0.8 and load[1] <= 0.8
 
 
 def test_qemu_gait_changes_are_acknowledged_quickly(rf433):
-    acks = int(_at_end_of_drive(rf433, 'gait_acks'))
-    median = float(_at_end_of_drive(rf433, 'gait_ack_median_s'))
-    p99 = float(_at_end_of_drive(rf433, 'gait_ack_p99_s'))
-    print(f'QEMU rf433 gait: {_at_end_of_drive(rf433, "gait_changes")} gait changes, '
-          f'{_at_end_of_drive(rf433, "gait_frames_sent")} GAIT frames, {acks} acknowledged: '
+    acks = int(rf433.at_end_of_drive('gait_acks'))
+    median = float(rf433.at_end_of_drive('gait_ack_median_s'))
+    p99 = float(rf433.at_end_of_drive('gait_ack_p99_s'))
+    print(f'QEMU rf433 gait: {rf433.at_end_of_drive("gait_changes")} gait changes, '
+          f'{rf433.at_end_of_drive("gait_frames_sent")} GAIT frames, {acks} acknowledged: '
           f'median {median:.3f} s, p99 {p99:.3f} s')
     assert acks >= len(SCHEDULE)
     assert median <= 0.3 and p99 <= 1.0

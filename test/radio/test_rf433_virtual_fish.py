@@ -56,28 +56,22 @@ def board(rf433, rf433_out) -> list[BoardFrame]:
     return board_frames(rf433_out)
 
 
-def _at_end_of_drive(record: Drive, key: str) -> str:
-    values = [v for t, v in record.bridge_values(key) if t <= record.started + DRIVE_S]
-    assert values, f'no {key} in the bridge diagnostics'
-    return values[-1]
-
-
 def test_rf433_link_use_stays_under_80_percent_each_way(rf433):
     load = (rf433.radio['load_to_fish'], rf433.radio['load_to_host'])
     air = (rf433.radio['use_to_fish'], rf433.radio['use_to_host'])
     print(f"rf433 gait: {load[0]:.1%} of the preset's {rf433.radio['capacity_bytes_s']:.0f} B/s "
           f'to the fish, {load[1]:.1%} to the host; air time {air[0]:.1%} and {air[1]:.1%} of '
           f'the half-duplex channel; turn-arounds {rf433.radio["turnarounds"]}')
-    assert _at_end_of_drive(rf433, 'drive_mode') == 'gait'
+    assert rf433.at_end_of_drive('drive_mode') == 'gait'
     assert load[0] <= 0.8 and load[1] <= 0.8
 
 
 def test_gait_changes_are_acknowledged_quickly(rf433):
-    acks = int(_at_end_of_drive(rf433, 'gait_acks'))
-    median = float(_at_end_of_drive(rf433, 'gait_ack_median_s'))
-    p99 = float(_at_end_of_drive(rf433, 'gait_ack_p99_s'))
-    changes = int(_at_end_of_drive(rf433, 'gait_changes'))
-    sent = int(_at_end_of_drive(rf433, 'gait_frames_sent'))
+    acks = int(rf433.at_end_of_drive('gait_acks'))
+    median = float(rf433.at_end_of_drive('gait_ack_median_s'))
+    p99 = float(rf433.at_end_of_drive('gait_ack_p99_s'))
+    changes = int(rf433.at_end_of_drive('gait_changes'))
+    sent = int(rf433.at_end_of_drive('gait_frames_sent'))
     print(f'rf433 gait: {changes} gait changes, {sent} GAIT frames, {acks} acknowledged: '
           f'median {median:.3f} s, p99 {p99:.3f} s')
     assert acks >= len(SCHEDULE)
