@@ -2,6 +2,8 @@
 """Helpers of the end-to-end tests: the whole graph started exactly as `make run` starts it."""
 
 import bisect
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 import math
 import os
@@ -61,6 +63,26 @@ def start_graph(domain_id: int, out_dir: Path, *options: str,
         raise
     stop_process(launcher)
     raise RuntimeError('wirefish up did not start:\n' + ''.join(seen) + launcher.stdout.read())
+
+
+@contextmanager
+def stopped_on_exit(graph: RunningGraph,
+                    timeout_s: float = 10.0) -> Iterator[list[psutil.Process]]:
+    """
+    Yield the graph's processes; on the way out stop it and leave nothing behind.
+
+    The launcher gets its Ctrl-C (``stop_process``), a process it left running is killed, and
+    its output is closed.
+    """
+    children = descendants(graph.launcher.pid)
+    try:
+        yield children
+    finally:
+        stop_process(graph.launcher, timeout_s=timeout_s)
+        for child in children:
+            if child.is_running():
+                child.kill()
+        graph.launcher.stdout.close()
 
 
 def descendants(pid: int) -> list[psutil.Process]:

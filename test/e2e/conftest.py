@@ -4,9 +4,8 @@
 from collections.abc import Iterator
 import os
 
-from e2e_utils import descendants, RunningGraph, start_graph
+from e2e_utils import RunningGraph, start_graph, stopped_on_exit
 import pytest
-from ros_utils import stop_process
 
 
 @pytest.fixture(scope='module')
@@ -20,15 +19,8 @@ def running_graph(e2e_domain_id: int, tmp_path_factory, request) -> Iterator[Run
     """Yield one whole graph shared by the module's observation tests; stop it afterwards."""
     namespace = '/e2e_' + request.module.__name__.rsplit('.', 1)[-1]  # one per module
     graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'), namespace=namespace)
-    children = descendants(graph.launcher.pid)
-    try:
+    with stopped_on_exit(graph):
         yield graph
-    finally:
-        stop_process(graph.launcher, timeout_s=10.0)
-        for child in children:
-            if child.is_running():
-                child.kill()
-        graph.launcher.stdout.close()
 
 
 @pytest.fixture

@@ -14,7 +14,7 @@ from pathlib import Path
 import time
 
 from ament_index_python.packages import get_package_prefix
-from e2e_utils import descendants, start_graph
+from e2e_utils import start_graph, stopped_on_exit
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -22,7 +22,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
-from ros_utils import spin_until, stop_process
+from ros_utils import spin_until
 from sensor_msgs.msg import Imu
 from tf2_msgs.msg import TFMessage
 from wirefish_common.qos import RELIABLE, reliable, SENSOR_DATA, TF_STATIC_LISTENER
@@ -108,7 +108,12 @@ def heard(tmp_path_factory):
     """Run `wirefish up --sim` and listen to its TF for a few seconds; yield the record."""
     domain = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21')) + 19
     graph = start_graph(domain, tmp_path_factory.mktemp('tf_run'), namespace=NAMESPACE)
-    children = descendants(graph.launcher.pid)
+    with stopped_on_exit(graph):
+        yield from _listened(domain)
+
+
+def _listened(domain: int):
+    """Listen to the graph's TF on ``domain`` until the transforms span enough; yield it."""
     context = Context()
     rclpy.init(context=context, domain_id=domain)
     node = rclpy.create_node('tf_listener', context=context)
@@ -128,11 +133,6 @@ def heard(tmp_path_factory):
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
-        stop_process(graph.launcher, timeout_s=10.0)
-        for child in children:
-            if child.is_running():
-                child.kill()
-        graph.launcher.stdout.close()
 
 
 def test_the_published_tf_message_is_jazzys_type(heard):

@@ -9,10 +9,9 @@ import shutil
 import socket
 import time
 
-from e2e_utils import descendants, RunningGraph, start_graph
+from e2e_utils import RunningGraph, start_graph, stopped_on_exit
 from foxglove_client import free_port
 import pytest
-from ros_utils import stop_process
 from wirefish_bringup.graph import default_params_file
 import yaml
 
@@ -65,16 +64,9 @@ def view_graph(tmp_path_factory, request) -> Iterator[ViewGraph]:
     namespace = '/e2e_' + request.module.__name__.rsplit('.', 1)[-1]
     graph = start_graph(domain, out, '--view', '--params-file', str(params),
                         *getattr(request.module, 'GRAPH_OPTIONS', ()), namespace=namespace)
-    children = descendants(graph.launcher.pid)
-    try:
+    with stopped_on_exit(graph):
         assert _wait_listening(ws_port, 30.0), 'the view does not listen'
         yield ViewGraph(graph, ws_port, http_port)
-    finally:
-        stop_process(graph.launcher, timeout_s=10.0)
-        for child in children:
-            if child.is_running():
-                child.kill()
-        graph.launcher.stdout.close()
 
 
 @pytest.fixture
