@@ -126,6 +126,7 @@ def machine_slots(request: pytest.FixtureRequest,
     asked = time.monotonic()
     with machine_share(run_directory, slots, weight):
         started = time.monotonic()
+        cpu_before = _cpu_seconds()
         try:
             yield
         finally:
@@ -133,7 +134,14 @@ def machine_slots(request: pytest.FixtureRequest,
             with open(run_directory / 'machine_share.jsonl', 'a') as log:
                 log.write(json.dumps({'module': request.node.nodeid, 'weight': weight,
                                       'waited_s': round(started - asked, 2),
-                                      'held_s': round(time.monotonic() - started, 2)}) + '\n')
+                                      'held_s': round(time.monotonic() - started, 2),
+                                      'cpu_s': round(_cpu_seconds() - cpu_before, 2)}) + '\n')
+
+
+def _cpu_seconds() -> float:
+    """Return this worker's CPU time with that of the children it has reaped (and theirs)."""
+    times = os.times()
+    return times.user + times.system + times.children_user + times.children_system
 
 
 @pytest.fixture
