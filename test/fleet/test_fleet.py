@@ -86,8 +86,9 @@ def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_en
     rest, _ = up.communicate(timeout=DURATION_S + 120)
     print(''.join(lines) + rest[-2000:])
     assert up.returncode == 0
-    # Off a terminal the timed run says how far it is, with the time left.
-    timed = [line for line in rest.splitlines() if line.startswith('recording, seconds: ')]
+    # Off a terminal the timed run says how far it is in simulated seconds, with the time left.
+    timed = [line for line in rest.splitlines()
+             if line.startswith('recording, simulated seconds: ')]
     assert any(' left' in line for line in timed), rest[-2000:]
     # Its last line says what the recording lost, whatever it was (three fish on two cores).
     assert re.match(r'recording: (0 lost on \d+ topics|LOST \d+ messages: )',

@@ -474,12 +474,10 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
     ``4``, ``max``). A process that parses its own options (the recorder) keeps the wall clock
     for its receive times; the messages it records carry simulated stamps.
     """
+    clock = simulated_clock_of(specs)
     simulator = entry('fish_sim')
     owners = [s for s in specs
               if (s.package, s.executable) == (simulator.package, simulator.executable)]
-    if not owners:
-        raise ValueError("simulated time is the virtual fish's clock: this graph has none")
-    clock = clock_topic(owners[0].namespace or '/')
     timed = []
     for spec in specs:
         if spec in owners:
@@ -492,6 +490,15 @@ def on_simulated_time(specs: list[NodeSpec], speed: str) -> list[NodeSpec]:
                            remaps={**spec.remaps, '/clock': clock})
         timed.append(spec)
     return timed
+
+
+def simulated_clock_of(specs: list[NodeSpec]) -> str:
+    """Return the clock topic of a virtual-fish graph: its (first) fish_sim's ``clock_topic``."""
+    simulator = entry('fish_sim')
+    for spec in specs:
+        if (spec.package, spec.executable) == (simulator.package, simulator.executable):
+            return clock_topic(spec.namespace or '/')
+    raise ValueError("simulated time is the virtual fish's clock: this graph has none")
 
 
 def simulated_time_parameters(executable: str) -> dict[str, str]:

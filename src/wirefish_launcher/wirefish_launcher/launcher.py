@@ -29,7 +29,7 @@ from wirefish_common.input_checks import params_file_problem, parse_speed, seria
 from wirefish_common.progress import duration_text, Progress
 from wirefish_launcher.errors import QemuBoardError
 from wirefish_launcher.radio_road import bridge_settings, DriveMode, Radio, with_radio
-from wirefish_launcher.status_view import LiveStatus, TerminalBlock
+from wirefish_launcher.status_view import LiveStatus, SimulatedClock, TerminalBlock
 from wirefish_launcher.stop_flag import stop_on_signals, StopFlag
 from wirefish_launcher.supervisor import Supervisor, wait_for_path
 
@@ -53,6 +53,9 @@ READY_PROGRESS_S = 15.0
 # answers at once when one is found). Discovery of a running node on one host took 0 to 2.3 s
 # on the loaded 2-core machine (6 tries): twice that leaves a margin.
 DUPLICATE_CHECK_S = 4.0
+# A timed run on simulated time ends after --duration of the virtual fish's clock; a clock that
+# has not moved for this long (wall s: the virtual fish gone, its restarts given up) ends it.
+CLOCK_STALL_S = 30.0
 
 
 class Fish(enum.StrEnum):
@@ -105,7 +108,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--frame-prefix', default='',
                         help='prefix of the frame ids (fish_1 -> fish_1/base_link)')
     parser.add_argument('--duration', type=duration_s, default=None,
-                        help='run this many seconds, record a bag and write a report')
+                        help='run this many seconds (of simulated time on the virtual fish), '
+                        'record a bag and write a report')
     parser.add_argument('--params-file', type=Path, default=None,
                         help='parameter YAML (default: the installed config/wirefish.yaml)')
     parser.add_argument('--out', type=Path, default=Path('out'),
@@ -385,6 +389,30 @@ def run(args: argparse.Namespace) -> int:
     return code
 
 
+class _RunTime:
+    """How long a run has run: the wall clock, or the virtual fish's clock when one is given."""
+
+    def __init__(self, clock: SimulatedClock | None) -> None:
+        self._clock = clock
+        self._started = time.monotonic()
+        self.unit = 'simulated seconds' if clock is not None else 'seconds'
+        if clock is not None:
+            clock.refresh()
+            self._base = clock.advanced
+
+    def elapsed(self) -> float:
+        """Return the seconds run since construction (of simulated time on a clock)."""
+        if self._clock is None:
+            return time.monotonic() - self._started
+        self._clock.refresh()
+        return self._clock.advanced - self._base
+
+    def stalled(self) -> bool:
+        """Return whether the virtual fish's clock has stood still for ``CLOCK_STALL_S``."""
+        return (self._clock is not None
+                and time.monotonic() - max(self._clock.moved_at, self._started) > CLOCK_STALL_S)
+
+
 def _run(args: argparse.Namespace) -> int:
     stamp = datetime.now().strftime('%Y%m%d_%H%M%S')
     run_dir = (args.out / f'run_{stamp}').resolve()
@@ -425,9 +453,11 @@ def _run(args: argparse.Namespace) -> int:
                 specs = with_radio(specs, Radio(args.radio), stats=run_dir / 'radio.json',
                                    control=run_dir / 'radio-control',
                                    tap=run_dir / 'radio-fish.tap')
+        clock_topic = None
         if on_simulated_time_road(args):
-            from wirefish_bringup.graph import on_simulated_time
+            from wirefish_bringup.graph import on_simulated_time, simulated_clock_of
             specs = on_simulated_time(specs, args.speed or DEFAULT_SPEED)
+            clock_topic = simulated_clock_of(specs)
         elif args.speed is not None:
             raise ValueError("--speed sets the virtual fish's simulated time: a real fish "
                              '(--port), the emulated board (--fish qemu), two hosts (--role) '
@@ -459,6 +489,7 @@ def _run(args: argparse.Namespace) -> int:
     stop = stop_on_signals()
     code = 0
     codes: dict[str, int | None] = {}
+    run_clock = None  # --duration on simulated time counts the virtual fish's seconds
     try:
         with _graph_probe(namespace) as (node, executor):
             if not args.allow_duplicate:
@@ -476,6 +507,8 @@ def _run(args: argparse.Namespace) -> int:
                     return 1
                 if stop.requested:
                     return 0
+            if clock_topic is not None and args.duration is not None:
+                run_clock = SimulatedClock(node, clock_topic)
             write_profile(env, own_profile)
             _write_params(params_file, merged_params)  # nothing written before this point
             for spec in specs:
@@ -506,7 +539,8 @@ def _run(args: argparse.Namespace) -> int:
         if stop.requested:
             pass  # Ctrl-C during start-up: straight to stopping
         elif bag_path is not None:
-            print(f'recording to {bag_path}; stopping after {args.duration:g} s')
+            print(f'recording to {bag_path}; stopping after {args.duration:g} s'
+                  + (' of simulated time' if run_clock is not None else ''))
         else:
             print('running: Ctrl-C stops everything', flush=True)
         if not stop.requested and not args.start_swimming and args.role != Role.SHORE:
@@ -514,9 +548,11 @@ def _run(args: argparse.Namespace) -> int:
                   '`wirefish retune --apply` or the dashboard set it swimming '
                   '(--start-swimming: at once)', flush=True)
         started = drawn = time.monotonic()
+        run_time = _RunTime(run_clock)
         # A timed run off a terminal says how far it is (a line per 5 %, with the time left);
         # on a terminal the live status's first line says it.
-        timed = (Progress('recording, seconds', math.ceil(args.duration), stream=sys.stdout)
+        timed = (Progress('recording, ' + run_time.unit, math.ceil(args.duration),
+                          stream=sys.stdout)
                  if args.duration is not None and block is None and not stop.requested
                  else None)
         while not stop.requested:
@@ -524,9 +560,13 @@ def _run(args: argparse.Namespace) -> int:
             if reports and block is not None:
                 block.forget()  # the reports stay; the status goes on below them
             _report(reports)
-            elapsed = time.monotonic() - started
+            elapsed = run_time.elapsed()
             if args.duration is not None and elapsed >= args.duration:
                 break
+            if run_time.stalled():
+                raise RuntimeError(f"the virtual fish's clock has not moved for "
+                                   f'{CLOCK_STALL_S:g} s: the run stops ({elapsed:.1f} of '
+                                   f'{args.duration:g} simulated s); see logs/fish_sim.log')
             if timed is not None and int(elapsed) > timed.done:
                 timed.step(int(elapsed))
             if live is not None and block is not None and (

@@ -128,6 +128,11 @@ class SimulatedClock:
 
         self._node, self.wall = node, wall
         self._samples: deque[tuple[float, float]] = deque()  # (wall s, simulated s)
+        # Simulated seconds the clock moved forward over every clock taken (a restarted
+        # fish_sim starts its clock again: the step back is not counted).
+        self.advanced = 0.0
+        self.moved_at = wall()  # wall s of the last forward move (or of subscribing)
+        self._last: float | None = None
         self._subscription = node.create_subscription(Clock, topic, _unused,
                                                       qos_profile_sensor_data)
 
@@ -139,7 +144,12 @@ class SimulatedClock:
             if got is None:
                 break
             stamp = got[0].clock
-            self._samples.append((now, stamp.sec + 1e-9 * stamp.nanosec))
+            simulated = stamp.sec + 1e-9 * stamp.nanosec
+            if self._last is not None and simulated > self._last:
+                self.advanced += simulated - self._last
+                self.moved_at = now
+            self._last = simulated
+            self._samples.append((now, simulated))
         while len(self._samples) > 2 and self._samples[0][0] < now - WINDOW_S:
             self._samples.popleft()
 

@@ -3,7 +3,11 @@
 `wirefish mission FILE`: drive the planner through timed cmd_vel legs, record, plot the path.
 
 FILE is a mission YAML (``wirefish_operator.mission_plan``) or the name of a shipped one
-(``square``). The legs go to ``<namespace>/cmd_vel`` at 20 Hz once the planner answers; the
+(``square``). The mission keeps the virtual fish's time: the stamps of its ground truth, which
+are simulated time on `wirefish up --sim` (lockstep at its ``--speed``: a mission on
+``--speed max`` takes as little wall time as the graph needs) and the wall clock's on the
+real-time roads. The legs go to ``<namespace>/cmd_vel`` at 20 Hz of that time once the
+planner answers; the
 whole namespace is recorded into a rosbag2 (MCAP) bag (``wirefish_bag.recorder``, as
 `wirefish record`); afterwards the report PNG (x-y path from sim/ground_truth with heading
 arrows, speed and yaw rate against the setpoints) and the closure error are written and printed.
@@ -19,6 +23,7 @@ import math
 from pathlib import Path
 import shutil
 import sys
+import time
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -103,12 +108,13 @@ def run(args: argparse.Namespace) -> int:
 @dataclass
 class _Run:
     """
-    Where a mission run is (node clock s): resting since, the first leg's start, a problem.
+    Where a mission run is (the fish's time, s): resting since, the first leg's start, a problem.
 
     ``turn_gain`` is the planner's own parameter, for judging the gain the run identifies
     (``turn_gain_answer``: the planner's answer to the question); ``planner_heard``: a
     planner_state came; ``hinted``: what is waited for was said; ``progress``: the legs'
-    progress, from the first leg's start.
+    progress, from the first leg's start; ``fish_now``: the last ground truth's stamp;
+    ``sent_at``: when (the fish's time) the last command went.
     """
 
     rest_from: float | None = None
@@ -120,12 +126,14 @@ class _Run:
     planner_heard: bool = False
     hinted: bool = False
     progress: Progress | None = None
+    fish_now: float | None = None
+    sent_at: float = -math.inf
 
 
 def _drive(mission, namespace: str, bag_path: Path,
            wait_s: float) -> tuple[float | None, str | None, bool, float | None]:
     """
-    Send the legs, record; return (first leg's start, node clock s; problem; Ctrl-C; turn_gain).
+    Send the legs, record; return (first leg's start, fish's s; problem; Ctrl-C; turn_gain).
 
     The start is None when no leg was sent (no graph within ``wait_s``, or interrupted first).
     Before leg 1 the fish is brought to rest (cmd_vel 0 for at least the mission's rest_s,
@@ -164,18 +172,25 @@ def _drive(mission, namespace: str, bag_path: Path,
         run.planner_heard = True
 
     node.create_subscription(PlannerState, 'planner_state', on_state, reliable)
-    speeds: deque[tuple[float, float]] = deque()  # (node clock s, |surge speed| m/s), last 1 s
+    speeds: deque[tuple[float, float]] = deque()  # (fish's s, |surge speed| m/s), last 1 s
 
     def on_truth(message: Odometry) -> None:
-        speeds.append((now(), abs(message.twist.twist.linear.x)))
+        t = _stamp(message)
+        if run.fish_now is not None and t < run.fish_now - 1.0 and run.problem is None:
+            run.problem = ("the virtual fish's clock went back (fish_sim restarted?): the "
+                           f'mission stops; the bag so far is in {bag_path}')
+            rclpy.try_shutdown()
+            return
+        run.fish_now = t
+        speeds.append((t, abs(message.twist.twist.linear.x)))
+        if run.rest_from is not None and t - run.sent_at >= 1.0 / CMD_RATE_HZ:
+            run.sent_at = t
+            drive(t)
 
     node.create_subscription(Odometry, 'sim/ground_truth', on_truth, reliable)
     parameters = node.create_client(GetParameters, 'planner_node/get_parameters')
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
-    started = node.get_clock().now().nanoseconds * 1e-9
-
-    def now() -> float:
-        return node.get_clock().now().nanoseconds * 1e-9
+    started = time.monotonic()
 
     def at_rest(t: float) -> bool:
         while speeds and speeds[0][0] < t - REST_HOLD_S:
@@ -200,29 +215,34 @@ def _drive(mission, namespace: str, bag_path: Path,
         run.progress = Progress(f'mission {mission.name}',
                                 math.ceil(mission.duration_s + mission.coast_s))
 
-    def tick() -> None:
-        t = now()
-        if run.rest_from is not None and run.t0 is None:
-            rest(t)
+    def wait_for_graph() -> None:
+        """Wall-clock timer: until the graph answers; from then the fish's time drives."""
+        if run.rest_from is not None or run.problem is not None:
             return
+        waited = time.monotonic() - started
+        if (run.planner_heard and run.fish_now is not None
+                and recorder.count(truth_topic) > 0):
+            run.rest_from = run.fish_now
+            print(f'mission {mission.name}: {len(mission.legs)} legs, '
+                  f'{mission.duration_s:.1f} s, recording to {bag_path}; the fish comes to '
+                  'rest first', flush=True)
+            if parameters.service_is_ready():
+                request = GetParameters.Request(names=['turn_gain'])
+                run.turn_gain_answer = parameters.call_async(request)
+        elif waited > wait_s:
+            run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
+                           f'within {wait_s:g} s: are the graph and the planner running? '
+                           f'(wirefish up --namespace {namespace}); nothing was written')
+            rclpy.try_shutdown()
+        elif waited > HINT_AFTER_S and not run.hinted:
+            run.hinted = True
+            print(f'wirefish mission: waiting for planner_state and sim/ground_truth '
+                  f'under {namespace} (is the graph running?)', file=sys.stderr, flush=True)
+
+    def drive(t: float) -> None:
+        """Rest the fish, then send the leg of the fish's time ``t``; stop after the coast."""
         if run.t0 is None:
-            if run.planner_heard and recorder.count(truth_topic) > 0:
-                run.rest_from = t
-                print(f'mission {mission.name}: {len(mission.legs)} legs, '
-                      f'{mission.duration_s:.1f} s, recording to {bag_path}; the fish comes to '
-                      'rest first', flush=True)
-                if parameters.service_is_ready():
-                    request = GetParameters.Request(names=['turn_gain'])
-                    run.turn_gain_answer = parameters.call_async(request)
-            elif t - started > wait_s:
-                run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
-                               f'within {wait_s:g} s: are the graph and the planner running? '
-                               f'(wirefish up --namespace {namespace}); nothing was written')
-                rclpy.try_shutdown()
-            elif t - started > HINT_AFTER_S and not run.hinted:
-                run.hinted = True
-                print(f'wirefish mission: waiting for planner_state and sim/ground_truth '
-                      f'under {namespace} (is the graph running?)', file=sys.stderr, flush=True)
+            rest(t)
             return
         command = mission.command_at(t - run.t0)
         elapsed = int(t - run.t0)
@@ -236,7 +256,7 @@ def _drive(mission, namespace: str, bag_path: Path,
             run.done = True
             rclpy.try_shutdown()
 
-    node.create_timer(1.0 / CMD_RATE_HZ, tick)
+    node.create_timer(1.0 / CMD_RATE_HZ, wait_for_graph)
     try:
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
