@@ -267,23 +267,16 @@ def planner_domain_id() -> int:
 
 
 @pytest.fixture(scope='module')
-def planner_graph(planner_domain_id: int) -> Iterator[PlannerGraph]:
-    """Yield the module's graph (virtual fish with a current); stop it afterwards."""
-    graph = start_planner_graph(planner_domain_id, fish_flags=(
-        '--yaw-disturbance', str(YAW_DISTURBANCE_RAD_S)))
-    try:
-        yield graph
-    finally:
-        codes = stop_planner_graph(graph)
-        assert not graph.link.exists(), 'fish_sim left its pty link behind'
-        print('exit codes:', codes)
+def simulated_planner_graph(planner_domain_id: int, tmp_path_factory,
+                            request: pytest.FixtureRequest) -> Iterator[PlannerGraph]:
+    """
+    Yield the module's graph on fish_sim's clock; stop it afterwards.
 
-
-@pytest.fixture(scope='module')
-def simulated_planner_graph(planner_domain_id: int, tmp_path_factory) -> Iterator[PlannerGraph]:
-    """Yield the module's graph on fish_sim's clock at --speed 1; stop it afterwards."""
+    At the module's ``GRAPH_SPEED`` (fish_sim --speed; default ``1``).
+    """
     graph = start_planner_graph(planner_domain_id, fish_flags=(
-        '--yaw-disturbance', str(YAW_DISTURBANCE_RAD_S)), speed='1',
+        '--yaw-disturbance', str(YAW_DISTURBANCE_RAD_S)),
+        speed=getattr(request.module, 'GRAPH_SPEED', '1'),
         directory=tmp_path_factory.mktemp('simulated_planner'))
     try:
         yield graph

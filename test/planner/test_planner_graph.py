@@ -30,6 +30,7 @@ HOLD_WINDOW_S = 30.0
 OFF_WINDOW_S = 10.0  # open loop drifts ~0.5 rad in it against the 0.05 rad/s current
 STOP_WITHIN_S = 5.0
 MAX_CPG_ACCELERATION = 300.0  # rad/s^2 (see the servo check)
+GRAPH_SPEED = 'max'  # fish_sim --speed: the drive's claims are in simulated time
 
 
 def _window(rows: list, start: float, end: float) -> np.ndarray:
