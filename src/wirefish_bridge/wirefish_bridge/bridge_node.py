@@ -61,7 +61,6 @@ from wirefish_bridge.bridge_node_parameters import (check_combination, DriveMode
                                                     PARAMETERS, SPECS)
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
-from wirefish_bridge.decimator import Decimator
 from wirefish_bridge.gait_link import ConfigLink, GaitLink, GaitParameters, OscillatorWatch
 from wirefish_bridge.graph_clock import GraphTime
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
@@ -75,6 +74,7 @@ from wirefish_bridge.ros_messages import (attitude_message, battery_message,
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
                                        SerialLink)
 from wirefish_common.cdr_views import CdrError, read_joint_state
+from wirefish_common.decimator import Decimator
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import declare, validate_update

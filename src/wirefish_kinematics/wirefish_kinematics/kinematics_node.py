@@ -12,9 +12,12 @@ Subscribes
     ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local): the desired wave;
     the latest of it and the ``wave_*`` parameters wins.
 Publishes (frame ``tail_base`` = C0 of paper section 3.1)
-    ``body_wave`` (wirefish_msgs/BodyWave, sensor data) at ``publish_rate_hz`` when a new
-    sample arrived: ``station_count`` stations, eqs 2-15; ``y_desired`` (eq 23) once the tail
-    beats, shown at the tail's phase (see ``desired_wave.wave_time_at_phase``).
+    ``body_wave`` (wirefish_msgs/BodyWave, sensor data) at ``publish_rate_hz`` of the
+    samples' own stamps: the samples are decimated by their stamps (``decimator``), each one
+    due published from its own angles and stamp, so a late tick publishes the ones it missed
+    and the rate holds in the graph's time (simulated on the virtual fish);
+    ``station_count`` stations, eqs 2-15; ``y_desired`` (eq 23) once the tail beats, shown at
+    the tail's phase (see ``desired_wave.wave_time_at_phase``).
     ``body_wave_markers`` (visualization_msgs/MarkerArray, reliable depth 5, so RViz's default
     subscription matches) with every n-th body_wave, n = round(publish_rate_hz /
     markers_rate_hz) (10 Hz by default: they cost more than the body wave): tail polyline,
@@ -37,6 +40,7 @@ from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 from wirefish_common.batch_intake import BatchIntake, intake_qos
 from wirefish_common.cdr_views import CdrError, read_joint_state
+from wirefish_common.decimator import Decimator
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import validate_update
@@ -74,8 +78,10 @@ class KinematicsNode(Node):
         self._geometry = geometry_from(self._values)
         self._target = wave_from(self._values)
         self._tracker = TailBeatTracker(self._values['max_tail_beat_period_s'])
-        self._latest: tuple[int, int, tuple[float, float]] | None = None
+        # The last sample (sec, nanosec, angles, history time s): shown again on a new geometry.
+        self._latest: tuple[int, int, tuple[float, float], float] | None = None
         self._fresh = False
+        self._due = Decimator(self._values['publish_rate_hz'])
         self._markers_every = 1
         self._ticks_to_markers = 0  # body_wave ticks before the next markers (0: this one)
         self._set_markers_rate()
@@ -112,6 +118,7 @@ class KinematicsNode(Node):
             self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'],
                                             self._on_tick)
             self._subscribe_servo()  # its queue holds the samples of a tick
+            self._due.rate_hz = self._values['publish_rate_hz']
         if names & {'publish_rate_hz', 'markers_rate_hz'}:
             self._set_markers_rate()
         if 'max_tail_beat_period_s' in names:
@@ -144,7 +151,8 @@ class KinematicsNode(Node):
         super().destroy_node()
 
     # --- inputs ---------------------------------------------------------------------------
-    def _on_servo(self, data: bytes) -> None:
+    def _on_servo(self, data: bytes) -> tuple[int, int, tuple[float, float], float] | None:
+        """Take one servo sample's bytes into the history; return it, or None if refused."""
         try:
             view = read_joint_state(data)
             sample = servo_sample(view)
@@ -156,13 +164,15 @@ class KinematicsNode(Node):
             if now - self._warned.get(sample.kind, -math.inf) >= WARN_PERIOD_S:
                 self._warned[sample.kind] = now
                 self.get_logger().warn(f'{sample.message}; sample dropped')
-            return
+            return None
         sec, nanosec = view.sec, view.nanosec
         if sec == 0 and nanosec == 0:
             sec, nanosec = self.get_clock().now().seconds_nanoseconds()
         angles, rates = sample
-        if self._tracker.history.add(sec, nanosec, angles, rates):
-            self._latest, self._fresh = (sec, nanosec, angles), True
+        if not self._tracker.history.add(sec, nanosec, angles, rates):
+            return None
+        self._latest = (sec, nanosec, angles, self._tracker.history.last_time())
+        return self._latest
 
     def _on_target(self, msg: BodyWaveSpec) -> None:
         try:
@@ -172,21 +182,31 @@ class KinematicsNode(Node):
 
     # --- outputs --------------------------------------------------------------------------
     def _on_tick(self) -> None:
+        due = []
         if self._servo_sub is not None:
             for data in self._servo_sub.take():
-                self._on_servo(data)
-        if not self._fresh or self._latest is None:
-            return
+                sample = self._on_servo(data)
+                if sample is not None and self._due.due(sample[0] + 1e-9 * sample[1]):
+                    due.append(sample)
+        if not due and self._fresh and self._latest is not None:
+            due.append(self._latest)  # the last sample again, on the new geometry
         self._fresh = False
-        sec, nanosec, angles = self._latest
-        stamp = to_stamp(sec, nanosec)
-        shape = tail_shape(angles, self._geometry, self._values['station_count'])
+        if not due:
+            return
         report = self._tracker.update(self._geometry)
         if report is not None:
             self._speed_pub.publish(speed_estimate_message(
                 report.estimate, to_stamp(*self._tracker.history.stamp_of(report.time_s)),
                 self._frame))
-        y_desired = self._desired_wave(self._tracker.history.last_time(), shape.stations)
+        for sample in due:
+            self._publish_body_wave(*sample)
+
+    def _publish_body_wave(self, sec: int, nanosec: int, angles: tuple[float, float],
+                           t: float) -> None:
+        """Publish the body wave of one servo sample (and every n-th time, its markers)."""
+        stamp = to_stamp(sec, nanosec)
+        shape = tail_shape(angles, self._geometry, self._values['station_count'])
+        y_desired = self._desired_wave(t, shape.stations)
         self._body_pub.publish(body_wave_message(shape, y_desired, stamp, self._frame))
         if self._ticks_to_markers == 0:
             self._marker_pub.publish(body_wave_markers(shape, y_desired, stamp, self._frame))

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The battery's decimation: one sample per period, and every change of state at once."""
+"""Decimation by time: one sample per period, every change of state at once, restarts."""
 
 import pytest
-from wirefish_bridge.decimator import Decimator
+from wirefish_common.decimator import Decimator
 
 
 def _published(decimator: Decimator, times: list[float], states: list[object]) -> list[float]:
@@ -35,3 +35,17 @@ def test_a_change_of_state_goes_out_at_once_and_a_steady_one_at_the_rate():
 def test_a_rate_that_is_not_positive_is_refused(rate):
     with pytest.raises(ValueError):
         Decimator(rate)
+
+
+def test_a_clock_that_goes_back_starts_the_schedule_again():
+    times = [100.0 + 0.01 * n for n in range(50)] + [0.01 * n for n in range(50)]
+    published = _published(Decimator(50.0), times, [False] * 100)
+    assert len(published) == 50
+    assert published[25] == pytest.approx(0.0)  # the restarted clock's first sample
+
+
+def test_late_samples_taken_in_one_batch_keep_every_due_one():
+    # A consumer that takes its queue late gets the samples in a batch: their own stamps
+    # decide, so 100 Hz samples give exactly 50 a second however they were taken.
+    times = [0.01 * n for n in range(500)]
+    assert len(_published(Decimator(50.0), times, [False] * 500)) == 250
