@@ -124,10 +124,11 @@ def test_the_badge_tells_coasting_from_resting_as_the_bridge_reports_them(
     while time.monotonic() < deadline and not (
             'coasting,resting,gait' in ','.join(log())
             and {'gait', 'coasting', 'resting'} <= set(seen)):
-        badge = dashboard.driver.find_element(By.ID, 'v-link-badge')
-        seen.setdefault(badge.get_attribute('data-state'), (
-            badge.text, badge.get_attribute('class'), badge.value_of_css_property(
-                'background-color')))
+        # One read of the page: the badge may change between two separate reads.
+        state, words, classes, colour = dashboard.live(
+            '(b => [b.dataset.state, b.innerText, b.className, getComputedStyle(b)'
+            '.backgroundColor])(document.getElementById("v-link-badge"))')
+        seen.setdefault(state, (words, classes, colour))
         executor.spin_once(timeout_sec=0.02)
     states = log()
     # Within a quiet spell the fish coasts, then rests; a host frame brings the gait back.
