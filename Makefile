@@ -32,10 +32,10 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
 # owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
 # files are dealt in collection order, which puts the longest first (test/module_order.py).
-# Most of test/ waits on real-time graphs (a fish swims in real time), so it runs on more workers
-# than cores. A module that loads the machine itself (the loaded recording, QEMU, the dashboard)
-# would starve the real-time streams of the modules beside it, so it holds two of the machine's
-# three slots and such modules run one at a time (test/machine_share.py).
+# Most of test/ waits on graphs (real-time ones, or simulated ones paced at real time), so it
+# runs on more workers than cores. A module that loads the machine itself (the loaded recording,
+# QEMU, the dashboard) would starve the real-time streams of the modules beside it, so it holds
+# all the machine's slots but one and such modules run one at a time (test/machine_share.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
 	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder test \
@@ -51,10 +51,10 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 	test/test_host_closure.py test/test_package_size.py test/test_entry_points.py \
 	test/test_spdx.py
 
-# pytest-xdist workers: one per core of the 2-core reference machine for the pure tests, one
-# more for the graphs of test/ (they mostly wait on the clock; see machine_share.py).
+# pytest-xdist workers: one per core of the 2-core reference machine for the pure tests, two
+# more for the graphs of test/ (they mostly wait on the clock or a peer; see machine_share.py).
 FAST_JOBS ?= 2
-GRAPH_JOBS ?= 3
+GRAPH_JOBS ?= 4
 
 test-fast: setup  ## cores and lint, no node processes (under a minute)
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) -m "not ros" $(FAST_TESTS) $(PYTEST_ARGS)

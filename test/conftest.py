@@ -16,7 +16,7 @@ import subprocess
 import sys
 import time
 
-from machine_share import machine_share, slot_count
+from machine_share import heavy_weight, machine_share, slot_count
 from module_order import module_rank
 import pytest
 from ros_utils import stop_process
@@ -112,14 +112,14 @@ def spawn(ros_env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen]]:
 def machine_slots(request: pytest.FixtureRequest,
                   tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """
-    Run each module on its share of the machine (machine_share.py): two slots if it loads it.
+    Run each module on its share of the machine (machine_share.py): all slots but one if heavy.
 
     The slots are shared by the run's workers (lock files in the run's base temp); mark a
     module that loads the machine itself ``pytest.mark.loads_machine``.
     """
     workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
     slots = slot_count(workers)
-    weight = 2 if request.node.get_closest_marker('loads_machine') else 1
+    weight = heavy_weight(slots) if request.node.get_closest_marker('loads_machine') else 1
     run_directory = tmp_path_factory.getbasetemp()  # a worker's is popen-gwK in the run's
     if _WORKER:
         run_directory = run_directory.parent

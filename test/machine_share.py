@@ -2,14 +2,15 @@
 """
 How test/'s modules share the machine: weighed slots taken through a turnstile.
 
-Most of test/ waits on real-time graphs, so `make test` runs more workers than the machine has
-cores; but a few modules load the machine themselves (busy loops beside a recording, an
-emulated STM32, a browser), and beside two other modules their real-time streams starved (seen
-with three workers: a failsafe of the QEMU board, a recording 1.8 s behind, a dashboard that
-never plotted). So the machine has as many slots as workers (at least two): a module holds one
-slot while it runs, a module that loads the machine holds two, and those modules run one at a
-time. Slots are lock files shared by the run's workers; a module takes its slots through a
-turnstile lock, so a module that needs two is not overtaken by ones that need one.
+Most of test/ waits on graphs (real-time ones, or simulated ones paced at real time), so `make
+test` runs more workers than the machine has cores; but a few modules load the machine
+themselves (busy loops beside a recording, an emulated STM32, a browser), and beside two other
+modules their real-time streams starved (seen with three workers: a failsafe of the QEMU board,
+a recording 1.8 s behind, a dashboard that never plotted). So the machine has as many slots as
+workers (at least two): a module holds one slot while it runs, a module that loads the machine
+holds all but one (``heavy_weight``: one light module runs beside it), and those modules run one
+at a time. Slots are lock files shared by the run's workers; a module takes its slots through a
+turnstile lock, so a module that needs several is not overtaken by ones that need one.
 """
 
 from __future__ import annotations
@@ -27,6 +28,11 @@ POLL_S = 0.2
 def slot_count(workers: int) -> int:
     """Return the machine's slots for a run of ``workers`` workers (at least two)."""
     return max(2, workers)
+
+
+def heavy_weight(slots: int) -> int:
+    """Return the slots a module that loads the machine holds: all but one."""
+    return slots - 1
 
 
 @contextmanager
@@ -54,9 +60,9 @@ def _try_slot(path: Path, stack: ExitStack) -> bool:
 
 @contextmanager
 def machine_share(directory: Path, slots: int, weight: int) -> Iterator[None]:
-    """Hold ``weight`` (1 or 2) of the ``slots`` slots kept in ``directory`` while inside."""
-    if not 1 <= weight <= min(2, slots):
-        raise ValueError(f'a module holds 1 or 2 of {slots} slots, not {weight}')
+    """Hold ``weight`` of the ``slots`` slots kept in ``directory`` while inside."""
+    if not 1 <= weight <= slots:
+        raise ValueError(f'a module holds 1 to {slots} of {slots} slots, not {weight}')
     with ExitStack() as stack:
         if weight > 1:  # the modules that load the machine take turns
             stack.enter_context(_locked(directory / 'loads_machine.lock'))

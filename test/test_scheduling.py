@@ -7,7 +7,7 @@ import subprocess
 import threading
 import time
 
-from machine_share import machine_share, slot_count
+from machine_share import heavy_weight, machine_share, slot_count
 from module_order import LONGEST_MODULES, module_rank
 import pytest
 
@@ -74,11 +74,11 @@ def _turnstile_held(directory: Path) -> bool:
         return False
 
 
-@pytest.mark.parametrize('workers', [1, 2, 3])
+@pytest.mark.parametrize('workers', [1, 2, 3, 4])
 def test_modules_never_hold_more_slots_than_the_machine_has(tmp_path, workers):
     events: list = []
-    weights = [2, 1, 1, 2, 1, 1, 1]
     slots = slot_count(workers)
+    weights = [heavy_weight(slots), 1, 1, heavy_weight(slots), 1, 1, 1]
     threads = [_hold(tmp_path, slots, w, events, f'm{i}', 0.05)
                for i, w in enumerate(weights)]
     for thread in threads:
@@ -106,7 +106,13 @@ def test_a_module_that_loads_the_machine_waits_for_two_free_slots(tmp_path):
     assert starts['late'] >= starts['heavy']
 
 
-def test_a_weight_outside_one_or_two_is_refused(tmp_path):
-    with pytest.raises(ValueError, match='1 or 2'):
-        with machine_share(tmp_path, 3, 3):
+@pytest.mark.parametrize('weight', [0, 4])
+def test_a_weight_outside_one_to_the_slots_is_refused(tmp_path, weight):
+    with pytest.raises(ValueError, match='1 to 3 of 3'):
+        with machine_share(tmp_path, 3, weight):
             pass
+
+
+@pytest.mark.parametrize('slots', [2, 3, 4])
+def test_a_module_that_loads_the_machine_leaves_one_slot_to_the_rest(slots):
+    assert heavy_weight(slots) == slots - 1
