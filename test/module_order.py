@@ -3,13 +3,14 @@
 The order `make test` deals test/'s modules to its workers in: the longest first.
 
 The modules below hold the machine longest (a minute or more each: the ``held_s`` of
-``machine_share.jsonl`` in a full run's base temp). `make test` runs test/ as `-n 4 --dist
+``machine_share.jsonl`` in a full run's base temp). `make test` runs test/ as `-n 3 --dist
 loadfile --no-loadscope-reorder`, so xdist deals the files in collection order, and conftest.py
 collects these first. By default xdist deals the files with most tests first, so these one-test
 files came last (the drive, the mission, the two hosts and the fleet once ran after everything
 else and test/ took 9.6 min); dealt first, they run side by side while the short files fill the
 gaps. The modules that load the machine (``loads_machine``) run one at a time, so they are
-spread among the others: a worker that waits for its turn runs nothing.
+spread among the others, none among the first three (one per worker): a worker that waits for
+its turn runs nothing, and a heavy module waiting for its slots holds the light ones back.
 """
 
 from pathlib import Path
@@ -17,24 +18,24 @@ from pathlib import Path
 WORKSPACE = Path(__file__).resolve().parents[1]
 LONGEST_MODULES = (
     'test/radio/test_rf433_virtual_fish.py',
-    'test/radio/test_rf433_qemu.py',
     'test/bringup/test_recorder_sigkill.py',
     'test/e2e/test_restart.py',
-    'test/firmware_qemu/test_link_in_the_loop.py',
+    'test/radio/test_rf433_qemu.py',
     'test/bridge/test_bridge_pty.py',
     'test/fleet/test_fleet.py',
     'test/twohost/test_two_hosts.py',
-    'test/bringup/test_loaded_recording.py',
+    'test/firmware_qemu/test_link_in_the_loop.py',
     'test/e2e/test_whole_graph.py',
     'test/view/test_foxglove_clients.py',
+    'test/bringup/test_loaded_recording.py',
     'test/test_repeated_signals.py',
-    'test/firmware_qemu/test_graph_on_qemu.py',
     'test/planner/test_planner_graph.py',
     'test/cpg/test_retune_action.py',
+    'test/firmware_qemu/test_graph_on_qemu.py',
     'test/bringup/test_topic_param_commands.py',
-    'test/view/test_dashboard_browser.py',
     'test/planner/test_planner_mission.py',
     'test/view/test_view_protocol.py',
+    'test/view/test_dashboard_browser.py',
 )
 
 
