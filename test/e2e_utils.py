@@ -132,8 +132,8 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     """
     Return {topic: (type, messages per simulated second)} over ``window_s`` of /clock.
 
-    A message with a header counts by its stamp (the graph's simulated time when it was
-    published), so a probe that falls behind on a loaded machine still counts every message of
+    A message with a header (or a sequence of them first: /tf, a MarkerArray) counts by its
+    (first item's) stamp, the graph's simulated time when it was published, so a probe that falls behind on a loaded machine still counts every message of
     the window: it listens until /clock is ``LATE_S`` past the window's end. A message without
     one counts at the simulated time current when the probe took it. Raises AssertionError
     naming what it waited for if /clock does not cover the window within ``wall_timeout_s`` of
@@ -147,12 +147,15 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     window: list[float] = []
     subscriptions = []
 
-    def count(data: bytes, topic: str, stamped: bool) -> None:
+    def count(data: bytes, topic: str, stamped: str) -> None:
         if not window:
             return
         if stamped:
             try:
-                sec, nanosec = CdrReader(data, topics[topic]).stamp()
+                reader = CdrReader(data, topics[topic])
+                if stamped == 'first_item' and reader.count('items') == 0:
+                    return
+                sec, nanosec = reader.stamp()
             except CdrError:
                 return
             at: float | None = sec + 1e-9 * nanosec
@@ -166,11 +169,10 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
             msg_class = message_class(type_name)
         except (ImportError, AttributeError, ValueError):
             continue
-        first_field = next(iter(msg_class.get_fields_and_field_types().items()), None)
-        stamped = first_field == ('header', 'std_msgs/Header')
+        stamped = _stamp_place(msg_class)
         subscriptions.append(node.create_subscription(
             msg_class, topic, lambda data, topic=topic, stamped=stamped: count(
-                data, topic, stamped), matching_qos(node, topic, 100), raw=True))
+                data, topic, stamped), matching_qos(node, topic, 1000), raw=True))
     deadline = time.monotonic() + wall_timeout_s
     # Let the subscriptions match their publishers before the window opens.
     settle_until = time.monotonic() + 1.0
@@ -191,6 +193,21 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
 
 # How long past a window's end (simulated s) stamped messages of the window may still arrive.
 LATE_S = 1.0
+
+
+def _stamp_place(msg_class) -> str:
+    """Return where a message's stamp is: 'header', 'first_item' (of its first sequence), ''."""
+    from wirefish_common.topics import message_class
+
+    first = next(iter(msg_class.get_fields_and_field_types().values()), '')
+    if first == 'std_msgs/Header':
+        return 'header'
+    if first.startswith('sequence<') and '/' in first:
+        package, name = first[len('sequence<'):].split(',')[0].rstrip('>').split('/')
+        item = message_class(f'{package}/msg/{name}')
+        if next(iter(item.get_fields_and_field_types().values()), '') == 'std_msgs/Header':
+            return 'first_item'
+    return ''
 
 
 # Streams a node decimates on the wall clock, not its node clock: judged as at least their
