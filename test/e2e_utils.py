@@ -133,11 +133,13 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     Return {topic: (type, messages per simulated second)} over ``window_s`` of /clock.
 
     A message with a header (or a sequence of them first: /tf, a MarkerArray) counts by its
-    (first item's) stamp, the graph's simulated time when it was published, so a probe that falls behind on a loaded machine still counts every message of
-    the window: it listens until /clock is ``LATE_S`` past the window's end. A message without
-    one counts at the simulated time current when the probe took it. Raises AssertionError
-    naming what it waited for if /clock does not cover the window within ``wall_timeout_s`` of
-    wall time.
+    (first item's) stamp, the graph's simulated time when it was published, so a probe that
+    falls behind on a loaded machine still counts every message of the window: it listens
+    until /clock is ``LATE_S`` past the window's end, and each subscription keeps 1,000
+    messages (10 s of the fastest stream: a queue of 100 overflowed beside two CPU hogs). A
+    message without one counts at the simulated time current when the probe took it. Raises
+    AssertionError naming what it waited for if /clock does not cover the window within
+    ``wall_timeout_s`` of wall time.
     """
     from wirefish_common.cdr_views import CdrError, CdrReader
     from wirefish_common.topics import graph_topics, matching_qos, message_class
