@@ -93,6 +93,7 @@ class PlannerNode(Node):
         # No command since start-up: the tail is still (or swims the CPG's own start-up gait).
         self._commanded = False
         self._start_pending = False  # the CPG's start is due, its service not yet seen
+        self._cpg_started = False  # a start call was answered (by this cpg_node or one before)
         self._cpg_was_ready: bool | None = None  # the CPG's start service at the last tick
         self._start_call: tuple[float, Future] | None = None  # (when, its answer) in flight
         self._wire_cpg()
@@ -132,6 +133,7 @@ class PlannerNode(Node):
             self.destroy_client(self._start_client)
             self._sent = self._cpg_params = self._cpg_status = None
             self._start_call = None
+            self._cpg_started = False
             self._wire_cpg()
 
     def _wire_cpg(self) -> None:
@@ -151,9 +153,15 @@ class PlannerNode(Node):
 
     def _on_cpg_status(self, msg: CpgStatus) -> None:
         previous, self._cpg_status = self._cpg_status, msg
-        if (self._commanded and previous is not None
-                and (previous.source, previous.refused) == (msg.source, msg.refused)):
-            self._start_pending = True  # a new cpg_node (no change said): it starts still
+        # cpg_node says its status once at its start and then only when it changes: the same
+        # status again is a new cpg_node, and so is a first status heard after a start was
+        # answered (the one started may have died before its own status reached this node).
+        # A new one starts still; a start of one that runs answers 'already running'.
+        if self._commanded and (
+                (previous is None and self._cpg_started) or (
+                    previous is not None
+                    and (previous.source, previous.refused) == (msg.source, msg.refused))):
+            self._start_pending = True
             self._start_cpg()
         if self._manual():  # a retune applied is a command: the fish swims the fit
             self._first_command()
@@ -181,6 +189,7 @@ class PlannerNode(Node):
             if answer.done():
                 self._start_call = None
                 self._start_pending = False
+                self._cpg_started = True
             elif self._now_s() - sent_s >= START_RETRY_S:
                 self._start_client.remove_pending_request(answer)  # no answer: call again
                 self._start_call = None
