@@ -27,9 +27,10 @@ Starts
     the CPG (its ``start`` service, std_srvs/Trigger) once, at the first command since start-up:
     the first cmd_vel that asks to move, or the first manual override it hears (a retune
     applied); and again a CPG restarted after that (its start service gone, then back, or a
-    cpg_status that says what the last one said: cpg_node publishes it only when it changes,
-    and once at its start, while a CPG killed outright leaves its old service matched for
-    DDS's lease time). A start is called again every ``START_RETRY_S`` until the CPG answers.
+    cpg_status that says what the last one said, or a first cpg_status after a start was
+    answered: cpg_node publishes it only when it changes, and once at its start, while a CPG
+    killed outright leaves its old service matched for DDS's lease time). A start is called
+    again every ``START_RETRY_S`` until the CPG answers.
     Until then planner_state says ``still`` (the graph's cpg_node starts with ``autostart``
     false: the servos at neutral), or ``own_gait`` with ``rest_at_start`` false.
     Hears ``cpg_params`` (what the CPG runs: planner_state's cpg_* fields) and ``cpg_status``.
