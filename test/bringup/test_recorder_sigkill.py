@@ -113,7 +113,9 @@ def test_a_resumed_recorder_goes_on_in_the_same_bag(tmp_path, spawn, talker_name
                                                     listener, kill_seed, ros_env):
     bag, topic = tmp_path / 'bag', f'{talker_namespace}/body_wave'
     killed_at = _record_then_kill(spawn, listener, talker_namespace, bag, kill_seed)
-    result = subprocess.run(_record(talker_namespace, bag, '--resume', '--duration', '2'),
+    # 5 s: with 2 a resumed recorder on a loaded machine recorded no body_wave at all (a
+    # fresh-clone run): its discovery of the talker took the whole run.
+    result = subprocess.run(_record(talker_namespace, bag, '--resume', '--duration', '5'),
                             env=ros_env, capture_output=True, text=True, timeout=90)
     assert result.returncode == 0, result.stdout + result.stderr
     assert [p.name for p in storage_files(bag)] == ['bag_0.mcap', 'bag_1.mcap']
@@ -121,7 +123,7 @@ def test_a_resumed_recorder_goes_on_in_the_same_bag(tmp_path, spawn, talker_name
     first = counters(bag, topic)[:read_file_info(bag / 'bag_0.mcap').message_count]
     assert first[-1] >= max(c for c, t in listener.heard if t <= killed_at - KILL_MARGIN_S)
     resumed = counters(bag, topic)[len(first):]
-    assert len(resumed) >= 20 and np.all(np.diff(resumed) == 1)  # ~2 s at 20 Hz, unbroken
+    assert len(resumed) >= 20 and np.all(np.diff(resumed) == 1)  # >= 1 s at 20 Hz, unbroken
 
 
 def test_a_clean_stop_writes_a_finished_bag(tmp_path, spawn, talker_namespace, listener,
