@@ -19,6 +19,8 @@ import sys
 import time
 from typing import Any
 
+from wirefish_cli.ros_session import ros_session
+
 ACK_WAIT_S = 5.0  # how long the played messages may take to be acknowledged at the end
 
 
@@ -110,9 +112,7 @@ def _wait_for_acks(publishers: dict[str, Any]) -> list[str]:
 
 def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
     from mcap.reader import make_reader
-    import rclpy
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-    from rclpy.signals import SignalHandlerOptions
     from wirefish_bag.bag_storage import storage_files
     from wirefish_common.topics import message_class
     from wirefish_common.progress import Progress
@@ -139,9 +139,8 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
         return 2
     # Not sys.argv: rcl would read play's own --remap FROM:=TO as a deprecated ROS remap rule
     # (and warn); ROS arguments reach it after --ros-args only, and play takes none.
-    rclpy.init(args=sys.argv[:1], signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node('wirefish_play', start_parameter_services=False)
-    try:
+    with ros_session('wirefish_play', rcl_args=sys.argv[:1]) as session:
+        node = session.node
         publishers = {}
         for topic, type_name in wanted.items():
             reliable, latched = qos_of.get(topic, (True, False))
@@ -182,6 +181,3 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
             print(f'wirefish play: not every subscriber acknowledged {", ".join(unacked)} within '
                   f'{ACK_WAIT_S:.0f} s of the last message', file=sys.stderr)
         return 0
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()

@@ -8,8 +8,9 @@ from pathlib import Path
 import sys
 
 from wirefish_bag.sequence_gaps import loss_line, recording_account, TopicAccount
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
-from wirefish_cli.api import duration_s
+from wirefish_bringup.graph import DEFAULT_NAMESPACE
+from wirefish_cli.api import duration_s, UsageError
+from wirefish_cli.ros_session import graph_namespace, ros_session
 from wirefish_common.progress import end_line, Progress
 
 NOTHING_TIMEOUT_S = 30.0
@@ -34,19 +35,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish record`; return the process exit code."""
-    import time
-
-    import rclpy
-    from rclpy.signals import SignalHandlerOptions
-
     from wirefish_bag.recorder import BagRecorder
     from wirefish_common.shutdown import SignalShutdown
 
-    try:
-        namespace = validate_namespace(args.namespace)
-    except ValueError as error:
-        print(f'wirefish record: {error}', file=sys.stderr)
-        return 2
+    namespace = graph_namespace(args.namespace)
     bag_path = args.output or Path('out', 'bags',
                                    datetime.now().strftime('wirefish_%Y%m%d_%H%M%S'))
     if bag_path.exists() and not args.resume:
@@ -57,16 +49,29 @@ def run(args: argparse.Namespace) -> int:
     # Ctrl-C and SIGTERM set a flag the recording loop reads between two takes: the readers
     # are drained and the bag is closed cleanly.
     signals = SignalShutdown()
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     # On a terminal its 'recording <topic>' lines would break the bar: the summary lists them.
     progress_on_terminal = sys.stderr.isatty()
-    try:
-        recorder = BagRecorder(bag_path, namespace, resume=args.resume,
+
+    def make_recorder(namespace: str) -> BagRecorder:
+        try:
+            return BagRecorder(bag_path, namespace, resume=args.resume,
                                announce=not progress_on_terminal)
-    except (OSError, ValueError) as error:  # not a bag, or one that cannot be recovered
-        rclpy.try_shutdown()
-        print(f'wirefish record: {error}', file=sys.stderr)
-        return 2
+        except (OSError, ValueError) as error:  # not a bag, or one that cannot be recovered
+            raise UsageError(str(error)) from None
+
+    with ros_session('wirefish_recorder', namespace, make_node=make_recorder) as session:
+        accounts = _record(session.node, namespace, args, bag_path, signals,
+                           progress_on_terminal)
+    end_line()
+    print(recording_summary(bag_path, accounts, namespace), flush=True)
+    return 0
+
+
+def _record(recorder, namespace: str, args: argparse.Namespace, bag_path: Path, signals,
+            progress_on_terminal: bool) -> dict:
+    """Record until the duration or a stop signal; return the topics' accounts."""
+    import time
+
     started_ns = time.time_ns()
     progress = (Progress(f'record {bag_path.name}', math.ceil(args.duration))
                 if args.duration is not None else None)
@@ -101,12 +106,7 @@ def run(args: argparse.Namespace) -> int:
         recorder.record(stopped)
     finally:
         recorder.close()
-        accounts = dict(recorder.accounts)
-        recorder.destroy_node()
-        rclpy.try_shutdown()
-    end_line()
-    print(recording_summary(bag_path, accounts, namespace), flush=True)
-    return 0
+    return dict(recorder.accounts)
 
 
 def empty_namespace_warning(node, namespace: str) -> str | None:

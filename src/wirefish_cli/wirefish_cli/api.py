@@ -20,6 +20,11 @@ import sys
 
 VERB_GROUP = 'wirefish.commands'
 INTERRUPTED = 130  # the exit code of a command stopped by Ctrl-C (128 + SIGINT)
+USAGE = 2  # the exit code of a command refused before it did anything (argparse's)
+
+
+class UsageError(ValueError):
+    """A verb's input that argparse could not judge (a namespace, a file): said, exit 2."""
 
 
 def verbs() -> dict[str, str]:
@@ -46,9 +51,12 @@ def duration_s(text: str) -> float:
 
 def run_verb(run: Callable[[argparse.Namespace], int], args: argparse.Namespace,
              name: str) -> int:
-    """Run a verb: Ctrl-C is one line and exit 130, a closed pipe ends quietly."""
+    """Run a verb: a UsageError is one line and exit 2, Ctrl-C exit 130, a closed pipe quiet."""
     try:
         return run(args)
+    except UsageError as error:
+        print(f'{name}: {error}', file=sys.stderr)
+        return USAGE
     except KeyboardInterrupt:
         # A command without its own SIGINT handling (a sweep, a fit): one line, no traceback.
         from wirefish_common.progress import end_line

@@ -21,6 +21,8 @@ import shutil
 import sys
 import time
 
+from wirefish_cli.ros_session import graph_namespace, ros_session, RosSession
+
 PUBLISH_HZ = 10.0
 NO_GRAPH_HINT_S = 3.0  # without planner_state, when the status line says what may be wrong
 ESC = '\x1b'
@@ -160,17 +162,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish drive` on this terminal; return the exit code."""
-    import select
-    import termios
-    import tty
-
-    from wirefish_bringup.graph import validate_namespace
-
-    try:
-        namespace = validate_namespace(args.namespace)
-    except ValueError as error:
-        print(f'wirefish drive: {error}', file=sys.stderr)
-        return 2
+    namespace = graph_namespace(args.namespace)
     values = (args.speed_step, args.max_speed, args.turn_step, args.max_turn)
     if not all(math.isfinite(v) and v > 0.0 for v in values):
         print('wirefish drive: steps and limits must be finite and > 0', file=sys.stderr)
@@ -178,8 +170,15 @@ def run(args: argparse.Namespace) -> int:
     if not sys.stdin.isatty():
         print('wirefish drive: needs a terminal (keys are read from stdin)', file=sys.stderr)
         return 2
-    limits = DriveLimits(*values)
-    link = _Link(namespace)
+    with ros_session('wirefish_drive', namespace) as session:
+        return _drive(_Link(session), DriveLimits(*values), namespace)
+
+
+def _drive(link: _Link, limits: DriveLimits, namespace: str) -> int:
+    import select
+    import termios
+    import tty
+
     fd = sys.stdin.fileno()
     decoder = KeyDecoder()
     saved = termios.tcgetattr(fd)
@@ -210,7 +209,6 @@ def run(args: argparse.Namespace) -> int:
         pass
     finally:
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
-        link.close()
         print()
     return 0
 
@@ -218,25 +216,21 @@ def run(args: argparse.Namespace) -> int:
 class _Link:
     """The teleop's node: cmd_vel out, planner_state in (spun between key reads)."""
 
-    def __init__(self, namespace: str) -> None:
+    def __init__(self, session: RosSession) -> None:
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.qos import QoSProfile, ReliabilityPolicy
-        from rclpy.signals import SignalHandlerOptions
 
         from geometry_msgs.msg import Twist
         from wirefish_msgs.msg import PlannerState
 
         self._rclpy = rclpy
         self._twist = Twist
-        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-        self.node = rclpy.create_node('wirefish_drive', namespace=namespace)
+        self._session = session
+        self.node = session.node
         reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         self._pub = self.node.create_publisher(Twist, 'cmd_vel', reliable)
         self.state = None
         self.node.create_subscription(PlannerState, 'planner_state', self._on_state, reliable)
-        self._executor = SingleThreadedExecutor()
-        self._executor.add_node(self.node)
 
     def _on_state(self, msg) -> None:
         self.state = msg
@@ -249,9 +243,4 @@ class _Link:
         msg.linear.x, msg.angular.z = speed, turn
         self._pub.publish(msg)
         for _ in range(5):  # planner_state comes at 20 Hz, the keys are read at 10 Hz
-            self._executor.spin_once(timeout_sec=0.0)
-
-    def close(self) -> None:
-        self._executor.shutdown()
-        self.node.destroy_node()
-        self._rclpy.try_shutdown()
+            self._session.spin_once(0.0)

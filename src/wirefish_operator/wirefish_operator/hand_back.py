@@ -11,9 +11,9 @@ cpg_command then sets the targets.
 
 import argparse
 import sys
-import time
 
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+from wirefish_bringup.graph import DEFAULT_NAMESPACE
+from wirefish_cli.ros_session import ros_session
 
 WAIT_S = 10.0
 
@@ -31,40 +31,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Call follow_commands once; return 0 when the CPG answered."""
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.signals import SignalHandlerOptions
     from std_srvs.srv import Trigger
 
-    try:
-        namespace = validate_namespace(args.namespace)
-    except ValueError as error:
-        print(f'wirefish hand-back: {error}', file=sys.stderr)
-        return 2
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node('wirefish_hand_back', namespace=namespace)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    client = node.create_client(Trigger, f'{namespace.rstrip("/")}/cpg_node/follow_commands')
-    try:
-        if not client.wait_for_service(timeout_sec=args.timeout):
-            print(f'wirefish hand-back: no {client.srv_name} service: is the graph running '
-                  '(wirefish up)?', file=sys.stderr)
-            return 1
-        future = client.call_async(Trigger.Request())
-        deadline = time.monotonic() + args.timeout
-        while not future.done() and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
-        if not future.done():
-            print(f'wirefish hand-back: {client.srv_name} did not answer within '
-                  f'{args.timeout:g} s', file=sys.stderr)
-            return 1
-        print(f'cpg_node: {future.result().message}')
-        return 0
-    except KeyboardInterrupt:
-        return 130
-    finally:
-        node.destroy_client(client)
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
+    with ros_session('wirefish_hand_back', args.namespace) as session:
+        client = session.node.create_client(
+            Trigger, f'{session.namespace.rstrip("/")}/cpg_node/follow_commands')
+        try:
+            if not client.wait_for_service(timeout_sec=args.timeout):
+                print(f'wirefish hand-back: no {client.srv_name} service: is the graph running '
+                      '(wirefish up)?', file=sys.stderr)
+                return 1
+            future = client.call_async(Trigger.Request())
+            if not session.spin_until(future.done, args.timeout):
+                print(f'wirefish hand-back: {client.srv_name} did not answer within '
+                      f'{args.timeout:g} s', file=sys.stderr)
+                return 1
+            print(f'cpg_node: {future.result().message}')
+            return 0
+        except KeyboardInterrupt:
+            return 130
+        finally:
+            session.node.destroy_client(client)

@@ -26,6 +26,8 @@ import sys
 import time
 from typing import TYPE_CHECKING
 
+from wirefish_cli.ros_session import graph_namespace, ros_session, RosSession
+
 if TYPE_CHECKING:
     from rclpy.task import Future
     from wirefish_common.progress import Progress
@@ -73,13 +75,12 @@ def mission_path(text: str) -> Path:
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish mission`; return the exit code."""
     from wirefish_cli.api import INTERRUPTED
-    from wirefish_bringup.graph import validate_namespace
     from wirefish_common.progress import end_line
     from wirefish_operator.mission_plan import load_mission
 
     try:
         mission = load_mission(mission_path(args.mission))
-        namespace = validate_namespace(args.namespace)
+        namespace = graph_namespace(args.namespace)
     except ValueError as error:
         print(f'wirefish mission: {error}', file=sys.stderr)
         return 2
@@ -140,29 +141,32 @@ def _drive(mission, namespace: str, bag_path: Path,
     until the ground truth's speed stayed below the report's REST_SPEED for a second, at most
     REST_WAIT_S more): a fish that still swims its start-up gait would start leg 1 moving.
     """
+    from wirefish_common.shutdown import SignalShutdown
+
+    signals = SignalShutdown()  # Ctrl-C stops the legs, the fish rests, the bag is closed
+    with ros_session('wirefish_mission', namespace) as session:
+        return _drive_in(session, signals, mission, bag_path, wait_s)
+
+
+def _drive_in(session: RosSession, signals, mission, bag_path: Path,
+              wait_s: float) -> tuple[float | None, str | None, bool, float | None]:
     from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
     from rcl_interfaces.msg import ParameterType
     from rcl_interfaces.srv import GetParameters
     import rclpy
-    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+    from rclpy.executors import ExternalShutdownException
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from rclpy.signals import SignalHandlerOptions
     from wirefish_bag.recorder import BagRecorder
     from wirefish_common.progress import Progress
-    from wirefish_common.shutdown import SignalShutdown
     from wirefish_msgs.msg import PlannerState
     from wirefish_operator.mission_report import REST_SPEED
 
-    signals = SignalShutdown()  # Ctrl-C stops the legs, the fish rests, the bag is closed
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node('wirefish_mission', namespace=namespace)
+    node, executor, namespace = session.node, session.executor, session.namespace
     # The recorder's line per topic would flood the mission's console: its warnings only.
     rclpy.logging.set_logger_level('wirefish_recorder', rclpy.logging.LoggingSeverity.WARN)
     recorder = BagRecorder(bag_path, namespace)
     signals.attach(node)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
     recorder.start_thread()  # takes its messages itself, beside the executor
     reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     publisher = node.create_publisher(Twist, 'cmd_vel', reliable)
@@ -263,10 +267,7 @@ def _drive(mission, namespace: str, bag_path: Path,
         pass
     finally:
         recorder.close()
-        executor.shutdown()
         recorder.destroy_node()
-        node.destroy_node()
-        rclpy.try_shutdown()
     interrupted = run.problem is None and not run.done
     if interrupted:
         run.problem = (f'interrupted (Ctrl-C); the bag so far is in {bag_path}'

@@ -17,6 +17,8 @@ import enum
 import sys
 import time
 
+from wirefish_cli.ros_session import ros_session, RosSession
+
 SERVICE_WAIT_S = 10.0  # how long to wait for the node's parameter services
 # How long the graph is looked at before a node it does not show is said missing (a running
 # node was discovered within 0 to 2.3 s on the loaded 2-core machine).
@@ -102,41 +104,35 @@ def parameter_message(name: str, text: str, declared_type: int | None = None):
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish param ...`; return the exit code."""
-    import rclpy
-    from rclpy.signals import SignalHandlerOptions
-
     target = node_name(args.node, args.namespace)
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node('wirefish_param', start_parameter_services=False)
-    try:
-        return _run(node, args, target)
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    with ros_session('wirefish_param') as session:
+        return _run(session, args, target)
 
 
-def _run(node, args: argparse.Namespace, target: str) -> int:
+def _run(session: RosSession, args: argparse.Namespace, target: str) -> int:
     from rcl_interfaces.srv import GetParameters, ListParameters, SetParameters
 
-    missing = _wait_for_node(node, target)
+    missing = _wait_for_node(session, target)
     if missing is not None:
         print(f'wirefish param {args.verb}: {missing}', file=sys.stderr)
         return 1
     if args.verb == ParamVerb.LIST:
-        response = _call(node, target, ListParameters, 'list_parameters', ListParameters.Request())
+        response = _call(session, target, ListParameters, 'list_parameters',
+                         ListParameters.Request())
         if isinstance(response, str):
             print(f'wirefish param list: {response}', file=sys.stderr)
             return 1
         for name in sorted(response.result.names):
             print(f'  {name}')
         return 0
-    current = _call(node, target, GetParameters, 'get_parameters',
+    current = _call(session, target, GetParameters, 'get_parameters',
                     GetParameters.Request(names=[args.name]))
     if isinstance(current, str):
         print(f'wirefish param {args.verb}: {current}', file=sys.stderr)
         return 1
     if not current.values or current.values[0].type == 0:
-        listed = _call(node, target, ListParameters, 'list_parameters', ListParameters.Request())
+        listed = _call(session, target, ListParameters, 'list_parameters',
+                       ListParameters.Request())
         names = [] if isinstance(listed, str) else list(listed.result.names)
         print(f'wirefish param {args.verb}: {unknown_name_text(target, args.name, names)}',
               file=sys.stderr)
@@ -149,7 +145,7 @@ def _run(node, args: argparse.Namespace, target: str) -> int:
     except (TypeError, ValueError) as error:
         print(f'wirefish param set: {error}', file=sys.stderr)
         return 2
-    response = _call(node, target, SetParameters, 'set_parameters',
+    response = _call(session, target, SetParameters, 'set_parameters',
                      SetParameters.Request(parameters=[parameter]))
     if isinstance(response, str):
         print(f'wirefish param set: {response}', file=sys.stderr)
@@ -162,15 +158,14 @@ def _run(node, args: argparse.Namespace, target: str) -> int:
     return 1
 
 
-def _wait_for_node(node, target: str) -> str | None:
+def _wait_for_node(session: RosSession, target: str) -> str | None:
     """
     Wait until ``target`` is on the graph; return why it is not there, or None.
 
     Once the graph shows other nodes for NODE_DISCOVERY_S, a missing node is missing (with the
     closest names); with nothing discovered at all the wait goes on to SERVICE_WAIT_S.
     """
-    import rclpy
-
+    node = session.node
     started = time.monotonic()
     while True:
         names = [f'{ns.rstrip("/")}/{name}' for name, ns in node.get_node_names_and_namespaces()]
@@ -180,7 +175,7 @@ def _wait_for_node(node, target: str) -> str | None:
         others = [name for name in names if name != node.get_fully_qualified_name()]
         if (others and waited >= NODE_DISCOVERY_S) or waited >= SERVICE_WAIT_S:
             return missing_node_text(target, others, waited)
-        rclpy.spin_once(node, timeout_sec=0.1)
+        session.spin_once(0.1)
 
 
 def missing_node_text(target: str, others: list[str], waited_s: float) -> str:
@@ -201,15 +196,12 @@ def unknown_name_text(target: str, name: str, names: list[str]) -> str:
     return f'{target} has no parameter {name}{hint}'
 
 
-def _call(node, target: str, kind, service: str, request):
+def _call(session: RosSession, target: str, kind, service: str, request):
     """Call one of the node's parameter services; return its response, or why there is none."""
-    import rclpy
-
-    client = node.create_client(kind, f'{target}/{service}')
+    client = session.node.create_client(kind, f'{target}/{service}')
     if not client.wait_for_service(timeout_sec=SERVICE_WAIT_S):
         return f'{target} has no {service} service (within {SERVICE_WAIT_S:g} s)'
     future = client.call_async(request)
-    rclpy.spin_until_future_complete(node, future, timeout_sec=SERVICE_WAIT_S)
-    if not future.done() or future.result() is None:
+    if not session.spin_until(future.done, SERVICE_WAIT_S) or future.result() is None:
         return f'{target} did not answer'
     return future.result()

@@ -15,7 +15,8 @@ import math
 import sys
 import time
 
-from wirefish_bringup.graph import DEFAULT_NAMESPACE, validate_namespace
+from wirefish_bringup.graph import DEFAULT_NAMESPACE
+from wirefish_cli.ros_session import ros_session, RosSession
 from wirefish_common.progress import estimate_text
 from wirefish_cpg.gait_library import FitMode
 from wirefish_operator.goal_sender import GoalSender
@@ -126,22 +127,16 @@ def goal_of(args: argparse.Namespace, goal_type):
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish retune`; return 0 when the tuner reports success."""
-    import rclpy
+    # Ctrl-C arrives as KeyboardInterrupt here (rclpy's handler off), so the goal is canceled.
+    with ros_session('wirefish_retune', args.namespace) as session:
+        return _retune(args, session)
+
+
+def _retune(args: argparse.Namespace, session: RosSession) -> int:
     from rclpy.action import ActionClient
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.signals import SignalHandlerOptions
     from wirefish_msgs.action import RetuneGait
 
-    try:
-        namespace = validate_namespace(args.namespace)
-    except ValueError as error:
-        print(f'wirefish retune: {error}', file=sys.stderr)
-        return 2
-    # Ctrl-C arrives as KeyboardInterrupt here (rclpy's handler off), so the goal is canceled.
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = rclpy.create_node('wirefish_retune', namespace=namespace)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
+    node, namespace = session.node, session.namespace
     # The goal's feedback is taken by the GoalSender (every iteration, also after the result).
     client = ActionClient(node, RetuneGait, 'retune_gait')
     terminal = sys.stderr.isatty()
@@ -165,9 +160,7 @@ def run(args: argparse.Namespace) -> int:
                                 estimate), file=sys.stderr, flush=True)
 
     def spin_until(done, deadline: float) -> bool:
-        while not done() and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
-        return done()
+        return session.spin_until(done, deadline - time.monotonic())
 
     handle = None
     try:
@@ -178,7 +171,7 @@ def run(args: argparse.Namespace) -> int:
         deadline = time.monotonic() + args.timeout
         # A goal whose answer is lost (a client that has just started) is adopted from the
         # server's status, or sent again: see goal_sender.
-        sender = GoalSender(node, client, lambda s: executor.spin_once(timeout_sec=s),
+        sender = GoalSender(node, client, session.spin_once,
                             'retune_gait', RetuneGait)
         handle = sender.send(goal_of(args, RetuneGait.Goal), on_feedback, deadline)
         if handle is None:
@@ -219,6 +212,3 @@ def run(args: argparse.Namespace) -> int:
         return 130
     finally:
         client.destroy()
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()

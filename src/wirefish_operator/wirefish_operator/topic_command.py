@@ -19,6 +19,8 @@ import math
 import sys
 import time
 
+from wirefish_cli.ros_session import ros_session, RosSession
+
 DISCOVERY_S = 2.0  # how long to listen for the graph before answering
 WAIT_S = 10.0  # how long echo and hz wait for the topic to appear
 
@@ -115,18 +117,11 @@ def rate_line(times: list[float]) -> str:
 
 
 class _Probe:
-    """A node of its own on the graph, spun by hand."""
+    """A node of its own on the graph (the verb's session), spun by hand."""
 
-    def __init__(self) -> None:
-        import rclpy
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.signals import SignalHandlerOptions
-
-        self._rclpy = rclpy
-        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-        self.node = rclpy.create_node('wirefish_topic', start_parameter_services=False)
-        self.executor = SingleThreadedExecutor()
-        self.executor.add_node(self.node)
+    def __init__(self, session: RosSession) -> None:
+        self.node = session.node
+        self.executor = session.executor
 
     def spin_for(self, seconds: float) -> None:
         end = time.monotonic() + seconds
@@ -143,36 +138,32 @@ class _Probe:
                 return None
             self.spin_for(0.1)
 
-    def close(self) -> None:
-        self.executor.shutdown()
-        self.node.destroy_node()
-        self._rclpy.try_shutdown()
-
 
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish topic ...`; return the exit code."""
-    probe = _Probe()
-    try:
-        if args.verb == TopicVerb.LIST:
-            return _list(probe, args)
-        topic = full_name(args.topic, args.namespace)
-        type_name = probe.type_of(topic, DISCOVERY_S)
-        if type_name is None:
-            names = [name for name, _ in probe.node.get_topic_names_and_types()]
-            missing = missing_topic_text(topic, names)
-            if missing is not None:  # the graph is there, the topic is not: say it at once
-                print(f'wirefish topic {args.verb}: {missing}', file=sys.stderr)
-                return 1
-            print(f'wirefish topic {args.verb}: waiting up to {WAIT_S:g} s for a publisher of '
-                  f'{topic} (Ctrl-C stops)', file=sys.stderr, flush=True)
-            type_name = probe.type_of(topic, WAIT_S - DISCOVERY_S)
-        if type_name is None:
-            print(f'wirefish topic {args.verb}: no publisher of {topic} within {WAIT_S:g} s '
-                  '(wirefish topic list shows what there is)', file=sys.stderr)
+    with ros_session('wirefish_topic') as session:
+        return _run(_Probe(session), args)
+
+
+def _run(probe: _Probe, args: argparse.Namespace) -> int:
+    if args.verb == TopicVerb.LIST:
+        return _list(probe, args)
+    topic = full_name(args.topic, args.namespace)
+    type_name = probe.type_of(topic, DISCOVERY_S)
+    if type_name is None:
+        names = [name for name, _ in probe.node.get_topic_names_and_types()]
+        missing = missing_topic_text(topic, names)
+        if missing is not None:  # the graph is there, the topic is not: say it at once
+            print(f'wirefish topic {args.verb}: {missing}', file=sys.stderr)
             return 1
-        return (_echo if args.verb == TopicVerb.ECHO else _hz)(probe, topic, type_name, args)
-    finally:
-        probe.close()
+        print(f'wirefish topic {args.verb}: waiting up to {WAIT_S:g} s for a publisher of '
+              f'{topic} (Ctrl-C stops)', file=sys.stderr, flush=True)
+        type_name = probe.type_of(topic, WAIT_S - DISCOVERY_S)
+    if type_name is None:
+        print(f'wirefish topic {args.verb}: no publisher of {topic} within {WAIT_S:g} s '
+              '(wirefish topic list shows what there is)', file=sys.stderr)
+        return 1
+    return (_echo if args.verb == TopicVerb.ECHO else _hz)(probe, topic, type_name, args)
 
 
 def _list(probe: _Probe, args: argparse.Namespace) -> int:
