@@ -107,9 +107,12 @@ def _dotted_problem(dotted: str) -> str | None:
     package, *rest = dotted.split('.')
     if not rest:
         return None
-    module = SRC / package / package / f'{rest[0]}.py'
     if package == 'wirefish_msgs' or not (SRC / package).is_dir():
         return None if (SRC / package).is_dir() else f'no package {package}'
+    folder = SRC / package / package
+    while len(rest) > 1 and (folder / rest[0] / '__init__.py').is_file():  # a subpackage
+        folder, package, rest = folder / rest[0], f'{package}.{rest[0]}', rest[1:]
+    module = folder / f'{rest[0]}.py'
     if not module.exists():
         return f'no module {package}.{rest[0]}'
     if len(rest) == 1:
@@ -256,6 +259,8 @@ def test_every_relative_link_leads_to_a_file(doc):
     ('wirefish_bridge.codec.FrameEncoder.encode', None),
     ('wirefish_bridge.codec.FrameDecoder', 'wirefish_bridge.codec defines no FrameDecoder'),
     ('wirefish_bridge.nothing', 'no module wirefish_bridge.nothing'),
+    ('wirefish_launcher.verb.nothing', 'no module wirefish_launcher.verb.nothing'),
+    ('wirefish_launcher.verb.up.nothing', 'wirefish_launcher.verb.up defines no nothing'),
     ('wirefish_bridge.codec.FrameEncoder.decode',
      'wirefish_bridge.codec.FrameEncoder has no decode'),
 ])

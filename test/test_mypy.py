@@ -88,9 +88,10 @@ def relaxed_modules(config: dict[str, dict[str, str]]) -> set[str]:
 
 
 def modules(package: str) -> dict[str, Path]:
-    """Return a package's modules by dotted name (``__init__`` aside)."""
-    return {f'{package}.{path.stem}': path for path in sorted((SRC / package / package).glob(
-        '*.py')) if path.name != '__init__.py'}
+    """Return a package's modules (its subpackages' too) by dotted name (``__init__`` aside)."""
+    root = SRC / package / package
+    return {'.'.join((package, *path.relative_to(root).with_suffix('').parts)): path
+            for path in sorted(root.rglob('*.py')) if path.name != '__init__.py'}
 
 
 def packages() -> list[str]:

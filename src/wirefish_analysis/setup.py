@@ -22,15 +22,15 @@ setup(
         'console_scripts': [
             'reproduce_paper = wirefish_analysis.reproduce_paper:main',
             'calibrate_drag = wirefish_analysis.calibrate_drag:main',
-            'identify_geometry = wirefish_analysis.identify_geometry:main',
+            'identify_geometry = wirefish_analysis.verb.identify_geometry:main',
             'fig11 = wirefish_analysis.fig11:main',
             'servo_calibration = wirefish_analysis.servo_calibration:main',
             'plot_body_wave = wirefish_analysis.plot_body_wave:main',
         ],
         # Subcommands of the `wirefish` command that live here (see wirefish_cli.cli).
         'wirefish.commands': [
-            'sweep = wirefish_analysis.sweep',
-            'identify-geometry = wirefish_analysis.identify_geometry',
+            'sweep = wirefish_analysis.verb.sweep',
+            'identify-geometry = wirefish_analysis.verb.identify_geometry',
         ],
     },
 )

@@ -24,10 +24,10 @@ setup(
             'recorder = wirefish_bag.executables:recorder',
         ],
         'wirefish.commands': [
-            'record = wirefish_bag.record',
-            'bag = wirefish_bag.bag_command',
-            'play = wirefish_bag.play_command',
-            'report = wirefish_bag.report',
+            'record = wirefish_bag.verb.record',
+            'bag = wirefish_bag.verb.bag',
+            'play = wirefish_bag.verb.play',
+            'report = wirefish_bag.verb.report',
         ],
     },
 )

@@ -25,10 +25,10 @@ setup(
             'compose = wirefish_launcher.executables:compose',
         ],
         'wirefish.commands': [
-            'up = wirefish_launcher.launcher',
-            'qemu = wirefish_launcher.qemu_board',
-            'compose = wirefish_launcher.compose',
-            'twohost = wirefish_launcher.twohost',
+            'up = wirefish_launcher.verb.up',
+            'qemu = wirefish_launcher.verb.qemu',
+            'compose = wirefish_launcher.verb.compose',
+            'twohost = wirefish_launcher.verb.twohost',
         ],
     },
 )

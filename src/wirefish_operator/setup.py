@@ -26,13 +26,13 @@ setup(
         'console_scripts': [
         ],
         'wirefish.commands': [
-            'retune = wirefish_operator.retune',
-            'hand-back = wirefish_operator.hand_back',
-            'gaits = wirefish_operator.gaits',
-            'drive = wirefish_operator.drive',
-            'mission = wirefish_operator.mission',
-            'topic = wirefish_operator.topic_command',
-            'param = wirefish_operator.param_command',
+            'retune = wirefish_operator.verb.retune',
+            'hand-back = wirefish_operator.verb.hand_back',
+            'gaits = wirefish_operator.verb.gaits',
+            'drive = wirefish_operator.verb.drive',
+            'mission = wirefish_operator.verb.mission',
+            'topic = wirefish_operator.verb.topic',
+            'param = wirefish_operator.verb.param',
         ],
     },
 )

@@ -29,7 +29,7 @@ setup(
             'view_node = wirefish_view.executables:view_node',
         ],
         'wirefish.commands': [
-            'view = wirefish_view.view_command',
+            'view = wirefish_view.verb.view',
         ],
     },
 )

@@ -7,7 +7,7 @@ import threading
 import time
 
 import pytest
-from wirefish_bag.play_command import remapped
+from wirefish_bag.verb.play import remapped
 
 CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 COUNT = 40

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-`wirefish sweep`: model and virtual-fish swimming speed over the paper's grid (Figs 9-11).
+Model and virtual-fish swimming speed over the paper's grid (Figs 9-11), for `wirefish sweep`.
 
 The grid of section 5.4 (``wirefish_cpg.table1_gait.PAPER_GRID_*``): f = 1.0 ... 3.0 Hz in
 steps of 0.2 at tail-tip half amplitudes {4, 4.5, 6.5, 8, 9} cm, plus 5 cm from 1 to 8 Hz
@@ -11,7 +11,6 @@ rate limit and lag, surge dynamics) driven by the same commands. The paper's sta
 drawn beside them.
 """
 
-import argparse
 from dataclasses import dataclass
 from pathlib import Path
 from typing import overload
@@ -50,14 +49,6 @@ class SweepPoint:
     def swimming_number(self, speed: float | None) -> float | None:
         """Return Sw = U / (f L) for ``speed``."""
         return None if speed is None else speed / (self.frequency_hz * self.body_length)
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Declare the options of `wirefish sweep`."""
-    parser.add_argument('-o', '--out', type=Path, default=Path('out', 'sweep'),
-                        help='where the PNGs and sweep.csv go')
-    parser.add_argument('--model-only', action='store_true',
-                        help='skip the virtual fish (eq 18 only, a second instead of ten)')
 
 
 def sweep_point(frequency_hz: float, tip_amplitude_m: float, with_fish: bool) -> SweepPoint:
@@ -204,14 +195,3 @@ def table(grid: list[SweepPoint], line: list[SweepPoint]) -> str:
                      f'{p.swimming_number(p.model_speed):8.3f} '
                      f'{_optional(p.swimming_number(p.fish_speed), "7.3f"):>7}  {note}')
     return '\n'.join(lines)
-
-
-def run(args: argparse.Namespace) -> int:
-    """Run `wirefish sweep`; print the table and the files written."""
-    label = 'sweep (eq 18)' if args.model_only else 'sweep (eq 18 and the virtual fish)'
-    grid, line = run_sweep(with_fish=not args.model_only,
-                           progress=Progress(label, sweep_size()))
-    print(table(grid, line))
-    for path in write_outputs(grid, line, args.out):
-        print(f'wrote {path}')
-    return 0

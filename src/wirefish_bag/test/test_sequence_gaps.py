@@ -4,8 +4,8 @@
 from pathlib import Path
 
 import pytest
-from wirefish_bag.record import recording_summary
 from wirefish_bag.sequence_gaps import recording_account, SequenceGaps, TopicAccount
+from wirefish_bag.verb.record import recording_summary
 
 
 def _gaps(numbers: list[int | None]) -> SequenceGaps:

@@ -229,3 +229,11 @@ def open_bag_file(bag_path: Path, resume: bool) -> tuple[BagFileWriter, dict[str
     else:
         bag_path.mkdir(parents=True, exist_ok=resume)
     return BagFileWriter(next_file_path(bag_path)), known_qos
+
+
+def main() -> int:
+    """Entry point of the ``recorder`` executable: `wirefish record` as the graph's node."""
+    from wirefish_bag.verb import record
+    from wirefish_cli.api import verb_main
+    return verb_main(record.add_arguments, record.run, 'recorder',
+                     record.__doc__.strip().splitlines()[0])

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-`wirefish report BAG`: plots and a summary table from a recorded run.
+Plots and a summary table from a recorded run (`wirefish report` writes them).
 
 PNGs: the CPG outputs, a body-wave snapshot against the desired wave, the estimated speed
 against the virtual fish's ground truth, the IMU attitude. The table: per topic, the message
@@ -9,10 +9,8 @@ stamps' span at the median period calls for but that are missing), and the bridg
 counters from /diagnostics.
 """
 
-import argparse
 from dataclasses import dataclass
 from pathlib import Path
-import sys
 
 import numpy as np
 
@@ -20,13 +18,6 @@ from wirefish_bag.bagfile import read_bag
 from wirefish_common.plotting import legend_beside, moving_mean
 
 SPEED_MEAN_S = 1.0  # the ground truth's mean in the speed plot: a few tail beats
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Declare the options of `wirefish report`."""
-    parser.add_argument('bag', type=Path, help='rosbag2 directory (wirefish record / up)')
-    parser.add_argument('-o', '--output', type=Path, default=None,
-                        help='where the PNGs and summary go (default: <bag>_report)')
 
 
 @dataclass(frozen=True)
@@ -216,22 +207,3 @@ def summary_table(stats: list[TopicStats], bag) -> str:
             values = ', '.join(f'{kv.key}={kv.value}' for kv in status.values)
             lines.append(f'  {status.name}: {status.message} ({values})')
     return '\n'.join(lines)
-
-
-def run(args: argparse.Namespace) -> int:
-    """Run `wirefish report`; return the process exit code."""
-    from wirefish_common.input_checks import bag_directory_problem
-
-    problem = bag_directory_problem(args.bag)
-    if problem is not None:
-        print(f'wirefish report: {problem}', file=sys.stderr)
-        return 2
-    if not (args.bag / 'metadata.yaml').is_file():
-        print(f'wirefish report: {args.bag} has no metadata.yaml: its recorder was killed? '
-              f'`wirefish bag reindex {args.bag}` repairs it', file=sys.stderr)
-        return 2
-    out_dir = args.output or args.bag.with_name(args.bag.name + '_report')
-    stats = write_report(args.bag, out_dir)
-    print((out_dir / 'summary.txt').read_text(), end='')
-    print(f'PNGs in {out_dir}: {", ".join(sorted(p.name for p in out_dir.glob("*.png")))}')
-    return 0 if stats else 1

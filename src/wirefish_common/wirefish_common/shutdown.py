@@ -30,7 +30,7 @@ acted on as soon as one is called.
 
 A process still running ``STOP_STACKS_AFTER_S`` after the first signal writes the stacks of all
 its threads to stderr (its log under `wirefish up`), before the launcher's deadline
-(``wirefish_launcher.launcher``) escalates to SIGTERM and SIGKILL: a stop that hangs then says
+(``wirefish_launcher.verb.up``) escalates to SIGTERM and SIGKILL: a stop that hangs then says
 where it hangs. A process that stops in time writes nothing (the interpreter cancels the dump at
 exit).
 """

@@ -2,7 +2,7 @@
 """The launcher's view of a fleet's nodes, pure."""
 
 from wirefish_bringup.fleet import fleet_graph
-from wirefish_launcher.launcher import _registry_nodes
+from wirefish_launcher.verb.up import _registry_nodes
 
 
 def test_the_launcher_names_a_fleets_nodes_relative_to_its_base():

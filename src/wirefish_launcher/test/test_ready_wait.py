@@ -4,8 +4,9 @@
 from dataclasses import dataclass, field
 
 import pytest
-from wirefish_launcher import launcher, monitor
+from wirefish_launcher import monitor
 from wirefish_launcher.stop_flag import StopFlag
+from wirefish_launcher.verb import up as launcher
 
 
 @dataclass

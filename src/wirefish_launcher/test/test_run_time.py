@@ -4,8 +4,8 @@
 from builtin_interfaces.msg import Time
 import pytest
 from rosgraph_msgs.msg import Clock
-from wirefish_launcher import launcher
 from wirefish_launcher.status_view import SimulatedClock
+from wirefish_launcher.verb import up as launcher
 
 
 class _Handle:

@@ -6,7 +6,7 @@ import subprocess
 import sys
 
 import pytest
-from wirefish_launcher.launcher import on_simulated_time_road, speed_option
+from wirefish_launcher.verb.up import on_simulated_time_road, speed_option
 
 
 def test_a_speed_is_a_factor_on_real_time_or_max():

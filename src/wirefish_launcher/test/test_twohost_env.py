@@ -4,8 +4,9 @@
 import pytest
 from wirefish_bringup.graph import Role
 from wirefish_cli.cli import main
-from wirefish_launcher import netns, twohost
+from wirefish_launcher import netns
 from wirefish_launcher.netns import Discovery, SIDES, TwoHosts
+from wirefish_launcher.verb import twohost
 
 
 def test_every_name_carries_the_wf_prefix_and_the_token_and_fits_an_interface_name():

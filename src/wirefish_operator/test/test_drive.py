@@ -5,7 +5,7 @@ import math
 from types import SimpleNamespace
 
 import pytest
-from wirefish_operator.drive import DriveLimits, key_action, KeyDecoder, state_line
+from wirefish_operator.verb.drive import DriveLimits, key_action, KeyDecoder, state_line
 
 LIMITS = DriveLimits(speed_step=0.05, max_speed=0.1, turn_step=0.1, max_turn=0.2)
 

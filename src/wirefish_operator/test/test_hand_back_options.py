@@ -4,7 +4,7 @@
 import argparse
 
 import pytest
-from wirefish_operator.hand_back import add_arguments, WAIT_S
+from wirefish_operator.verb.hand_back import add_arguments, WAIT_S
 
 
 def _parse(argv: list[str]) -> argparse.Namespace:

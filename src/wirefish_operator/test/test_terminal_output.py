@@ -5,9 +5,9 @@ import argparse
 from pathlib import Path
 
 import pytest
-from wirefish_operator import mission
-from wirefish_operator.drive import screen_lines, state_line
-from wirefish_operator.retune import bar_redraw, progress_line
+from wirefish_operator.verb import mission
+from wirefish_operator.verb.drive import screen_lines, state_line
+from wirefish_operator.verb.retune import bar_redraw, progress_line
 
 
 def shown(written: str) -> list[str]:

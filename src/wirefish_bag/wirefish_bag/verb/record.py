@@ -149,9 +149,3 @@ def recording_summary(bag_path: Path, accounts: dict[str, TopicAccount],
     else:
         lines.append(loss_line(recording_account(accounts)))
     return '\n'.join(lines)
-
-
-def main() -> int:
-    """Entry point of the ``recorder`` executable (the graph's registry starts it)."""
-    from wirefish_cli.api import verb_main
-    return verb_main(add_arguments, run, 'recorder', __doc__.strip().splitlines()[0])
