@@ -24,7 +24,7 @@ from ros_utils import stop_process
 WORKSPACE = Path(__file__).resolve().parents[1]
 # Fast DDS maps a domain to UDP ports; 0..101 is the portable range. A test run owns the window
 # [base, base + 20): each test takes the next of the first 19 ids (so a test never shares a
-# domain with the one before it); base + 19 is kept for module-scoped graphs (test/e2e).
+# domain with the one before it); base + 19 is kept for module-scoped graphs (test/bringup).
 # Under pytest-xdist (`make test` runs test/ on two workers) worker k owns the next window,
 # [base + 20 k, base + 20 k + 20): set here, before any conftest or test module reads it.
 _WORKER = os.environ.get('PYTEST_XDIST_WORKER', '')

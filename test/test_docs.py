@@ -302,3 +302,29 @@ def test_no_readme_documents_a_flag_fish_sim_lacks(readme):
 def test_a_stale_flag_is_found():
     text = '## fish_sim (virtual fish)\n| `--speed-time-constant` | 0.75 s | |\n## Other\n'
     assert documented_flags(text, 'fish_sim') == {'--speed-time-constant'}
+
+
+# The folders of test/ that name no package: the firmware's two roads and the shared helpers.
+TEST_FOLDERS_BESIDE_PACKAGES = {'firmware', 'firmware_qemu', 'support'}
+
+
+def workspace_test_modules(text: str) -> set[str]:
+    """Return the top-level test modules that ARCHITECTURE's Tests table lists."""
+    tests = text.split('\n## Tests\n', 1)[1].split('\n## ', 1)[0]
+    return set(re.findall(r'^\| `(test_\w+\.py)` \|', tests, flags=re.MULTILINE))
+
+
+def test_every_folder_of_test_names_a_package_or_the_firmware():
+    packages = {p.name.removeprefix('wirefish_') for p in SRC.iterdir()
+                if (p / 'package.xml').is_file()}
+    folders = {p.name for p in (ROOT / 'test').iterdir()
+               if p.is_dir() and not p.name.startswith(('.', '__'))}
+    strays = folders - packages - TEST_FOLDERS_BESIDE_PACKAGES
+    assert folders and not strays, f'test/ folders naming no package: {sorted(strays)}'
+
+
+def test_every_module_at_the_top_of_test_is_a_listed_workspace_wide_one():
+    listed = workspace_test_modules(_text(ARCHITECTURE))
+    found = {p.name for p in (ROOT / 'test').glob('test_*.py')}
+    assert listed and found == listed, (
+        f'ARCHITECTURE.md Tests: unlisted {sorted(found - listed)}, gone {sorted(listed - found)}')

@@ -88,7 +88,7 @@ def relaxed_modules(config: dict[str, dict[str, str]]) -> set[str]:
 
 
 def modules(package: str) -> dict[str, Path]:
-    """Return a package's modules (its subpackages' too) by dotted name (``__init__`` aside)."""
+    """Return every module of a package and its subpackages by dotted name, ``__init__`` aside."""
     root = SRC / package / package
     return {'.'.join((package, *path.relative_to(root).with_suffix('').parts)): path
             for path in sorted(root.rglob('*.py')) if path.name != '__init__.py'}

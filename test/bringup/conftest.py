@@ -1,60 +1,39 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Fixtures of the recorder's cross-process tests: a talker, an independent listener, a seed."""
+"""Fixtures of the whole graph's tests: one graph shared by a module's tests, the cpg probe."""
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field
 import os
-from pathlib import Path
-import secrets
-import time
 
+from cpg_fixtures import probe  # noqa: F401 (a fixture, found by name)
+from e2e_utils import RunningGraph, start_graph, stopped_on_exit
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import QoSProfile, ReliabilityPolicy
-from wirefish_msgs.msg import BodyWave
-
-PEERS = str(Path(__file__).resolve().parents[1] / 'ros_peers.py')
-KILL_NAMESPACE = '/wf_kill'
 
 
-@dataclass
-class Listener:
-    """Hears the talker beside the recorder: (counter, time.monotonic()) of each message."""
-
-    executor: SingleThreadedExecutor
-    heard: list[tuple[int, float]] = field(default_factory=list)
+@pytest.fixture(scope='module')
+def e2e_domain_id() -> int:
+    """Return the ROS domain of this module's graph (outside the per-test window)."""
+    return int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21')) + 19
 
 
-@pytest.fixture
-def talker_namespace(spawn, python) -> str:
-    """Start ros_peers' body_wave_talker (20 Hz, a counter in y[2]); return its namespace."""
-    proc = spawn([python, PEERS, 'body_wave_talker', '--ros-args', '-r',
-                  f'__ns:={KILL_NAMESPACE}'])
-    assert proc.stdout.readline().strip() == 'ready'
-    return KILL_NAMESPACE
+@pytest.fixture(scope='module')
+def running_graph(e2e_domain_id: int, tmp_path_factory, request) -> Iterator[RunningGraph]:
+    """Yield one whole graph shared by the module's observation tests; stop it afterwards."""
+    namespace = '/e2e_' + request.module.__name__.rsplit('.', 1)[-1]  # one per module
+    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'), namespace=namespace)
+    with stopped_on_exit(graph):
+        yield graph
 
 
 @pytest.fixture
-def listener(ros_context) -> Iterator[Listener]:
-    """Yield a subscriber of the talker in this process, spun by the tests' waits."""
-    node = rclpy.create_node('kill_test_listener', namespace=KILL_NAMESPACE,
-                             context=ros_context)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    heard = Listener(executor)
-    node.create_subscription(
-        BodyWave, 'body_wave',
-        lambda msg: heard.heard.append((int(msg.y[2]), time.monotonic())),
-        QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE))
-    yield heard
-    executor.shutdown()
-    node.destroy_node()
+def graph_context(running_graph: RunningGraph, monkeypatch: pytest.MonkeyPatch):
+    """Yield an rclpy context of this test's own, on the shared graph's domain."""
+    import rclpy
+    from rclpy.context import Context
 
-
-@pytest.fixture
-def kill_seed() -> int:
-    """Return the seed of the kill moment, printed; WIREFISH_KILL_SEED=<seed> replays one."""
-    seed = int(os.environ.get('WIREFISH_KILL_SEED') or secrets.randbits(32))
-    print(f'recorder kill seed: {seed} (replay: WIREFISH_KILL_SEED={seed})')
-    return seed
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    context = Context()
+    rclpy.init(context=context, domain_id=running_graph.domain_id)
+    try:
+        yield context
+    finally:
+        rclpy.try_shutdown(context=context)

@@ -1,47 +1,4 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Fixtures of the CPG/tuner cross-process tests (helpers live in cpg_probe.py)."""
+"""The fixtures of the cpg_node and tuner_node process tests, shared with test/support."""
 
-from collections.abc import Iterator
-from pathlib import Path
-import sys
-
-import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import qos_profile_sensor_data
-from sensor_msgs.msg import JointState
-from wirefish_msgs.msg import CpgParams
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cpg_probe import LATCHED, Probe  # noqa: E402, I100 (needs the path above)
-
-
-@pytest.fixture
-def probe(ros_context) -> Iterator[Probe]:
-    """Yield a probe subscribed to servo_cmd and the latched cpg_params."""
-    node = rclpy.create_node('cpg_probe', context=ros_context)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    p = Probe(node, executor)
-    node.create_subscription(JointState, 'servo_cmd', p.servo.append, qos_profile_sensor_data)
-    node.create_subscription(CpgParams, 'cpg_params', p.cpg_params.append, LATCHED)
-    yield p
-    executor.shutdown()
-    node.destroy_node()
-
-
-@pytest.fixture
-def library_path(tmp_path: Path) -> Path:
-    """Return a gait library file of this test's own (never the user's ROS home)."""
-    return tmp_path / 'gaits.yaml'
-
-
-@pytest.fixture
-def tuner(spawn, library_path: Path):
-    """Return a starter of tuner_node on this test's library (extra --ros-args as arguments)."""
-    from cpg_probe import TUNER_NODE
-
-    def _tuner(*ros_args: str):
-        return spawn([TUNER_NODE, '--ros-args', '-p', f'library_path:={library_path}',
-                      *ros_args])
-    return _tuner
+from cpg_fixtures import library_path, probe, tuner  # noqa: F401 (fixtures, found by name)

@@ -5,8 +5,8 @@ The firmware's fail-safe parts on the host port: the reset path, servo limits, a
 The host port models what the stm32f4 port does and QEMU 7.2 cannot show (it models neither
 RCC_CSR nor the IWDG): the reset flags a boot reads, the fault record that survives a reset,
 the fault handler's neutral compares (wf_host.h). The IMU runs against the register-level
-MPU6050 model (test/mpu6050_model.py) with its faults: a bus held low by a read cut mid-byte or
-by a short, frozen data, a sensor reset; the bus recovery is the one both ports run
+MPU6050 model (test/support/mpu6050_model.py) with its faults: a bus held low by a read cut
+mid-byte or by a short, frozen data, a sensor reset; the bus recovery is the one both ports run
 (wf/i2c_bus.h), driven here through the model's open-drain lines.
 
 Bounds, in the firmware's own terms: a stuck sensor is flagged within STUCK_SAMPLES samples

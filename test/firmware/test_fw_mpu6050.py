@@ -2,7 +2,7 @@
 """
 The MPU6050 driver and the attitude filter on the host port, against a register-level model.
 
-The model (test/mpu6050_model.py) answers the driver's I2C transactions as the part's
+The model (test/support/mpu6050_model.py) answers the driver's I2C transactions as the part's
 register map says. Scaling and the axis remap are exact: the values in the board (and in its
 telemetry) equal, bit for bit, the counts times the full-scale factor in binary32, moved to
 FLU by the mounting. The filter: a still, tilted fish reads its roll and pitch within 0.5 deg

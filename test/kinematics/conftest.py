@@ -2,9 +2,8 @@
 """Fixtures of the kinematics node's cross-process tests (helpers in kinematics_probe.py)."""
 
 from collections.abc import Iterator
-from pathlib import Path
-import sys
 
+from kinematics_probe import KINEMATICS_NODE, LATCHED, Probe
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
@@ -12,9 +11,6 @@ from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from kinematics_probe import KINEMATICS_NODE, LATCHED, Probe  # noqa: E402, I100 (path above)
 
 
 @pytest.fixture

@@ -286,21 +286,21 @@ def simulated_planner_graph(planner_domain_id: int, tmp_path_factory,
         print('exit codes:', codes)
 
 
-@pytest.fixture
-def driver(simulated_planner_graph: PlannerGraph,
-           monkeypatch: pytest.MonkeyPatch) -> Iterator[Driver]:
-    """Yield a driver node on the simulated graph's domain and clock, in a context of its own."""
+@pytest.fixture(scope='module')
+def driver(simulated_planner_graph: PlannerGraph) -> Iterator[Driver]:
+    """Yield the module's driver node on the graph's domain and clock, in a context of its own."""
     import rclpy
     from rclpy.context import Context
 
     planner_graph = simulated_planner_graph
-    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    context = Context()
-    rclpy.init(context=context, domain_id=planner_graph.domain_id)
-    probe = Driver(context, planner_graph.namespace, simulated=planner_graph.simulated)
-    try:
-        yield probe
-    finally:
-        probe.command = None
-        probe.close()
-        rclpy.try_shutdown(context=context)
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+        context = Context()
+        rclpy.init(context=context, domain_id=planner_graph.domain_id)
+        probe = Driver(context, planner_graph.namespace, simulated=planner_graph.simulated)
+        try:
+            yield probe
+        finally:
+            probe.command = None
+            probe.close()
+            rclpy.try_shutdown(context=context)

@@ -9,12 +9,14 @@ needs many seconds of swimming: rest before any cmd_vel; speed
 setpoints 0.10 / 0.20 / 0.30 m/s; 0.6 m/s clamped (planner_state, /diagnostics); yaw rate
 +-0.2 rad/s at 0.2 m/s; heading hold against the current, then the same straight run with the
 hold off (rate loop only) and with the yaw loop off (open loop), printed; cmd_vel stops. The
-servo commands of the whole drive are checked for steps at every switch. Wall time ~2 min.
+servo commands of the whole drive are checked for steps at every switch. Wall time ~2 min. The
+drive runs once per module (the ``drive`` fixture); each test judges one of its claims.
 The square mission has a file (and so a graph and an xdist worker) of its own:
 test_planner_mission.py.
 """
 
 from collections import Counter
+from dataclasses import dataclass
 import math
 import time
 
@@ -57,8 +59,25 @@ def _hold(driver, command: tuple[float, float], seconds: float) -> tuple[float, 
     return start, driver.now()
 
 
-@pytest.mark.ros
-def test_drive_the_virtual_fish(driver):
+@dataclass(frozen=True)
+class Drive:
+    """What the drive measured, phase by phase (see the module's docstring)."""
+
+    rest_amplitude: float
+    rest_mode: str
+    results: dict
+    clamped: object
+    warned: list
+    turns: dict
+    hold_rms: float
+    drifts: dict
+    stop_time: float
+    worst: float
+
+
+@pytest.fixture(scope='module')
+def drive(driver) -> Drive:
+    """Drive the virtual fish through every phase once; return what each phase measured."""
     rec = driver.recording
     deadline = time.monotonic() + 30.0
     # Discovery on a loaded machine: each stream its own writer in its own process (a clean-clone
@@ -78,8 +97,7 @@ def test_drive_the_virtual_fish(driver):
         if rest_amplitude < 0.02 or time.monotonic() > rest_deadline:
             break
     print(f'rest before any cmd_vel: max |servo_cmd| over 1 s {rest_amplitude:.4f} rad')
-    assert rest_amplitude < 0.02
-    assert rec.state[-1][1].mode == 'still'
+    rest_mode = rec.state[-1][1].mode
 
     results = {}
     for setpoint in (0.10, 0.20, 0.30):
@@ -153,15 +171,57 @@ def test_drive_the_virtual_fish(driver):
           f'largest change there {steps[close].max():.4f} rad, largest excess over the smooth '
           f'bound {worst:.5f} rad; longest gap {dt.max():.3f} s, {int((dt > 0.05).sum())} gaps '
           '> 50 ms')
+    return Drive(rest_amplitude, rest_mode, results, clamped, warned, turns, hold_rms, drifts,
+                 stop_time, worst)
 
-    assert 'above the fastest feasible gait' in clamped.clamp_reason
-    assert clamped.predicted_speed < 0.6
+
+@pytest.mark.ros
+def test_the_fish_rests_before_any_cmd_vel(drive):
+    assert drive.rest_amplitude < 0.02
+    assert drive.rest_mode == 'still'
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize('setpoint', (0.10, 0.20, 0.30))
+def test_each_speed_setpoint_is_swum_within_ten_percent(drive, setpoint):
+    speed = drive.results[setpoint]
+    assert abs(speed - setpoint) <= 0.10 * setpoint, (setpoint, speed)
+
+
+@pytest.mark.ros
+def test_a_speed_above_the_fastest_gait_is_clamped_with_the_reason(drive):
+    assert 'above the fastest feasible gait' in drive.clamped.clamp_reason
+    assert drive.clamped.predicted_speed < 0.6
+
+
+@pytest.mark.ros
+def test_the_clamp_is_a_warning_on_diagnostics(drive):
+    warned = drive.warned
     assert warned and warned[-1].level == b'\x01' and 'clamped' in warned[-1].message
-    for setpoint, speed in results.items():
-        assert abs(speed - setpoint) <= 0.10 * setpoint, (setpoint, speed)
-    for rate, measured in turns.items():
-        assert np.sign(measured) == np.sign(rate) and abs(measured - rate) <= 0.2 * abs(rate)
-    assert hold_rms < 3.0
-    assert abs(drifts['yaw loops off (open loop)']) > 3.0 * hold_rms
-    assert stop_time <= STOP_WITHIN_S
-    assert worst <= 0.0
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize('rate', (0.2, -0.2))
+def test_each_yaw_rate_setpoint_is_turned_within_twenty_percent(drive, rate):
+    measured = drive.turns[rate]
+    assert np.sign(measured) == np.sign(rate) and abs(measured - rate) <= 0.2 * abs(rate)
+
+
+@pytest.mark.ros
+def test_the_heading_is_held_against_the_current(drive):
+    assert drive.hold_rms < 3.0
+
+
+@pytest.mark.ros
+def test_without_the_yaw_loops_the_current_turns_the_fish(drive):
+    assert abs(drive.drifts['yaw loops off (open loop)']) > 3.0 * drive.hold_rms
+
+
+@pytest.mark.ros
+def test_the_fish_stops_when_cmd_vel_stops(drive):
+    assert drive.stop_time <= STOP_WITHIN_S
+
+
+@pytest.mark.ros
+def test_the_servo_commands_never_step(drive):
+    assert drive.worst <= 0.0

@@ -5,12 +5,12 @@ The virtual fish's speed over the radio road, run after run, in gait and in stre
 
     tools/wfenv python tools/probes/radio_speed_spread.py --runs 2
 
-Each run drives the whole graph three times with test/radio_run's 60 s of cmd_vel: the wired
-preset in gait mode, the wired preset in stream mode, and rf433 in its road's mode (gait). A line
-per drive: the ground truth's mean speed over 5-60 s and per command segment. The radio road runs
-on the wall clock: in stream mode the tail follows the host's 100 Hz stream as it arrives, in
-gait mode the fish integrates eq 1 itself, so compare each mode's spread across runs; this is
-why test/radio/test_rf433_virtual_fish.py takes its reference in gait mode.
+Each run drives the whole graph three times with test/support/radio_run's 60 s of cmd_vel: the
+wired preset in gait mode, the wired preset in stream mode, and rf433 in its road's mode
+(gait). A line per drive: the ground truth's mean speed over 5-60 s and per command segment. The
+radio road runs on the wall clock: in stream mode the tail follows the host's 100 Hz stream as it
+arrives, in gait mode the fish integrates eq 1 itself, so compare each mode's spread across
+runs; this is why test/sim/test_rf433_virtual_fish.py takes its reference in gait mode.
 """
 
 import argparse

@@ -15,7 +15,7 @@ for ``ros2 launch`` in another namespace:
 Over a radio (``wirefish up --role fish|shore``) the graph's own profile also has a default
 participant that announces itself every ANNOUNCE_S (lease LEASE_S) instead of Fast DDS's 3 s
 (20 s): the fish's and the shore's participants announcing to each other every 3 s saturated a
-100 kbit/s radio (test/twohost: fish->shore 12.4 kB/s and 26-41 packets dropped by the bucket
+100 kbit/s radio (test/launcher/test_two_hosts.py: fish->shore 12.4 kB/s and 26-41 packets dropped by the bucket
 in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped). A 10 s radio cut stays inside the lease. That
 participant names its UDPv4 transport itself: a default participant profile otherwise brings
 the builtin transports (shared memory) back. On one host (role all) there is no such

@@ -23,7 +23,7 @@ from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat,
                                       MsgType, ProtocolMessage, Role, ServoCommand, Telemetry,
                                       TelemetryCompact)
 
-WORKSPACE = Path(__file__).resolve().parents[1]
+WORKSPACE = Path(__file__).resolve().parents[2]
 FIRMWARE = WORKSPACE / 'firmware'
 BUILD = FIRMWARE / 'build'
 LIBRARY = BUILD / 'host' / 'libwirefish_fw.so'

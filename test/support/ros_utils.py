@@ -3,9 +3,13 @@
 
 from collections.abc import Callable
 import os
+from pathlib import Path
 import signal
 import subprocess
 import time
+
+# The helper processes of the cross-process tests (a BodyWave talker, a RetuneGait server).
+PEERS = str(Path(__file__).with_name('ros_peers.py'))
 
 
 def spin_until(executor, predicate: Callable[[], bool], timeout_s: float) -> bool:

@@ -1,15 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
 """`wirefish record` writes a rosbag2 MCAP bag that rosbags reads back, and `report` reads it."""
 
-from pathlib import Path
 import subprocess
 
 import numpy as np
 import pytest
+from ros_utils import PEERS
 from wirefish_bag.bagfile import read_bag
 from wirefish_bag.report import topic_stats, write_report
 
-PEERS = str(Path(__file__).resolve().parents[1] / 'ros_peers.py')
 pytestmark = pytest.mark.ros
 
 

@@ -15,7 +15,7 @@ publisher sequence number of any topic is missing except while the recorder itse
 (from at most KILL_MARGIN_S before its kill). The refusal test gives
 the tuner a parameter it refuses at start-up: a configuration error, which the launcher says on
 the terminal and does not restart, keeping the rest running. (A crash loop's back-off, and a
-required node that spends its budget stopping the graph: test/bringup/test_supervisor.py,
+required node that spends its budget stopping the graph: test/launcher/test_supervisor.py,
 without the cost of a whole graph.)
 """
 

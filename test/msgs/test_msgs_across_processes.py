@@ -1,16 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """wirefish_msgs travel between processes over real DDS."""
 
-from pathlib import Path
-
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
-from ros_utils import spin_until
+from ros_utils import PEERS, spin_until
 from wirefish_msgs.msg import BodyWave
 from wirefish_msgs.srv import RetuneGait
 
-PEERS = str(Path(__file__).with_name('ros_peers.py'))
 pytestmark = pytest.mark.ros
 
 

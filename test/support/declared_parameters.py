@@ -8,7 +8,7 @@ from pathlib import Path
 from wirefish_bringup.graph import NodeEntry
 from wirefish_common.parameter_table import ParameterSpec
 
-SRC = Path(__file__).resolve().parents[1] / 'src'
+SRC = Path(__file__).resolve().parents[2] / 'src'
 # Entries without a node class: where the table their process declares comes from.
 _TABLES_OF_PROCESSES = {'fish_sim': ('wirefish_kinematics.geometry_parameters',
                                      'geometry_parameters')}

@@ -17,7 +17,7 @@ from wirefish_launcher.netns import Discovery, MULTICAST_ROUTE
 
 pytestmark = pytest.mark.ros
 
-CHAT = str(Path(__file__).with_name('chat.py'))
+CHAT = str(Path(__file__).resolve().parents[1] / 'support' / 'chat.py')
 HEAR_WITHIN_S = 20.0
 
 

@@ -15,24 +15,24 @@ its turn runs nothing, and a heavy module waiting for its slots holds the light 
 
 from pathlib import Path
 
-WORKSPACE = Path(__file__).resolve().parents[1]
+WORKSPACE = Path(__file__).resolve().parents[2]
 LONGEST_MODULES = (
-    'test/radio/test_rf433_virtual_fish.py',
-    'test/bringup/test_recorder_sigkill.py',
-    'test/e2e/test_restart.py',
-    'test/radio/test_rf433_qemu.py',
+    'test/sim/test_rf433_virtual_fish.py',
+    'test/bag/test_recorder_sigkill.py',
+    'test/bringup/test_restart.py',
+    'test/sim/test_rf433_qemu.py',
     'test/bridge/test_bridge_pty.py',
-    'test/fleet/test_fleet.py',
-    'test/twohost/test_two_hosts.py',
+    'test/launcher/test_fleet.py',
+    'test/launcher/test_two_hosts.py',
     'test/firmware_qemu/test_link_in_the_loop.py',
-    'test/e2e/test_whole_graph.py',
+    'test/bringup/test_whole_graph.py',
     'test/view/test_foxglove_clients.py',
-    'test/bringup/test_loaded_recording.py',
+    'test/bag/test_loaded_recording.py',
     'test/test_repeated_signals.py',
     'test/planner/test_planner_graph.py',
-    'test/cpg/test_retune_action.py',
+    'test/tuner/test_retune_action.py',
     'test/firmware_qemu/test_graph_on_qemu.py',
-    'test/bringup/test_topic_param_commands.py',
+    'test/operator/test_topic_param_commands.py',
     'test/planner/test_planner_mission.py',
     'test/view/test_view_protocol.py',
     'test/view/test_dashboard_browser.py',
