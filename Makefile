@@ -31,11 +31,13 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # process), then the workspace tests that start nodes and graphs (test/). There a file's tests
 # stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
 # owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
-# files are dealt in collection order, which puts the longest first (test/module_order.py).
+# files are dealt in collection order, which puts the longest first
+# (test/support/module_order.py).
 # Most of test/ waits on graphs (real-time ones, or simulated ones paced at real time), so it
 # runs on more workers than cores. A module that loads the machine itself (the loaded recording,
 # QEMU, the dashboard) would starve the real-time streams of the modules beside it, so it holds
-# all the machine's slots but one and such modules run one at a time (test/machine_share.py).
+# all the machine's slots but one and such modules run one at a time
+# (test/support/machine_share.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
 	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder test \

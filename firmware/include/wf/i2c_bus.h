@@ -2,7 +2,8 @@
 /*
  * I2C bus recovery, portable: the ports drive the two lines as open-drain GPIO through these
  * callbacks (the stm32f4 port its PB8/PB9 registers, the host port the register-level sensor
- * model of test/mpu6050_model.py), so the sequence a board runs is the one the host tests run.
+ * model of test/support/mpu6050_model.py), so the sequence a board runs is the one the host
+ * tests run.
  *
  * Why it is needed: a reset (of the board, or of the I2C peripheral) in the middle of a read
  * leaves the sensor half-way through a byte, holding SDA low for its next 0 bit while it waits
