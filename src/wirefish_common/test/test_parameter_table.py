@@ -107,7 +107,8 @@ def test_a_table_names_each_parameter_once():
 def test_a_table_judges_an_update_by_its_specs_then_its_rule():
     table = ParameterTable((RATE, COUNT), builds(_ordered_count))
     assert table.problem(table.defaults(), [('count', 7)]) is None
-    assert table.problem(table.defaults(), [('rate', 4.0), ('count', 7)]) == 'count must be <= rate'
+    reason = table.problem(table.defaults(), [('rate', 4.0), ('count', 7)])
+    assert reason == 'count must be <= rate'
     assert 'count' in table.problem(table.defaults(), [('count', 0)])
 
 
