@@ -25,7 +25,7 @@ from link_hosts import wait_for
 import numpy as np
 import pytest
 from wirefish_bringup.graph import Role
-from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
+from wirefish_cpg.cpg_node_parameters import TABLE as CPG_TABLE
 from wirefish_relay.crossing import default_crossing_file, load_crossing
 
 pytestmark = pytest.mark.ros
@@ -43,7 +43,7 @@ CUT_S = 10.0
 # be discovered again; data resumes with the next sample or resend.
 RECOVERY_BOUND_S = 15.0
 SERVO_GAP_BOUND_S = 0.25  # 25 periods at 100 Hz: a pause, not a scheduling hiccup
-SERVO_MIN_HZ = 0.95 * CPG_SPECS['publish_rate_hz'].default
+SERVO_MIN_HZ = 0.95 * CPG_TABLE.by_name['publish_rate_hz'].default
 REST_WITHIN_S = 3.0  # cmd_vel_timeout_s 0.5 + a control period + the CPG's parameter call
 RATE_WINDOW_S = 10.0
 SERVO_WINDOW_S = 5.0  # of driving before the cut

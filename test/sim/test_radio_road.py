@@ -4,8 +4,7 @@
 from pathlib import Path
 
 import pytest
-from wirefish_bridge.bridge_node_parameters import (check_combination, DriveMode as BridgeMode,
-                                                    PARAMETERS)
+from wirefish_bridge.bridge_node_parameters import DriveMode as BridgeMode, RULE, TABLE
 from wirefish_bringup.graph import fish_graph
 from wirefish_launcher.radio_road import (bridge_settings, DriveMode, Radio, RADIO_BRIDGE,
                                           RELAY_NAME, road_drive_mode, with_radio)
@@ -19,9 +18,9 @@ def test_the_launcher_names_what_the_relay_and_the_bridge_know():
 
 @pytest.mark.parametrize('radio', list(Radio))
 def test_each_preset_gives_the_bridge_values_it_accepts(radio):
-    values = {spec.name: spec.default for spec in PARAMETERS}
+    values = {spec.name: spec.default for spec in TABLE}
     values.update(bridge_settings(port=False, radio=radio, drive_mode=None))
-    assert check_combination(values) is None
+    assert RULE(values) is None
 
 
 def test_each_road_has_its_drive_mode():

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The parameters each registry entry's node declares, read from its ``declare(...)`` table."""
+"""The parameters each registry entry's node declares, read from its ``NodeParameters`` table."""
 
 import ast
 import importlib
@@ -15,14 +15,14 @@ _TABLES_OF_PROCESSES = {'fish_sim': ('wirefish_kinematics.geometry_parameters',
 
 
 def tables_declared_in(module: str) -> list[tuple[str, str]]:
-    """Return (module, name) of each table ``module`` passes to ``declare(self, NAME, ...)``."""
+    """Return (module, name) of each table ``module`` binds (``NodeParameters(self, NAME)``)."""
     package, name = module.split('.')
     tree = ast.parse((SRC / package / package / f'{name}.py').read_text(encoding='utf-8'))
     imported = {a.asname or a.name: n.module for n in ast.walk(tree)
                 if isinstance(n, ast.ImportFrom) for a in n.names}
     return [(imported.get(call.args[1].id, module), call.args[1].id) for call in ast.walk(tree)
             if isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
-            and call.func.id == 'declare' and len(call.args) >= 2
+            and call.func.id == 'NodeParameters' and len(call.args) >= 2
             and isinstance(call.args[1], ast.Name)]
 
 

@@ -11,7 +11,7 @@ from hypothesis import given, strategies as st
 import numpy as np
 import pytest
 import serial
-from wirefish_bridge.bridge_node_parameters import check_combination, PARAMETERS
+from wirefish_bridge.bridge_node_parameters import RULE, TABLE
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.conversions import diagonal_covariance, quaternion_from_rpy, \
     rpy_from_quaternion
@@ -21,7 +21,7 @@ from wirefish_bridge.transport import LinkDown, LinkState, LinkWriteError, next_
     SerialLink
 from wirefish_common.parameter_table import check_value
 
-SPECS = {spec.name: spec for spec in PARAMETERS}
+SPECS = TABLE.by_name
 
 
 def test_gate_forwards_at_most_max_rate_and_releases_the_newest_held_command():
@@ -131,19 +131,19 @@ def test_invalid_parameter_values_are_refused_with_a_reason(name, value):
 
 
 def test_backoff_limits_must_be_ordered():
-    values = {s.name: s.default for s in PARAMETERS}
-    assert check_combination(values) is None
+    values = {s.name: s.default for s in TABLE}
+    assert RULE(values) is None
     values['reconnect_backoff_max_s'] = 0.05
-    assert 'reconnect_backoff_max_s' in check_combination(values)
+    assert 'reconnect_backoff_max_s' in RULE(values)
 
 
 @pytest.mark.parametrize('tilt, yaw, consistent', [
     (0.0175, 0.1, True), (0.0, 0.0, True), (0.0, 0.1, False), (0.0175, 0.0, False),
 ])
 def test_orientation_stddevs_are_all_known_or_all_unknown(tilt, yaw, consistent):
-    values = {s.name: s.default for s in PARAMETERS}
+    values = {s.name: s.default for s in TABLE}
     values['orientation_stddev_rad'], values['yaw_stddev_rad'] = tilt, yaw
-    assert (check_combination(values) is None) == consistent
+    assert (RULE(values) is None) == consistent
 
 
 @pytest.mark.parametrize('status, fault', [(0, False), (int(Status.IMU_FAULT), True),

@@ -50,15 +50,13 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Vector3Stamped
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.timer import Timer
 from sensor_msgs.msg import BatteryState, Imu, JointState
 
-from wirefish_bridge.bridge_node_parameters import (check_combination, DriveMode, link_config,
+from wirefish_bridge.bridge_node_parameters import (DriveMode, link_config,
                                                     LINK_CONFIG_PARAMETERS, LINK_PARAMETERS,
-                                                    PARAMETERS, SPECS)
+                                                    TABLE)
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.command_gate import CommandGate, NEUTRAL
 from wirefish_bridge.gait_link import ConfigLink, GaitLink, GaitParameters, OscillatorWatch
@@ -77,7 +75,7 @@ from wirefish_common.cdr_views import CdrError, read_joint_state
 from wirefish_common.decimator import Decimator
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_angles
 from wirefish_msgs.msg import CpgParams
@@ -97,9 +95,9 @@ class BridgeNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, wire topics and timers, start the serial link."""
         super().__init__('bridge_node', **kwargs)
-        declare(self, PARAMETERS, check_combination)
+        self._node_parameters = NodeParameters(self, TABLE, self._apply)
         self._frame_prefix = declare_frame_prefix(self)  # fish_1 -> fish_1/imu_link
-        self._values = {s.name: self.get_parameter(s.name).value for s in PARAMETERS}
+        self._values = self._node_parameters.values  # live: a set is in it before _apply
         self._started = time.monotonic()  # the host's uptime in its HEARTBEAT: a process age
         self._graph_time = GraphTime()
         self._encoder = FrameEncoder()
@@ -135,19 +133,11 @@ class BridgeNode(Node):
         self.create_subscription(CpgParams, 'cpg_params', self._on_cpg_params, LATCHED)
         self._bridge_timers: dict[str, Timer] = {}
         self._make_timers()
-        self.add_on_set_parameters_callback(self._validate)
-        self.add_post_set_parameters_callback(self._apply)
         self._link = self._make_link()
         self._link.start()
 
     # --- parameters -------------------------------------------------------------------------
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        return validate_update(SPECS, self._values, parameters, check_combination)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        names = {p.name for p in parameters if p.name in SPECS}
-        for name in names:
-            self._values[name] = self.get_parameter(name).value
+    def _apply(self, names: frozenset[str]) -> None:
         self._gate.max_rate_hz = self._values['max_command_rate_hz']
         self._gate.timeout_s = self._values['command_timeout_s']
         self._gate.limit_rad = self._values['servo_limit_rad']

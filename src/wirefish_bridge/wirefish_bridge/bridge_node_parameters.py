@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Parameters of bridge_node: one table and the rules of their combination.
+Parameters of bridge_node: one table (``TABLE``) and the rule of their combination (``RULE``).
 
 Name, default, description and range of each; no rclpy, so the validation is testable without
 ROS.
@@ -16,7 +16,7 @@ from typing import Any
 from wirefish_bridge.protocol import (COAST_RANGE_MS, DEFAULT_BAUDRATE, HEALTH_PERIOD_RANGE_MS,
                                       LINK_TIMEOUT_RANGE_MS, LinkConfig,
                                       TELEMETRY_PERIOD_RANGE_MS, TelemetryForm)
-from wirefish_common.parameter_table import ParameterSpec
+from wirefish_common.parameter_table import ParameterSpec, ParameterTable, Rule
 
 
 class DriveMode(enum.StrEnum):
@@ -41,7 +41,7 @@ class TelemetryFormName(enum.StrEnum):
     COMPACT = 'compact'   # TELEMETRY_COMPACT, 38 bytes on the wire: for narrow radios
 
 
-PARAMETERS = (
+_SPECS = (
     ParameterSpec('port', '/dev/ttyUSB0', 'Serial device of the fish (a stable path such as '
                   '/dev/serial/by-id/... or the virtual fish symlink); reopened when it returns'),
     ParameterSpec('baudrate', DEFAULT_BAUDRATE, 'Serial baud rate', 1200, 4000000),
@@ -114,7 +114,6 @@ PARAMETERS = (
     ParameterSpec('divergence_window_s', 3.0,
                   'Gait mode: the window of the divergence check (s, a few periods)', 0.5, 60.0),
 )
-SPECS = {spec.name: spec for spec in PARAMETERS}
 LINK_PARAMETERS = {'port', 'baudrate', 'reconnect_backoff_min_s', 'reconnect_backoff_max_s',
                    'fish_identify_timeout_s'}
 LINK_CONFIG_PARAMETERS = {'telemetry_period_s', 'telemetry_form', 'health_period_s',
@@ -129,7 +128,7 @@ def link_config(values: Mapping[str, Any]) -> LinkConfig:
                       round(values['link_timeout_s'] * 1000.0), round(values['coast_s'] * 1000.0))
 
 
-def check_combination(values: Mapping[str, Any]) -> str | None:
+def _combination_problem(values: Mapping[str, Any]) -> str | None:
     """Return why a full set of parameter values is inconsistent, or None."""
     if values['reconnect_backoff_max_s'] < values['reconnect_backoff_min_s']:
         return 'reconnect_backoff_max_s must be >= reconnect_backoff_min_s'
@@ -143,3 +142,7 @@ def check_combination(values: Mapping[str, Any]) -> str | None:
             return (f'{name} must be one of {", ".join(member.value for member in kind)}, '
                     f'got {values[name]!r}')
     return link_config(values).problem()
+
+
+RULE: Rule = _combination_problem
+TABLE = ParameterTable(_SPECS, RULE)

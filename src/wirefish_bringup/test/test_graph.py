@@ -5,11 +5,11 @@ import ast
 from pathlib import Path
 
 import pytest
-from wirefish_bridge.bridge_node_parameters import SPECS as BRIDGE_SPECS
+from wirefish_bridge.bridge_node_parameters import TABLE as BRIDGE_TABLE
 from wirefish_bringup.graph import (combined_policy, composable_entries, entries, expected_rates,
                                     fish_graph, NODES, NodeSpec, RestartBudget, RestartPolicy,
                                     Role, sim_tty_link, validate_namespace)
-from wirefish_cpg.cpg_node_parameters import SPECS as CPG_SPECS
+from wirefish_cpg.cpg_node_parameters import TABLE as CPG_TABLE
 
 LAUNCH_FILE = Path(__file__).resolve().parents[1] / 'launch' / 'wirefish.launch.py'
 
@@ -71,8 +71,8 @@ def test_every_node_class_names_a_module_and_a_class():
 
 def test_servo_cmd_is_expected_at_the_rate_the_bridge_forwards_to_the_board():
     nominal, _ = expected_rates(sim=True)
-    assert nominal['servo_cmd'] == CPG_SPECS['publish_rate_hz'].default
-    assert nominal['servo_cmd'] == BRIDGE_SPECS['max_command_rate_hz'].default
+    assert nominal['servo_cmd'] == CPG_TABLE.by_name['publish_rate_hz'].default
+    assert nominal['servo_cmd'] == BRIDGE_TABLE.by_name['max_command_rate_hz'].default
 
 
 def test_the_expected_rates_are_the_registry_streams():

@@ -6,7 +6,8 @@ import math
 import pytest
 from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.parameter import Parameter
-from wirefish_common.parameter_table import (check_value, merged_update, ParameterSpec,
+from wirefish_common.parameter_table import (builds, check_value, merged_update,
+                                             no_combination, ParameterSpec, ParameterTable,
                                              validate_update, wrong_type_reason)
 
 RATE = ParameterSpec('rate', 50.0, 'a rate (Hz)', 0.0, 100.0, low_exclusive=True)
@@ -90,3 +91,28 @@ def test_a_wrong_type_message_of_another_form_is_kept_whole():
     line = wrong_type_reason('a_node', RATE, 'something else went wrong')
     assert line == ('a_node: parameter rate must be a double (default 50.0): '
                     'something else went wrong')
+
+
+def _ordered_count(values):
+    if values['count'] > values['rate']:
+        raise ValueError('count must be <= rate')
+    return values['count']
+
+
+def test_a_table_names_each_parameter_once():
+    with pytest.raises(ValueError, match='parameters named twice in one table: rate'):
+        ParameterTable((RATE, COUNT, RATE))
+
+
+def test_a_table_judges_an_update_by_its_specs_then_its_rule():
+    table = ParameterTable((RATE, COUNT), builds(_ordered_count))
+    assert table.problem(table.defaults(), [('count', 7)]) is None
+    reason = table.problem(table.defaults(), [('rate', 4.0), ('count', 7)])
+    assert reason == 'count must be <= rate'
+    assert 'count' in table.problem(table.defaults(), [('count', 0)])
+
+
+def test_a_table_without_a_combination_judges_each_value_alone():
+    table = ParameterTable((RATE, COUNT))
+    assert table.rule is no_combination and table.names == ('rate', 'count')
+    assert table.problem(table.defaults(), [('rate', 1.0), ('count', 10)]) is None

@@ -3,18 +3,23 @@
 ROS parameters from one table: declaration with descriptors, and pure validation.
 
 Each ``ParameterSpec`` is a name, a default (its type is the parameter's type), a description
-and, for numbers, an inclusive range with an optional strict lower bound. ``check_value`` is the
-pure validation a node runs in its ``add_on_set_parameters_callback``; ``declare`` builds the
-``ParameterDescriptor`` with the matching ``FloatingPointRange`` / ``IntegerRange``. No rclpy
-import at module level, so the validation is testable without ROS.
+and, for numbers, an inclusive range with an optional strict lower bound. A node's
+``ParameterTable`` is its specs and the ``Rule`` of their combination (``<node>_parameters``
+exports it as ``TABLE``, the rule as ``RULE``). ``NodeParameters`` is the one way a node takes
+its table: it declares every spec (``declare``: a ``ParameterDescriptor`` with the matching
+``FloatingPointRange`` / ``IntegerRange``), keeps the current values, judges every update
+whole against the specs and the rule (``update_problem``: refused with the reason, nothing
+changed) and hands the accepted names to the node. No rclpy import at module level, so the
+tables and their validation are testable without ROS.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
 import math
 import re
+from types import MappingProxyType
 from typing import Any, TYPE_CHECKING
 
 if TYPE_CHECKING:  # rclpy only for the type checker: the validation stays importable without it
@@ -23,6 +28,9 @@ if TYPE_CHECKING:  # rclpy only for the type checker: the validation stays impor
 
 # Judges a whole set of values (see validate_update): a reason, or anything else for "fine".
 Combination = Callable[[dict[str, object]], object]
+# The rule of a table's combination: why a whole set of values (name -> value, every name of the
+# table) is refused, or None. Pure, so a refusal is testable without a node.
+Rule = Callable[[Mapping[str, Any]], str | None]
 
 
 @dataclass(frozen=True)
@@ -185,3 +193,128 @@ def update_problem(specs: dict[str, ParameterSpec], current: dict[str, object],
         except ValueError as error:
             reason = str(error)
     return reason
+
+
+def no_combination(values: Mapping[str, Any]) -> str | None:
+    """Return None: the rule of a table whose values each stand alone (their specs judge them)."""
+    return None
+
+
+def builds(build: Callable[[Mapping[str, Any]], object]) -> Rule:
+    """
+    Return the rule "``build(values)`` succeeds": the message of its ``ValueError`` is the reason.
+
+    For a table whose values make one object together (``CpgParameters``, ``FishGeometry``, a
+    ``Planner``): the object's own checks are the combination's, written once.
+    """
+    def rule(values: Mapping[str, Any]) -> str | None:
+        try:
+            build(values)
+        except ValueError as error:
+            return str(error)
+        return None
+
+    rule.__name__ = rule.__qualname__ = f'builds({getattr(build, "__name__", build)})'
+    return rule
+
+
+@dataclass(frozen=True)
+class ParameterTable:
+    """A node's parameters: the specs in declaration order, and the rule of their combination."""
+
+    specs: tuple[ParameterSpec, ...]
+    rule: Rule = no_combination
+    by_name: Mapping[str, ParameterSpec] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        """Refuse a name given twice (the node could not declare it); index the specs by name."""
+        names = [spec.name for spec in self.specs]
+        repeated = sorted({name for name in names if names.count(name) > 1})
+        if repeated:
+            raise ValueError(f'parameters named twice in one table: {", ".join(repeated)}')
+        object.__setattr__(self, 'by_name',
+                           MappingProxyType({spec.name: spec for spec in self.specs}))
+
+    def __iter__(self) -> Iterator[ParameterSpec]:
+        """Iterate over the specs, in declaration order."""
+        return iter(self.specs)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Return the parameters' names, in declaration order."""
+        return tuple(spec.name for spec in self.specs)
+
+    def defaults(self) -> dict[str, Any]:
+        """Return the parameters' defaults by name."""
+        return {spec.name: spec.default for spec in self.specs}
+
+    def problem(self, current: Mapping[str, object],
+                updates: Sequence[tuple[str, object]]) -> str | None:
+        """Return why ``updates`` of ``current`` are refused (values, then the rule), or None."""
+        return update_problem(dict(self.by_name), dict(current), list(updates), self.rule)
+
+
+class NodeParameters:
+    """
+    The parameters of one ``ParameterTable`` on one node: declared, kept, judged and applied.
+
+    Building it declares the table (``declare``: a refused start-up value raises
+    ``InvalidParameters``) and keeps the values the node starts with. Then every update is
+    judged whole, each value against its spec and then the table's rule over the values it
+    would make; a refused one changes nothing and its reason is the answer. An accepted one is
+    kept here first, then ``on_change`` gets the names of the table it changed (never an empty
+    set: ``use_sim_time`` or ``frame_prefix`` alone are not the table's). The callbacks are
+    registered after the declaration: rclpy runs them on every ``declare_parameter`` too, and a
+    name outside the table (``frame_prefix`` declared later) is left to rclpy.
+    """
+
+    def __init__(self, node: Node, table: ParameterTable,
+                 on_change: Callable[[frozenset[str]], None] | None = None) -> None:
+        """Declare ``table`` on ``node``, keep its values, register the set callbacks."""
+        declare(node, table.specs, table.rule)
+        self.table = table
+        self._node = node
+        self._specs = dict(table.by_name)
+        self._current: dict[str, Any] = {
+            name: node.get_parameter(name).value for name in table.names}
+        # Read-only and live: whoever holds it reads the values as they are now.
+        self.values: Mapping[str, Any] = MappingProxyType(self._current)
+        self._on_change = on_change
+        node.add_on_set_parameters_callback(self._judge)
+        node.add_post_set_parameters_callback(self._take)
+
+    def _judge(self, parameters: list[Parameter]) -> Any:
+        return validate_update(self._specs, self._current, parameters, self.table.rule)
+
+    def _take(self, parameters: list[Parameter]) -> None:
+        names = frozenset(p.name for p in parameters if p.name in self._specs)
+        for name in names:
+            self._current[name] = self._node.get_parameter(name).value
+        if names and self._on_change is not None:
+            self._on_change(names)
+
+    def _typed(self, name: str, kind: type) -> Any:
+        spec = self.table.by_name.get(name)
+        if spec is None:
+            raise KeyError(f'{name} is no parameter of this table')
+        if type(spec.default) is not kind:
+            raise TypeError(f'{name} is {_article(ROS_TYPE_NAMES[type(spec.default)])} '
+                            f'{ROS_TYPE_NAMES[type(spec.default)]} parameter, not '
+                            f'{_article(ROS_TYPE_NAMES[kind])} {ROS_TYPE_NAMES[kind]}')
+        return self._current[name]
+
+    def float_value(self, name: str) -> float:
+        """Return the current value of the double parameter ``name``."""
+        return float(self._typed(name, float))
+
+    def int_value(self, name: str) -> int:
+        """Return the current value of the integer parameter ``name``."""
+        return int(self._typed(name, int))
+
+    def bool_value(self, name: str) -> bool:
+        """Return the current value of the bool parameter ``name``."""
+        return bool(self._typed(name, bool))
+
+    def str_value(self, name: str) -> str:
+        """Return the current value of the string parameter ``name``."""
+        return str(self._typed(name, str))

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from wirefish_common.parameter_table import update_problem
 from wirefish_cpg.cpg_control import CpgTargets, TargetSource
-from wirefish_cpg.cpg_node_parameters import (flat_values, NODE_PARAMETERS, parameters_from,
-                                              SPECS)
+from wirefish_cpg.cpg_node_parameters import flat_values, parameters_from, TABLE
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_cpg.table1_gait import table1_locked_at
 
-VALUES = {spec.name: spec.default for spec in NODE_PARAMETERS}
+VALUES = TABLE.defaults()
+SPECS = TABLE.by_name
 TURNING = CpgParameters(frequency_hz=1.5, amplitude=(0.3, 0.4), offset=(0.1, 0.1))
 # The planner drive test's smoothness bound on servo_cmd (test/planner/test_planner_graph.py):
 # between two samples no more than the larger reported rate allows plus the CPG's largest

@@ -9,9 +9,10 @@ import pytest
 from wirefish_common.parameter_table import check_value
 from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.cpg_node_parameters import (CPG_PARAMETER_NAMES, CPG_PARAMETERS, flat_values,
-                                              parameters_from, SPECS)
+                                              parameters_from, TABLE)
 from wirefish_cpg.oscillator import at_rest, CpgParameters
 
+SPECS = TABLE.by_name
 TURNING = CpgParameters(frequency_hz=2.5, amplitude=(0.3, -0.2), offset=(0.1, -0.05),
                         w12=1.5, w21=-2.0, phi12=-0.5, phi21=2.0, alpha=30.0)
 

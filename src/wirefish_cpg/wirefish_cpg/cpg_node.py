@@ -40,20 +40,17 @@ from __future__ import annotations
 
 import threading
 
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.timer import Timer
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import COMMAND, LATCHED, SENSOR_DATA
 from wirefish_common.servo_joints import servo_joint_state
 from wirefish_cpg.cpg_control import CpgTargets, TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values, to_message
-from wirefish_cpg.cpg_node_parameters import (CPG_PARAMETER_NAMES, NODE_PARAMETERS,
-                                              parameters_from, SPECS)
+from wirefish_cpg.cpg_node_parameters import CPG_PARAMETER_NAMES, TABLE
 from wirefish_cpg.fixed_rate import FixedRateLoop
 from wirefish_cpg.oscillator import at_rest, CpgIntegrator, CpgParameters
 from wirefish_cpg.servo_limit import clamp_to_limit
@@ -69,9 +66,9 @@ class CpgNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, wire the topics and services, start the publish loop."""
         super().__init__('cpg_node', **kwargs)
-        declare(self, NODE_PARAMETERS, parameters_from)
-        self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
-        self._control = CpgTargets(SPECS, self._values, self.get_fully_qualified_name())
+        self._node_parameters = NodeParameters(self, TABLE, self._apply)
+        self._values = self._node_parameters.values  # live: a set is in it before _apply
+        self._control = CpgTargets(TABLE.by_name, self._values, self.get_fully_qualified_name())
         self._running = bool(self._values['autostart'])
         params = self._runs()
         # The CPG is stepped on the loop's thread and re-parameterised on the executor's.
@@ -92,8 +89,6 @@ class CpgNode(Node):
         self.create_service(Trigger, 'stop', self._on_stop)
         self.create_service(Trigger, '~/follow_commands', self._on_follow_commands)
         self.create_subscription(CpgCommand, 'cpg_command', self._on_command, COMMAND)
-        self.add_on_set_parameters_callback(self._validate)
-        self.add_post_set_parameters_callback(self._apply)
         self._params_pub.publish(to_message(params))
         self._publish_status()
         period_s = 1.0 / self._values['publish_rate_hz']
@@ -119,16 +114,9 @@ class CpgNode(Node):
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        # Every value, then the CpgParameters they make together (its ValueError is the reason).
-        return validate_update(SPECS, self._values, parameters, parameters_from)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        names = {p.name for p in parameters if p.name in SPECS}
+    def _apply(self, names: frozenset[str]) -> None:
         params = None
         with self._lock:
-            for name in names:
-                self._values[name] = self.get_parameter(name).value
             if 'integration_step_s' in names:
                 self._cpg.step_s = float(self._values['integration_step_s'])
             if 'publish_rate_hz' in names:

@@ -7,9 +7,10 @@ become ``amplitude_1``/``amplitude_2`` and ``offset_1``/``offset_2``; the scalar
 field names. ``flat_values`` and ``parameters_from`` are the one mapping between the two (the
 latter also the rule of the parameters' combination). ``CPG_PARAMETERS`` gives each flat name
 its range and description; its defaults are those of ``CpgParameters()`` (Table 1 of the paper,
-v = 1 Hz, alpha = 20, b = 0), written only there. ``NODE_PARAMETERS`` adds what drives the
-node's publish loop. Validation and declaration are the shared ones of ``wirefish_common``; the
-cpg node, the tuner, the planner and pure tests share this module.
+v = 1 Hz, alpha = 20, b = 0), written only there. The node's ``TABLE`` adds what drives its
+publish loop; its ``RULE`` is that the values make a ``CpgParameters``. Validation and
+declaration are the shared ones of ``wirefish_common.parameter_table``; the cpg node, the
+tuner, the planner and pure tests share this module.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
-from wirefish_common.parameter_table import ParameterSpec
+from wirefish_common.parameter_table import builds, ParameterSpec, ParameterTable, Rule
 from wirefish_cpg.oscillator import CpgParameters
 
 HALF_PI = math.pi / 2
@@ -80,7 +81,8 @@ _SPEC_OF = {
 CPG_PARAMETERS = tuple(
     ParameterSpec(name, _DEFAULT[name], description, low, high, low_exclusive=exclusive)
     for name, (description, low, high, exclusive) in _SPEC_OF.items())
-NODE_PARAMETERS = CPG_PARAMETERS + (
+RULE: Rule = builds(parameters_from)
+TABLE = ParameterTable(CPG_PARAMETERS + (
     # The default is the rate the fish receives: the bridge forwards at most its
     # max_command_rate_hz (100 Hz) to the board, so a faster stream is paid for by every
     # subscriber and then dropped at the gate. eq 1 is integrated at integration_step_s
@@ -93,5 +95,4 @@ NODE_PARAMETERS = CPG_PARAMETERS + (
     ParameterSpec('servo_limit_rad', math.pi / 2, 'Servo angle limit; outputs are clamped (rad)',
                   0.0, math.pi, low_exclusive=True),
     ParameterSpec('autostart', True, 'Start oscillating at launch (else wait for start)'),
-)
-SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
+), RULE)

@@ -8,7 +8,9 @@ import pytest
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.geometry_parameters import (BODY_WAVE_GEOMETRY_FIELDS, geometry_from,
                                                      geometry_parameters)
-from wirefish_kinematics.kinematics_node_parameters import SPECS
+from wirefish_kinematics.kinematics_node_parameters import TABLE
+
+SPECS = TABLE.by_name
 
 
 def test_the_geometry_block_declares_the_fields_asked_for_with_the_node_specs():

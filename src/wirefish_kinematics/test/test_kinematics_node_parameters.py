@@ -9,8 +9,10 @@ import pytest
 from wirefish_common.parameter_table import check_value
 from wirefish_kinematics.geometry import FishGeometry, GEOMETRY_FIELDS
 from wirefish_kinematics.geometry_parameters import geometry_from
-from wirefish_kinematics.kinematics_node_parameters import SPECS, wave_from, WAVE_PARAMETER_NAMES
+from wirefish_kinematics.kinematics_node_parameters import TABLE, wave_from, WAVE_PARAMETER_NAMES
 from wirefish_kinematics.wave_spec import WaveSpec
+
+SPECS = TABLE.by_name
 
 
 def test_every_parameter_has_a_description_and_its_default_is_valid():

@@ -2,7 +2,9 @@
 """markers_every: body_wave_markers go out with every n-th body_wave."""
 
 import pytest
-from wirefish_kinematics.kinematics_node_parameters import markers_every, SPECS
+from wirefish_kinematics.kinematics_node_parameters import markers_every, TABLE
+
+SPECS = TABLE.by_name
 
 
 @pytest.mark.parametrize(('publish_hz', 'markers_hz', 'every'), [

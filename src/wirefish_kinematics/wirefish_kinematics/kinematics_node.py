@@ -33,9 +33,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 from wirefish_common.batch_intake import BatchIntake, intake_qos
@@ -43,7 +41,7 @@ from wirefish_common.cdr_views import CdrError, read_joint_state
 from wirefish_common.decimator import Decimator
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import validate_update
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_sample
 from wirefish_kinematics.desired_wave import desired_wave_at_phase
@@ -51,8 +49,7 @@ from wirefish_kinematics.geometry import GEOMETRY_FIELDS
 from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_kinematics.kinematics_messages import (body_wave_markers, body_wave_message, FRAME,
                                                      speed_estimate_message, to_stamp)
-from wirefish_kinematics.kinematics_node_parameters import (declare, markers_every,
-                                                            NODE_PARAMETERS, SPECS, wave_from,
+from wirefish_kinematics.kinematics_node_parameters import (markers_every, TABLE, wave_from,
                                                             WAVE_PARAMETER_NAMES)
 from wirefish_kinematics.tail_beat_tracker import TailBeatTracker
 from wirefish_kinematics.tail_shape import tail_shape
@@ -72,9 +69,9 @@ class KinematicsNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters; wire subscriptions, publishers and the publish timer."""
         super().__init__('kinematics_node', **kwargs)
-        declare(self, NODE_PARAMETERS)
+        self._node_parameters = NodeParameters(self, TABLE, self._apply)
         self._frame = prefixed(declare_frame_prefix(self), FRAME)  # fish_1/tail_base
-        self._values = {s.name: self.get_parameter(s.name).value for s in NODE_PARAMETERS}
+        self._values = self._node_parameters.values  # live: a set is in it before _apply
         self._geometry = geometry_from(self._values)
         self._target = wave_from(self._values)
         self._tracker = TailBeatTracker(self._values['max_tail_beat_period_s'])
@@ -95,18 +92,9 @@ class KinematicsNode(Node):
         self._servo_sub: BatchIntake | None = None
         self._subscribe_servo()
         self._timer = self.create_timer(1.0 / self._values['publish_rate_hz'], self._on_tick)
-        self.add_on_set_parameters_callback(self._validate)
-        self.add_post_set_parameters_callback(self._apply)
 
     # --- parameters -----------------------------------------------------------------------
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        # Every value, then the geometry they make together (its ValueError is the reason).
-        return validate_update(SPECS, self._values, parameters, geometry_from)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        names = {p.name for p in parameters if p.name in SPECS}
-        for name in names:
-            self._values[name] = self.get_parameter(name).value
+    def _apply(self, names: frozenset[str]) -> None:
         if names & set(GEOMETRY_FIELDS):
             self._geometry = geometry_from(self._values)
             self._fresh = self._latest is not None

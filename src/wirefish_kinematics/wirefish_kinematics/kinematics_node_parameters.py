@@ -3,16 +3,15 @@
 The kinematics node's parameters as one table (no rclpy import).
 
 The geometry comes from the graph's one geometry block (``geometry_parameters``); the
-``wave_*`` defaults are ``WaveSpec()``'s. Validation and declaration are the shared ones of
-``wirefish_common.parameter_table``.
+``wave_*`` defaults are ``WaveSpec()``'s. ``RULE``: the values make a ``FishGeometry``.
+Validation and declaration are the shared ones of ``wirefish_common.parameter_table``.
 """
 
 from __future__ import annotations
 
 from typing import Any, Mapping
 
-from wirefish_common.parameter_table import declare as declare_specs, ParameterSpec
-from wirefish_kinematics.geometry import GEOMETRY_FIELDS
+from wirefish_common.parameter_table import builds, ParameterSpec, ParameterTable, Rule
 from wirefish_kinematics.geometry_parameters import geometry_from, GEOMETRY_PARAMETERS
 from wirefish_kinematics.wave_spec import WaveSpec
 
@@ -29,7 +28,8 @@ WAVE_PARAMETERS = (
     ParameterSpec('wave_frequency_hz', _WAVE.frequency_hz, 'Desired wave frequency (Hz), eq 23',
                   0.0, 10.0, low_exclusive=True),
 )
-NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
+RULE: Rule = builds(geometry_from)
+TABLE = ParameterTable(GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
     ParameterSpec('station_count', 50, 'Stations along the tail in body_wave', 2, 1000),
     ParameterSpec('publish_rate_hz', 50.0, 'Rate of body_wave (Hz)', 0.1, 500.0),
     ParameterSpec('markers_rate_hz', 10.0,
@@ -40,8 +40,7 @@ NODE_PARAMETERS = GEOMETRY_PARAMETERS + WAVE_PARAMETERS + (
     ParameterSpec('max_tail_beat_period_s', 2.5,
                   'Longest tail-beat period detected (s); samples of twice this are kept',
                   0.1, 20.0),
-)
-SPECS = {spec.name: spec for spec in NODE_PARAMETERS}
+), RULE)
 
 
 def markers_every(publish_rate_hz: float, markers_rate_hz: float) -> int:
@@ -58,9 +57,3 @@ def markers_every(publish_rate_hz: float, markers_rate_hz: float) -> int:
 def wave_from(values: Mapping[str, Any]) -> WaveSpec:
     """Return the WaveSpec of the ``wave_*`` parameters in a name -> value mapping."""
     return WaveSpec(**{field: values[name] for name, field in WAVE_PARAMETER_NAMES.items()})
-
-
-def declare(node, specs: tuple[ParameterSpec, ...] = NODE_PARAMETERS) -> None:
-    """Declare the kinematics node's parameters (all of them by default) on ``node``."""
-    combination = geometry_from if set(GEOMETRY_FIELDS) <= {s.name for s in specs} else None
-    declare_specs(node, specs, combination)

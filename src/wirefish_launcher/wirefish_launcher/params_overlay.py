@@ -24,17 +24,17 @@ import re
 from typing import Any
 
 PARAMETERS_KEY = 'ros__parameters'
-# Where each registry node's parameter table is (module, attribute: a tuple of ParameterSpec, or
-# a function returning one); the parameters every rclpy node takes are added to all of them.
+# Where each registry node's parameter table is (module, attribute: its ParameterTable, or a
+# function returning ParameterSpecs); the parameters every rclpy node takes are added to all.
 PARAMETER_TABLES: dict[str, tuple[str, str]] = {
     'fish_sim': ('wirefish_kinematics.geometry_parameters', 'geometry_parameters'),
-    'bridge_node': ('wirefish_bridge.bridge_node_parameters', 'PARAMETERS'),
-    'cpg_node': ('wirefish_cpg.cpg_node_parameters', 'NODE_PARAMETERS'),
-    'kinematics_node': ('wirefish_kinematics.kinematics_node_parameters', 'NODE_PARAMETERS'),
-    'tf_node': ('wirefish_tf.tf_node_parameters', 'TF_PARAMETERS'),
-    'planner_node': ('wirefish_planner.planner_node_parameters', 'PLANNER_PARAMETERS'),
-    'tuner_node': ('wirefish_tuner.tuner_node_parameters', 'TUNER_PARAMETERS'),
-    'view_node': ('wirefish_view.view_node_parameters', 'VIEW_PARAMETERS'),
+    'bridge_node': ('wirefish_bridge.bridge_node_parameters', 'TABLE'),
+    'cpg_node': ('wirefish_cpg.cpg_node_parameters', 'TABLE'),
+    'kinematics_node': ('wirefish_kinematics.kinematics_node_parameters', 'TABLE'),
+    'tf_node': ('wirefish_tf.tf_node_parameters', 'TABLE'),
+    'planner_node': ('wirefish_planner.planner_node_parameters', 'TABLE'),
+    'tuner_node': ('wirefish_tuner.tuner_node_parameters', 'TABLE'),
+    'view_node': ('wirefish_view.view_node_parameters', 'TABLE'),
 }
 EVERY_NODE = frozenset({'use_sim_time', 'frame_prefix', 'start_type_description_service'})
 

@@ -20,7 +20,7 @@ from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_planner.gait_choice import GaitLimits, GaitPlanner, Table1Family
 from wirefish_planner.planner_config import planner_from
 from wirefish_planner.planner_core import Planner
-from wirefish_planner.planner_node_parameters import default_values
+from wirefish_planner.planner_node_parameters import TABLE
 from wirefish_sim.faults import disturb, Disturbance
 from wirefish_sim.virtual_fish import SimConfig, VirtualFish
 
@@ -120,7 +120,7 @@ def gait_planner() -> GaitPlanner:
 def make_planner():
     """Return ``make(**parameter overrides) -> Planner`` on the node's defaults."""
     def make(**overrides) -> Planner:
-        return planner_from({**default_values(), **overrides})
+        return planner_from({**TABLE.defaults(), **overrides})
     return make
 
 

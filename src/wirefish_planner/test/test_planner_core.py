@@ -144,11 +144,11 @@ def test_the_command_topic_is_in_the_cpg_nodes_namespace(name, topic):
 def turn_and_hold(closed_loop):
     """One in-process drive with a 0.05 rad/s current: straight, left, right, straight."""
     from wirefish_planner.planner_config import planner_from
-    from wirefish_planner.planner_node_parameters import default_values
+    from wirefish_planner.planner_node_parameters import TABLE
 
     leg = closed_loop.Leg
     legs = [leg(6.0, 0.2), leg(8.0, 0.2, 0.2), leg(8.0, 0.2, -0.2), leg(16.0, 0.2)]
-    return closed_loop.run_legs(planner_from(default_values()), legs,
+    return closed_loop.run_legs(planner_from(TABLE.defaults()), legs,
                                 Disturbance(yaw_rate_rad_s=0.05))
 
 
@@ -172,10 +172,10 @@ def test_in_process_servo_commands_never_step(turn_and_hold):
 
 
 def test_the_default_turn_gain_is_what_the_in_process_fish_identifies(turn_and_hold):
-    from wirefish_planner.planner_node_parameters import default_values
+    from wirefish_planner.planner_node_parameters import TABLE
     from wirefish_planner.yaw_control import identify_turn_gain, steady_means
 
     tr = turn_and_hold
     gain, bias = identify_turn_gain(*steady_means(tr.t, tr.speed, tr.offset, tr.yaw_rate))
-    assert gain == pytest.approx(default_values()['turn_gain'], rel=0.15)
+    assert gain == pytest.approx(TABLE.defaults()['turn_gain'], rel=0.15)
     assert bias == pytest.approx(0.05, abs=0.02)  # the current

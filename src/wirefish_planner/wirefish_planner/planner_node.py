@@ -46,16 +46,14 @@ import math
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.task import Future
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Trigger
 from wirefish_common.batch_intake import BatchIntake, intake_qos
 from wirefish_common.cdr_views import CdrError, read_imu
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import COMMAND, LATCHED, RELIABLE
 from wirefish_cpg.cpg_control import TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values
@@ -63,7 +61,7 @@ from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
 from wirefish_planner.planner_config import (command_targets, cpg_topic, cpg_values,
                                              planner_from, values_changed)
 from wirefish_planner.planner_core import ignored_fields, PlannerMode, PlannerOutput
-from wirefish_planner.planner_node_parameters import PLANNER_PARAMETERS, SPECS
+from wirefish_planner.planner_node_parameters import TABLE
 from wirefish_planner.yaw_control import yaw_from_quaternion
 
 DIAGNOSTICS_PERIOD_S = 1.0
@@ -82,8 +80,8 @@ class PlannerNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, build the planner, wire topics and timers."""
         super().__init__('planner_node', **kwargs)
-        declare(self, PLANNER_PARAMETERS, planner_from)
-        self._values = {s.name: self.get_parameter(s.name).value for s in PLANNER_PARAMETERS}
+        self._node_parameters = NodeParameters(self, TABLE, self._apply)
+        self._values = self._node_parameters.values  # live: a set is in it before _apply
         self._planner = planner_from(self._values)
         self._said_ignored: set[str] = set()
         self._last_cmd_s: float | None = None
@@ -103,8 +101,6 @@ class PlannerNode(Node):
         self._subscribe_imu()
         self._state_pub = self.create_publisher(PlannerState, 'planner_state', RELIABLE)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
-        self.add_on_set_parameters_callback(self._validate)
-        self.add_post_set_parameters_callback(self._apply)
         self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                 self._on_control)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._on_diagnostics)
@@ -113,13 +109,7 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     # --- parameters -----------------------------------------------------------------------
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        return validate_update(SPECS, self._values, parameters, planner_from)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        names = {p.name for p in parameters if p.name in SPECS}
-        for name in names:
-            self._values[name] = self.get_parameter(name).value
+    def _apply(self, names: frozenset[str]) -> None:
         if names - {'control_rate_hz', 'cpg_node_name'}:
             self._planner.reconfigure(planner_from(self._values))
         if 'control_rate_hz' in names:

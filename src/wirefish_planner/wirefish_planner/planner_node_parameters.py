@@ -4,25 +4,26 @@ The planner node's parameters as one table (no rclpy import).
 
 The fish's geometry is the graph's one geometry block (``geometry_parameters``): eq 18 needs
 it. Defaults are those of ``GaitLimits()``, ``YawGains()`` and ``WaveSpec()``. The rule of
-their combination is ``planner_config.planner_from``; validation and declaration are the shared
-ones of ``wirefish_common.parameter_table``.
+their combination (``RULE``) is that ``planner_config.planner_from`` builds a planner of them;
+validation and declaration are the shared ones of ``wirefish_common.parameter_table``.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
 
-from wirefish_common.parameter_table import ParameterSpec
+from wirefish_common.parameter_table import builds, ParameterSpec, ParameterTable, Rule
 from wirefish_cpg.gait_library import default_library_path
 from wirefish_kinematics.geometry_parameters import geometry_parameters
 from wirefish_kinematics.wave_spec import WaveSpec
 from wirefish_planner.gait_choice import GaitLimits
+from wirefish_planner.planner_config import planner_from
 from wirefish_planner.yaw_control import YawGains
 
 HALF_PI = math.pi / 2
 _LIMITS, _GAINS, _WAVE = GaitLimits(), YawGains(), WaveSpec()
-PLANNER_PARAMETERS = (
+RULE: Rule = builds(planner_from)
+TABLE = ParameterTable((
     ParameterSpec('cpg_node_name', 'cpg_node',
                   'Name (relative or absolute) of the CPG node the planner drives'),
     ParameterSpec('cmd_vel_timeout_s', 0.5,
@@ -84,10 +85,4 @@ PLANNER_PARAMETERS = (
     ParameterSpec('rest_at_start', True,
                   'Rest the CPG at start-up (no cmd_vel yet: the fish rests); false: leave '
                   'cpg_node as it is until the first cmd_vel'),
-) + geometry_parameters()  # eq 18 needs the fish's geometry: the graph's one /** block
-SPECS = {spec.name: spec for spec in PLANNER_PARAMETERS}
-
-
-def default_values() -> dict[str, Any]:
-    """Return the parameters' defaults by name."""
-    return {spec.name: spec.default for spec in PLANNER_PARAMETERS}
+) + geometry_parameters(), RULE)  # eq 18 needs the fish's geometry: the graph's /** block

@@ -8,16 +8,17 @@ import pytest
 from wirefish_common.parameter_table import check_value
 from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.geometry_parameters import geometry_parameters
-from wirefish_tf.tf_node_parameters import (consistent_geometry, GEOMETRY_NAMES, SPECS,
-                                            TF_PARAMETERS)
+from wirefish_tf.tf_node_parameters import consistent_geometry, GEOMETRY_NAMES, TABLE
+
+SPECS = TABLE.by_name
 
 
 def _defaults():
-    return {spec.name: spec.default for spec in TF_PARAMETERS}
+    return {spec.name: spec.default for spec in TABLE}
 
 
 def test_every_parameter_has_a_description_and_its_default_is_valid():
-    for spec in TF_PARAMETERS:
+    for spec in TABLE:
         assert spec.description
         assert check_value(spec, spec.default) is None, spec.name
 

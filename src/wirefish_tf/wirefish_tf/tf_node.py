@@ -31,15 +31,13 @@ import math
 
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from sensor_msgs.msg import Imu
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, RELIABLE, reliable, SENSOR_DATA, TF, TF_STATIC
 from wirefish_kinematics.geometry_parameters import geometry_from
 from wirefish_msgs.msg import BodyWave, SpeedEstimate
@@ -47,8 +45,7 @@ from wirefish_tf.frames import (dead_reckoned, Frame, OdomSource, PlanarPose, qu
                                 tail_base_in_base_link, tail_frames)
 from wirefish_tf.model import fish_urdf
 from wirefish_tf.tf_messages import tf_message, transform
-from wirefish_tf.tf_node_parameters import (consistent_geometry, GEOMETRY_NAMES, SPECS,
-                                            TF_PARAMETERS)
+from wirefish_tf.tf_node_parameters import GEOMETRY_NAMES, TABLE
 
 
 # A second of the virtual fish's 50 Hz ground truth: a tf_node starved for a moment on a
@@ -66,10 +63,10 @@ class TfNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters; wire /tf, /tf_static and the subscriptions."""
         super().__init__('tf_node', **kwargs)
-        declare(self, TF_PARAMETERS, consistent_geometry)
+        self._node_parameters = NodeParameters(self, TABLE, self._apply)
         prefix = declare_frame_prefix(self)
         self._frame = {frame: prefixed(prefix, frame.value) for frame in Frame}
-        self._values = {s.name: self.get_parameter(s.name).value for s in TF_PARAMETERS}
+        self._values = self._node_parameters.values  # live: a set is in it before _apply
         self._geometry = geometry_from(self._values, GEOMETRY_NAMES)
         self._source = OdomSource(self._values['odom_source'])
         self._heard_ground_truth = False
@@ -86,18 +83,10 @@ class TfNode(Node):
                                  GROUND_TRUTH_QOS)
         self.create_subscription(Imu, 'imu/data', self._on_imu, SENSOR_DATA)
         self.create_subscription(SpeedEstimate, 'speed_estimate', self._on_speed, RELIABLE)
-        self.add_on_set_parameters_callback(self._validate)
-        self.add_post_set_parameters_callback(self._apply)
         self._publish_static()
 
     # --- parameters -----------------------------------------------------------------------
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        return validate_update(SPECS, self._values, parameters, consistent_geometry)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        names = {p.name for p in parameters if p.name in SPECS}
-        for name in names:
-            self._values[name] = self.get_parameter(name).value
+    def _apply(self, names: frozenset[str]) -> None:
         self._geometry = geometry_from(self._values, GEOMETRY_NAMES)
         self._source = OdomSource(self._values['odom_source'])
         if names & {*GEOMETRY_NAMES, 'imu_x', 'imu_y', 'imu_z'}:

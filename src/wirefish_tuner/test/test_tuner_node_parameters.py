@@ -9,17 +9,19 @@ from wirefish_kinematics.geometry import GEOMETRY_FIELDS
 from wirefish_kinematics.geometry_parameters import (BODY_WAVE_GEOMETRY_FIELDS,
                                                      geometry_parameters)
 from wirefish_tuner.feasibility import FitLimits
-from wirefish_tuner.tuner_node_parameters import SPECS, TUNER_PARAMETERS
+from wirefish_tuner.tuner_node_parameters import TABLE
+
+SPECS = TABLE.by_name
 
 
 def test_every_parameter_has_a_description_and_its_default_is_valid():
-    for spec in TUNER_PARAMETERS:
+    for spec in TABLE:
         assert spec.description
         assert check_value(spec, spec.default) is None, spec.name
 
 
 def test_the_geometry_is_the_body_waves_from_the_one_block():
-    declared = tuple(spec for spec in TUNER_PARAMETERS if spec.name in GEOMETRY_FIELDS)
+    declared = tuple(spec for spec in TABLE if spec.name in GEOMETRY_FIELDS)
     assert declared == geometry_parameters(BODY_WAVE_GEOMETRY_FIELDS)
 
 

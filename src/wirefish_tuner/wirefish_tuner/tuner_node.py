@@ -36,7 +36,7 @@ from __future__ import annotations
 from pathlib import Path
 import threading
 
-from rcl_interfaces.msg import Parameter as ParameterMsg, SetParametersResult
+from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
@@ -44,7 +44,7 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, validate_update
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, latched, reliable
 from wirefish_cpg.cpg_messages import to_message
 from wirefish_cpg.gait_library import Gait, GaitLibrary, LibraryFile
@@ -59,7 +59,7 @@ from wirefish_tuner.feasibility import FitLimits
 from wirefish_tuner.pso import PsoOptions
 from wirefish_tuner.retune_core import (FitCancelled, gait_of, retune, RetuneOrder, RetuneOutcome,
                                         RetuneProgress, RetuneSettings)
-from wirefish_tuner.tuner_node_parameters import SPECS, TUNER_PARAMETERS
+from wirefish_tuner.tuner_node_parameters import TABLE
 
 # A burst of requests must fit the service's own DDS queues while a fit holds the executor;
 # its clients' queues are protected by pacing the answers (answered_service).
@@ -100,11 +100,9 @@ class TunerNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters; wire the service, the action, publishers, the library."""
         super().__init__('tuner_node', **kwargs)
-        declare(self, TUNER_PARAMETERS)
-        self.add_on_set_parameters_callback(self._validate)
-        self.add_post_set_parameters_callback(self._on_parameters_set)
+        self._node_parameters = NodeParameters(self, TABLE, self._on_parameters_set)
         self._busy = threading.Lock()  # one fit at a time, service or action
-        self._library = LibraryFile(Path(self._value('library_path')))
+        self._library = LibraryFile(self._library_path())
         self._load_library()
         self._wave_pub = self.create_publisher(BodyWaveSpec, 'target_wave', LATCHED)
         self._client_group = MutuallyExclusiveCallbackGroup()
@@ -122,13 +120,13 @@ class TunerNode(Node):
         self._action.destroy()
         super().destroy_node()
 
-    def _validate(self, parameters: list[Parameter]) -> SetParametersResult:
-        return validate_update(SPECS, {}, parameters)
-
-    def _on_parameters_set(self, parameters: list[Parameter]) -> None:
-        if any(p.name == 'library_path' for p in parameters):
-            self._library = LibraryFile(Path(self._value('library_path')))
+    def _on_parameters_set(self, names: frozenset[str]) -> None:
+        if 'library_path' in names:
+            self._library = LibraryFile(self._library_path())
             self._load_library()
+
+    def _library_path(self) -> Path:
+        return Path(self._node_parameters.str_value('library_path'))
 
     def _load_library(self) -> None:
         try:
@@ -138,29 +136,27 @@ class TunerNode(Node):
             return
         self.get_logger().info(f'gait library {self._library.path}: {count} gaits')
 
-    def _value(self, name: str):
-        return self.get_parameter(name).value
-
     def _settings(self) -> RetuneSettings:
         """Return the fit settings of the current parameters (raises ValueError if invalid)."""
-        value = self._value
+        value, count = self._node_parameters.float_value, self._node_parameters.int_value
         return RetuneSettings(
             geometry=FishGeometry(**{name: value(name) for name in BODY_WAVE_GEOMETRY_FIELDS}),
             limits=FitLimits(servo_range_rad=value('amplitude_bound'),
                              servo_rate_limit_rad_s=value('servo_rate_limit_rad_s'),
                              min_frequency_hz=value('min_frequency_hz'),
                              max_rmse_deg=value('max_rmse_deg')),
-            pso=PsoOptions(swarm_size=value('swarm_size'),
-                           max_iterations=value('max_iterations'), inertia=value('inertia'),
+            pso=PsoOptions(swarm_size=count('swarm_size'),
+                           max_iterations=count('max_iterations'), inertia=value('inertia'),
                            cognitive=value('cognitive'), social=value('social'),
-                           stall_iterations=value('stall_iterations'),
+                           stall_iterations=count('stall_iterations'),
                            stall_tolerance=value('stall_tolerance')),
             upper=(value('weight_bound'),) * 2 + (value('phase_bound'),) * 2
             + (value('amplitude_bound'),) * 2,
-            alpha=value('alpha'), samples_per_period=value('samples_per_period'))
+            alpha=value('alpha'), samples_per_period=count('samples_per_period'))
 
     def _parameter_client(self):
-        service = f'{self._value("cpg_node_name")}/set_parameters_atomically'
+        name = self._node_parameters.str_value('cpg_node_name')
+        service = f'{name}/set_parameters_atomically'
         if service not in self._param_clients:
             self._param_clients[service] = self.create_client(
                 SetParametersAtomically, service, callback_group=self._client_group)
@@ -195,7 +191,8 @@ class TunerNode(Node):
         result = RetuneGaitAction.Result()
         try:
             order = order_of(goal, use_library=goal.use_library)
-            limit = order.max_iterations or self._value('max_iterations')
+            limit = (order.max_iterations
+                     or self._node_parameters.int_value('max_iterations'))
 
             def progress(iteration: int, best_loss: float, rmse) -> None:
                 if goal_handle.is_cancel_requested:
@@ -273,7 +270,7 @@ class TunerNode(Node):
     def _apply(self, params: CpgParameters) -> str | None:
         """Set the fit on the CPG node atomically; return why it failed, or None."""
         client = self._parameter_client()
-        timeout = self._value('apply_timeout_s')
+        timeout = self._node_parameters.float_value('apply_timeout_s')
         if not client.wait_for_service(timeout_sec=timeout):
             return f'no service {client.srv_name} within {timeout:g} s'
         done = threading.Event()

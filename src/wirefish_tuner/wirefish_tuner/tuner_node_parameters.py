@@ -4,15 +4,17 @@ The tuner node's parameters as one table (no rclpy import).
 
 The geometry is that of the body wave (``l1`` ... ``rd2``: all a fit needs), from the graph's
 one geometry block (``wirefish_kinematics.geometry_parameters``); the fit limits' defaults are
-``FitLimits()``'s and the PSO bounds ``retune_core``'s. Validation and declaration are the
-shared ones of ``wirefish_common.parameter_table``.
+``FitLimits()``'s and the PSO bounds ``retune_core``'s. Each value stands alone (``RULE`` is
+``no_combination``): a fit judges its settings when it starts. Validation and declaration are
+the shared ones of ``wirefish_common.parameter_table``.
 """
 
 from __future__ import annotations
 
 import math
 
-from wirefish_common.parameter_table import ParameterSpec
+from wirefish_common.parameter_table import (no_combination, ParameterSpec, ParameterTable,
+                                             Rule)
 from wirefish_cpg.gait_library import default_library_path
 from wirefish_kinematics.geometry_parameters import (BODY_WAVE_GEOMETRY_FIELDS,
                                                      geometry_parameters)
@@ -20,7 +22,8 @@ from wirefish_tuner.feasibility import FitLimits
 from wirefish_tuner.retune_core import MAX_ITERATIONS, MAX_SWARM_SIZE
 
 _LIMITS = FitLimits()
-TUNER_PARAMETERS = (
+RULE: Rule = no_combination
+TABLE = ParameterTable((
     ParameterSpec('cpg_node_name', 'cpg_node',
                   'Name (relative or absolute) of the CPG node whose parameters apply sets'),
     ParameterSpec('swarm_size', 40, 'Default PSO particles per run', 2, MAX_SWARM_SIZE),
@@ -56,5 +59,4 @@ TUNER_PARAMETERS = (
                   'Gait library file (YAML): read at start-up and when changed, every '
                   'successful fit stored; default $ROS_HOME/wirefish/gaits.yaml or '
                   '~/.ros/wirefish/gaits.yaml'),
-) + geometry_parameters(BODY_WAVE_GEOMETRY_FIELDS)  # the fit needs the body wave's only
-SPECS = {spec.name: spec for spec in TUNER_PARAMETERS}
+) + geometry_parameters(BODY_WAVE_GEOMETRY_FIELDS), RULE)  # the fit needs the body wave's

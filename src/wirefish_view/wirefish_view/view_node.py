@@ -58,7 +58,7 @@ from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 from wirefish_common.frames import declare_frame_prefix, prefixed
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import declare, InvalidParameters
+from wirefish_common.parameter_table import InvalidParameters, NodeParameters
 from wirefish_common.qos import RELIABLE, SENSOR_DATA, TF
 from wirefish_msgs.action import RetuneGait
 from wirefish_msgs.msg import BodyWave
@@ -68,7 +68,7 @@ from wirefish_view.front_door import FrontDoor
 from wirefish_view.json_messages import from_json, json_schema
 from wirefish_view.scene import fish_scene, tail_segments
 from wirefish_view.schemas import ros2msg_schema
-from wirefish_view.view_node_parameters import VIEW_PARAMETERS
+from wirefish_view.view_node_parameters import TABLE
 from wirefish_view.web import DashboardServer
 
 GLOBAL_TOPICS = ('/tf', '/tf_static', '/diagnostics')
@@ -120,8 +120,10 @@ class ViewNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, start the servers, wire discovery, scene and services."""
         super().__init__('view_node', **kwargs)
-        declare(self, VIEW_PARAMETERS)
-        self._values = {s.name: self.get_parameter(s.name).value for s in VIEW_PARAMETERS}
+        # Read once: the servers, the timers and the dashboard's limits are built from these,
+        # so a later set is judged (refused if invalid) but not applied.
+        self._node_parameters = NodeParameters(self, TABLE)
+        self._values = dict(self._node_parameters.values)
         prefix = declare_frame_prefix(self)
         self._frames = {f: prefixed(prefix, f) for f in ('odom', 'base_link', 'tail_base')}
         namespace = self.get_namespace().rstrip('/')
