@@ -196,8 +196,25 @@ static void send_health(wf_app_t *app)
     send(app, &msg);
 }
 
+/* servo 0 or 1: its calibration as it is in force now, and where it comes from. */
+static void send_trim_report(wf_app_t *app, unsigned servo)
+{
+    const wf_servo_cal_t *cal = &app->config.servo_cal[servo];
+    wf_msg_t msg = {.type = WF_MSG_SERVO_TRIM_REPORT};
+    wf_servo_trim_report_t *r = &msg.u.servo_trim_report;
+    r->servo = (uint8_t)(servo + 1u);
+    r->source = app->cal_source[servo];
+    r->direction = cal->direction;
+    r->reserved = 0;
+    r->neutral_us = cal->neutral_us;
+    r->us_per_rad = cal->us_per_rad;
+    r->min_us = cal->min_us;
+    r->max_us = cal->max_us;
+    send(app, &msg);
+}
+
 /* The oldest waiting ACK; a refused GAIT's ERROR (its code, the GAIT's seq) goes just before
- * it. */
+ * it, an accepted SERVO_TRIM's SERVO_TRIM_REPORT just after it. */
 static void send_ack(wf_app_t *app)
 {
     if (app->ack_count == 0) {
@@ -205,24 +222,36 @@ static void send_ack(wf_app_t *app)
     }
     wf_msg_t msg = {.type = WF_MSG_ACK};
     msg.u.ack = app->acks[0];
+    const uint8_t report = app->ack_report[0];
     app->ack_count--;
     memmove(app->acks, app->acks + 1, app->ack_count * sizeof app->acks[0]);
+    memmove(app->ack_report, app->ack_report + 1, app->ack_count * sizeof app->ack_report[0]);
     if (msg.u.ack.acked_type == WF_MSG_GAIT && msg.u.ack.result != 0) {
         send_error(app, msg.u.ack.result, msg.u.ack.acked_seq);
     }
     send(app, &msg);
+    if (report != 0) {
+        send_trim_report(app, report - 1u);
+    }
 }
 
-static void queue_ack(wf_app_t *app, const wf_msg_t *msg, uint8_t result)
+/* report: the servo (1, 2) whose SERVO_TRIM_REPORT follows the ACK, 0 for none. */
+static void queue_ack_report(wf_app_t *app, const wf_msg_t *msg, uint8_t result, uint8_t report)
 {
     if (app->ack_count >= WF_ACK_QUEUE) {
         app->acks_dropped++;
         return;
     }
+    app->ack_report[app->ack_count] = report;
     wf_ack_t *ack = &app->acks[app->ack_count++];
     ack->acked_type = msg->type;
     ack->acked_seq = msg->seq;
     ack->result = result;
+}
+
+static void queue_ack(wf_app_t *app, const wf_msg_t *msg, uint8_t result)
+{
+    queue_ack_report(app, msg, result, 0);
 }
 
 static uint16_t saturating_increment(uint16_t count)
@@ -249,9 +278,10 @@ static bool from_host(const wf_msg_t *msg)
     case WF_MSG_LINK_CONFIG:
     case WF_MSG_SERVO_CMD:
     case WF_MSG_GAIT:
+    case WF_MSG_SERVO_TRIM:
         return true;
     default:
-        return false; /* TELEMETRY, ACK, HEALTH and ERROR are a fish's to send */
+        return false; /* TELEMETRY, ACK, HEALTH, ERROR, SERVO_TRIM_REPORT are a fish's */
     }
 }
 
@@ -306,6 +336,115 @@ static void on_gait(wf_app_t *app, const wf_msg_t *msg)
     queue_ack(app, msg, 0);
 }
 
+/* --- calibration ------------------------------------------------------------------------ */
+static uint32_t neutral_compare(const wf_app_t *app, unsigned servo)
+{
+    return wf_servo_compare(&app->config.servo_cal[servo], 0.0f, wf_hal_pwm_ticks_per_us(),
+                            frame_us(&app->config));
+}
+
+/* The build's calibration of servo (0, 1) with the given values: true when it is one the
+ * board may run (direction +-1, gain > 0, every pulse of the limit's range within the
+ * build's min_us..max_us and the frame). NaN fails. */
+static bool trim_fits(const wf_app_t *app, unsigned servo, float neutral_us, float us_per_rad,
+                      int8_t direction, wf_servo_cal_t *cal)
+{
+    *cal = app->cal_defaults[servo];
+    cal->neutral_us = neutral_us;
+    cal->us_per_rad = us_per_rad;
+    cal->direction = direction;
+    return (direction == 1 || direction == -1) && us_per_rad > 0.0f &&
+           wf_servo_cal_fits(cal, app->config.servo_limit_rad, frame_us(&app->config));
+}
+
+static void set_calibration(wf_app_t *app, unsigned servo, const wf_servo_cal_t *cal,
+                            wf_cal_source_t source)
+{
+    app->config.servo_cal[servo] = *cal;
+    app->cal_source[servo] = (uint8_t)source;
+    app->neutral_compare[servo] = neutral_compare(app, servo);
+}
+
+/* At boot: the stored record's servos with valid 1 that fit the build run on it (STORED), the
+ * others on the build's values (DEFAULTS). */
+static void load_calibration(wf_app_t *app)
+{
+    for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
+        app->cal_defaults[i] = app->config.servo_cal[i];
+        app->cal_source[i] = WF_CAL_DEFAULTS;
+    }
+    (void)wf_cal_store_load(&app->cal_stored); /* none, or unreadable: all zero, none valid */
+    for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
+        const wf_cal_entry_t *e = &app->cal_stored.servo[i];
+        wf_servo_cal_t cal;
+        if (e->valid == 1 && trim_fits(app, i, e->neutral_us, e->us_per_rad, e->direction,
+                                       &cal)) {
+            set_calibration(app, i, &cal, WF_CAL_STORED);
+        }
+    }
+}
+
+/* SET, SAVE or FACTORY of servo (0, 1), already judged in range and allowed now. SAVE and
+ * FACTORY write a record first (the other servo's entry as stored) and change nothing when
+ * that fails. */
+static bool apply_trim(wf_app_t *app, const wf_servo_trim_t *t, unsigned servo,
+                       const wf_servo_cal_t *cal)
+{
+    if (t->op == WF_TRIM_SET) {
+        set_calibration(app, servo, cal, WF_CAL_LIVE);
+        return true;
+    }
+    wf_cal_record_t record = app->cal_stored;
+    wf_cal_entry_t *e = &record.servo[servo];
+    memset(e, 0, sizeof *e); /* FACTORY: valid 0 and zero values */
+    if (t->op == WF_TRIM_SAVE) {
+        e->neutral_us = cal->neutral_us;
+        e->us_per_rad = cal->us_per_rad;
+        e->direction = cal->direction;
+        e->valid = 1;
+    }
+    if (!wf_cal_store_append(&record)) {
+        return false;
+    }
+    app->cal_stored = record;
+    set_calibration(app, servo, cal, t->op == WF_TRIM_SAVE ? WF_CAL_STORED : WF_CAL_DEFAULTS);
+    return true;
+}
+
+/* PROTOCOL.md's order: the host's version, the fields' ranges and the fit (6), the mode (7:
+ * only READ in gait mode), the storage (8); then applied, and the ACK of 0 takes the servo's
+ * report with it. */
+static void on_servo_trim(wf_app_t *app, const wf_msg_t *msg)
+{
+    const wf_servo_trim_t *t = &msg->u.servo_trim;
+    const unsigned servo = t->servo - 1u; /* wraps for servo 0: out of range below */
+    const bool sets = t->op == WF_TRIM_SET || t->op == WF_TRIM_SAVE;
+    wf_servo_cal_t cal;
+    uint8_t result = 0;
+    if (!app->host_version_ok) {
+        result = WF_ERR_VERSION_MISMATCH;
+    } else if (servo >= WF_SERVO_COUNT || t->op > WF_TRIM_FACTORY || t->reserved != 0 ||
+               (sets && !trim_fits(app, servo, t->neutral_us, t->us_per_rad, t->direction,
+                                   &cal))) {
+        result = WF_ERR_COMMAND_OUT_OF_RANGE;
+    } else if (t->op != WF_TRIM_READ && app->gait_mode) {
+        result = WF_ERR_NOT_NOW;
+    } else {
+        if (t->op == WF_TRIM_FACTORY) {
+            cal = app->cal_defaults[servo];
+        }
+        if (t->op != WF_TRIM_READ && !apply_trim(app, t, servo, &cal)) {
+            result = WF_ERR_STORAGE_FAILED;
+        }
+    }
+    if (result == 0) {
+        app->trims_accepted++;
+    } else {
+        app->trims_refused++;
+    }
+    queue_ack_report(app, msg, result, result == 0 ? t->servo : 0);
+}
+
 static void on_frame(wf_app_t *app, const wf_msg_t *msg)
 {
     if (!from_host(msg)) {
@@ -332,6 +471,9 @@ static void on_frame(wf_app_t *app, const wf_msg_t *msg)
         return;
     case WF_MSG_GAIT:
         on_gait(app, msg);
+        return;
+    case WF_MSG_SERVO_TRIM:
+        on_servo_trim(app, msg);
         return;
     case WF_MSG_SERVO_CMD:
         if (!app->host_version_ok) {
@@ -602,9 +744,10 @@ void wf_app_init(wf_app_t *app, const wf_config_t *config)
         app->report_due_ms[i] = app->now_ms;
     }
     (void)wf_hal_pwm_init(app->config.servo_frame_hz); /* the rate was validated above */
+    load_calibration(app); /* before the first pulse: a stored neutral is the one to hold */
     for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
-        app->compare[i] = wf_servo_compare(&app->config.servo_cal[i], 0.0f,
-                                           wf_hal_pwm_ticks_per_us(), frame_us(&app->config));
+        app->neutral_compare[i] = neutral_compare(app, i);
+        app->compare[i] = app->neutral_compare[i];
         wf_hal_pwm_set_compare(i, app->compare[i]);
     }
     app->status = WF_STATUS_FAILSAFE_COMMAND | WF_STATUS_FAILSAFE_HEARTBEAT;
@@ -632,7 +775,14 @@ void wf_app_poll(wf_app_t *app)
         (app->config.health_period_ms != 0 && due(app->now_ms, app->next_health_ms))) {
         app->next_health_ms = app->health_sent ? app->next_health_ms + app->config.health_period_ms
                                                : app->now_ms + app->config.health_period_ms;
+        const bool boot = !app->health_sent;
         app->health_sent = true;
         send_health(app);
+        if (boot) {
+            /* Where each servo's calibration comes from after this boot, right after its
+             * HEALTH (a stored one may not fit this build: then DEFAULTS). */
+            send_trim_report(app, 0);
+            send_trim_report(app, 1);
+        }
     }
 }

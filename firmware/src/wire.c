@@ -19,6 +19,10 @@ static_assert(WF_TELEMETRY_COMPACT_SIZE == 4 + 11 * 2 + 3 * 2,
               "TELEMETRY_COMPACT: u32, 11 i16, battery, status, gait_id u16");
 static_assert(WF_HEALTH_SIZE == 3 * 1 + 5 * 4 + 2 * 2 + 7 * 4 + 3 * 2,
               "HEALTH: 3 u8, fault record and uptime u32, stack u16, 7 counters u32, 3 u16");
+static_assert(WF_SERVO_TRIM_SIZE == 4 * 1 + 2 * 4,
+              "SERVO_TRIM: servo u8, op u8, direction i8, reserved u8, 2 f32");
+static_assert(WF_SERVO_TRIM_REPORT_SIZE == 4 * 1 + 4 * 4,
+              "SERVO_TRIM_REPORT: servo u8, source u8, direction i8, reserved u8, 4 f32");
 static_assert(WF_ERROR_SIZE == 1 + 2, "ERROR: code u8, ref_seq u16");
 static_assert(WF_MAX_BODY == 66, "the longest body is a HEALTH's");
 static_assert(WF_MAX_ENCODED == 67, "HEALTH is 69 bytes on the wire at most (PROTOCOL.md)");
@@ -38,6 +42,10 @@ size_t wf_payload_size(uint8_t type)
         return WF_SERVO_CMD_SIZE;
     case WF_MSG_GAIT:
         return WF_GAIT_SIZE;
+    case WF_MSG_SERVO_TRIM:
+        return WF_SERVO_TRIM_SIZE;
+    case WF_MSG_SERVO_TRIM_REPORT:
+        return WF_SERVO_TRIM_REPORT_SIZE;
     case WF_MSG_TELEMETRY:
         return WF_TELEMETRY_SIZE;
     case WF_MSG_TELEMETRY_COMPACT:
@@ -203,6 +211,28 @@ static size_t put_payload(const wf_msg_t *msg, uint8_t *p)
         }
         return WF_GAIT_SIZE;
     }
+    case WF_MSG_SERVO_TRIM: {
+        const wf_servo_trim_t *t = &msg->u.servo_trim;
+        p[0] = t->servo;
+        p[1] = t->op;
+        p[2] = (uint8_t)t->direction;
+        p[3] = t->reserved;
+        put_f32(p + 4, t->neutral_us);
+        put_f32(p + 8, t->us_per_rad);
+        return WF_SERVO_TRIM_SIZE;
+    }
+    case WF_MSG_SERVO_TRIM_REPORT: {
+        const wf_servo_trim_report_t *r = &msg->u.servo_trim_report;
+        p[0] = r->servo;
+        p[1] = r->source;
+        p[2] = (uint8_t)r->direction;
+        p[3] = r->reserved;
+        put_f32(p + 4, r->neutral_us);
+        put_f32(p + 8, r->us_per_rad);
+        put_f32(p + 12, r->min_us);
+        put_f32(p + 16, r->max_us);
+        return WF_SERVO_TRIM_REPORT_SIZE;
+    }
     case WF_MSG_TELEMETRY_COMPACT: {
         wf_telemetry_compact_t c = msg->u.compact;
         int16_t *fields[11];
@@ -302,6 +332,29 @@ static bool get_payload(uint8_t type, const uint8_t *p, wf_msg_t *msg)
             finite = get_finite_f32(p + 2 + 4 * i, floats[i]) && finite;
         }
         return finite; /* ranges are the receiver's rules (wf_gait_valid): ACK 6 */
+    }
+    case WF_MSG_SERVO_TRIM: {
+        wf_servo_trim_t *t = &msg->u.servo_trim;
+        t->servo = p[0];
+        t->op = p[1];
+        t->direction = (int8_t)p[2];
+        t->reserved = p[3];
+        const bool ok0 = get_finite_f32(p + 4, &t->neutral_us);
+        const bool ok1 = get_finite_f32(p + 8, &t->us_per_rad);
+        return ok0 && ok1; /* every other value is the receiver's rule: ACK 6 */
+    }
+    case WF_MSG_SERVO_TRIM_REPORT: {
+        wf_servo_trim_report_t *r = &msg->u.servo_trim_report;
+        float *const floats[4] = {&r->neutral_us, &r->us_per_rad, &r->min_us, &r->max_us};
+        bool finite = true;
+        r->servo = p[0];
+        r->source = p[1];
+        r->direction = (int8_t)p[2];
+        r->reserved = p[3];
+        for (size_t i = 0; i < 4; i++) {
+            finite = get_finite_f32(p + 4 + 4 * i, floats[i]) && finite;
+        }
+        return finite;
     }
     case WF_MSG_TELEMETRY_COMPACT: {
         wf_telemetry_compact_t *c = &msg->u.compact;

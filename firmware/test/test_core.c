@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "wf/calibration_store.h"
 #include "wf/cobs.h"
 #include "wf/crc16.h"
 #include "wf_host.h"
@@ -81,7 +82,17 @@ static size_t board_output(wf_host_msg_t *out, size_t max)
     return wf_host_decode_stream(bytes, len, out, max, NULL);
 }
 
+/* A new board with an erased calibration storage. */
 static void fresh_board(void)
+{
+    wf_host_storage_clear();
+    wf_host_reset();
+    wf_host_board_init(NULL);
+    host_seq = 0;
+}
+
+/* The same board powered off and on: the storage kept, everything else new. */
+static void reboot_board(void)
 {
     wf_host_reset();
     wf_host_board_init(NULL);
@@ -1188,6 +1199,427 @@ static void test_degenerate_couplings_keep_the_output_finite(void)
     CHECK(fabsf(state[2] - 0.38f) < 1e-4f && fabsf(state[0]) <= 3.1416f);
 }
 
+
+/* --- servo calibration from the shore: SERVO_TRIM, SERVO_TRIM_REPORT, the storage --------- */
+static const uint8_t TRIM_EXAMPLE[] = {0x00, 0x03, 0x12, 0x0d, 0x04, 0x01, 0x02, 0xff, 0x01, 0x01,
+                                       0x03, 0xbe, 0x44, 0x01, 0x05, 0x16, 0x44, 0x09, 0xac, 0x00};
+static const uint8_t REPORT_EXAMPLE[] = {
+    0x00, 0x03, 0x22, 0x0e, 0x04, 0x01, 0x01, 0xff, 0x01, 0x01, 0x03, 0xbe, 0x44, 0x01,
+    0x03, 0x16, 0x44, 0x01, 0x03, 0xfa, 0x43, 0x06, 0x40, 0x1c, 0x45, 0xb6, 0x83, 0x00};
+/* Generation 1, servo 1 stored (1520 us, 600 us/rad, direction -1), servo 2 not. */
+static const uint8_t RECORD_EXAMPLE[WF_CAL_RECORD_SIZE] = {
+    0x57, 0x46, 0x43, 0x4c, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0xbe, 0x44,
+    0x00, 0x00, 0x16, 0x44, 0xff, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xa7, 0x83, 0x09, 0xcb};
+
+static wf_msg_t trim_msg(uint8_t servo, uint8_t op, int8_t direction, float neutral_us,
+                         float us_per_rad)
+{
+    wf_msg_t msg = {.type = WF_MSG_SERVO_TRIM};
+    msg.u.servo_trim = (wf_servo_trim_t){.servo = servo, .op = op, .direction = direction,
+                                         .neutral_us = neutral_us, .us_per_rad = us_per_rad};
+    return msg;
+}
+
+/* Sends the trim at t, polls once more at t + 1 (one ACK per poll); returns the seq. */
+static uint16_t send_trim(uint32_t t, wf_msg_t msg)
+{
+    send_msg(t, &msg);
+    wf_host_board_step(t + 1, NULL, 0, NULL, 0);
+    return msg.seq;
+}
+
+typedef struct {
+    wf_servo_trim_report_t cal[2];
+    wf_cal_record_t stored;
+    bool have_stored;
+    uint8_t bytes[512]; /* the unit's first records */
+} cal_state_t;
+
+static cal_state_t cal_state(void)
+{
+    cal_state_t c;
+    memset(&c, 0, sizeof c);
+    wf_host_board_calibration(c.cal);
+    c.have_stored = wf_cal_store_load(&c.stored);
+    wf_host_storage_peek(0, c.bytes, sizeof c.bytes);
+    return c;
+}
+
+/* Field by field: a struct's padding holds no value. */
+static bool same_record(const wf_cal_record_t *a, const wf_cal_record_t *b)
+{
+    bool same = a->generation == b->generation;
+    for (unsigned i = 0; i < WF_SERVO_COUNT; i++) {
+        const wf_cal_entry_t *x = &a->servo[i], *y = &b->servo[i];
+        same = same && x->neutral_us == y->neutral_us && x->us_per_rad == y->us_per_rad &&
+               x->direction == y->direction && x->valid == y->valid;
+    }
+    return same;
+}
+
+static bool same_cal_state(const cal_state_t *a, const cal_state_t *b)
+{
+    return memcmp(a->cal, b->cal, sizeof a->cal) == 0 && same_record(&a->stored, &b->stored) &&
+           a->have_stored == b->have_stored && memcmp(a->bytes, b->bytes, sizeof a->bytes) == 0;
+}
+
+/* The ACK of seq among out[0..n): its index, or n. */
+static size_t find_ack(const wf_host_msg_t *out, size_t n, uint16_t seq)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (out[i].type == WF_MSG_ACK && out[i].n[0] == WF_MSG_SERVO_TRIM && out[i].n[1] == seq) {
+            return i;
+        }
+    }
+    return n;
+}
+
+static void test_servo_trim_and_report_examples_byte_for_byte(void)
+{
+    CHECK(wf_payload_size(WF_MSG_SERVO_TRIM) == 12);
+    CHECK(wf_payload_size(WF_MSG_SERVO_TRIM_REPORT) == 20);
+    wf_msg_t trim = trim_msg(1, WF_TRIM_SAVE, -1, 1520.0f, 600.0f);
+    trim.seq = 13;
+    wf_msg_t report = {.type = WF_MSG_SERVO_TRIM_REPORT, .seq = 14};
+    report.u.servo_trim_report = (wf_servo_trim_report_t){
+        .servo = 1, .source = WF_CAL_STORED, .direction = -1, .neutral_us = 1520.0f,
+        .us_per_rad = 600.0f, .min_us = 500.0f, .max_us = 2500.0f};
+    uint8_t wire[WF_MAX_WIRE];
+    CHECK(frame_of(&trim, wire) == sizeof TRIM_EXAMPLE &&
+          !memcmp(wire, TRIM_EXAMPLE, sizeof TRIM_EXAMPLE));
+    CHECK(frame_of(&report, wire) == sizeof REPORT_EXAMPLE &&
+          !memcmp(wire, REPORT_EXAMPLE, sizeof REPORT_EXAMPLE));
+    wf_host_msg_t back[2];
+    CHECK(wf_host_decode_stream(TRIM_EXAMPLE, sizeof TRIM_EXAMPLE, back, 2, NULL) == 1);
+    CHECK(back[0].type == WF_MSG_SERVO_TRIM && back[0].seq == 13 && back[0].n[0] == 1 &&
+          back[0].n[1] == 2 && back[0].n[2] == -1 && back[0].n[3] == 0);
+    CHECK(back[0].f[0] == 1520.0f && back[0].f[1] == 600.0f);
+    CHECK(wf_host_decode_stream(REPORT_EXAMPLE, sizeof REPORT_EXAMPLE, back, 2, NULL) == 1);
+    CHECK(back[0].type == WF_MSG_SERVO_TRIM_REPORT && back[0].n[1] == WF_CAL_STORED &&
+          back[0].f[2] == 500.0f && back[0].f[3] == 2500.0f);
+}
+
+static void test_a_non_finite_servo_trim_is_dropped_with_error_6(void)
+{
+    static wf_host_msg_t out[64];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    run_until(1, 5);
+    board_output(out, 64);
+    const cal_state_t before = cal_state();
+    send_trim(10, trim_msg(1, WF_TRIM_SET, 1, 1500.0f, INFINITY));
+    const size_t n = board_output(out, 64);
+    const size_t e = find(out, n, WF_MSG_ERROR);
+    CHECK(e < n && out[e].version_or_code == WF_ERR_COMMAND_OUT_OF_RANGE &&
+          out[e].ref_seq_or_status == 0);
+    CHECK(count(out, n, WF_MSG_ACK) == 0 && count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 0);
+    const cal_state_t after = cal_state();
+    CHECK(same_cal_state(&before, &after));
+}
+
+static void test_each_out_of_range_servo_trim_gets_ack_6_and_changes_nothing(void)
+{
+    static wf_host_msg_t out[64];
+    const wf_msg_t refused[] = {
+        trim_msg(0, WF_TRIM_READ, 0, 0.0f, 0.0f),        /* servo 0 */
+        trim_msg(3, WF_TRIM_SET, 1, 1500.0f, 600.0f),    /* servo 3 */
+        trim_msg(1, 4, 1, 1500.0f, 600.0f),              /* op 4 */
+        trim_msg(1, WF_TRIM_SET, 0, 1500.0f, 600.0f),    /* direction 0 */
+        trim_msg(1, WF_TRIM_SAVE, 2, 1500.0f, 600.0f),   /* direction 2 */
+        trim_msg(2, WF_TRIM_SET, 1, 1500.0f, 0.0f),      /* no gain */
+        trim_msg(2, WF_TRIM_SAVE, 1, 1500.0f, -600.0f),  /* negative gain */
+        trim_msg(1, WF_TRIM_SET, 1, 1000.0f, 600.0f),    /* 1000 - 942 us: below min_us */
+        trim_msg(2, WF_TRIM_SAVE, -1, 1600.0f, 636.62f), /* 1600 + 1000 us: above max_us */
+    };
+    for (size_t i = 0; i < sizeof refused / sizeof refused[0] + 1; i++) {
+        fresh_board();
+        send_heartbeat(0, WF_PROTOCOL_VERSION);
+        run_until(1, 5);
+        board_output(out, 64);
+        const cal_state_t before = cal_state();
+        wf_msg_t msg = i < sizeof refused / sizeof refused[0]
+                           ? refused[i]
+                           : trim_msg(1, WF_TRIM_FACTORY, 0, 0.0f, 0.0f);
+        if (i == sizeof refused / sizeof refused[0]) {
+            msg.u.servo_trim.reserved = 1;
+        }
+        const uint16_t seq = send_trim(10, msg);
+        const size_t n = board_output(out, 64);
+        const size_t a = find_ack(out, n, seq);
+        CHECK(a < n && out[a].n[2] == WF_ERR_COMMAND_OUT_OF_RANGE);
+        CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 0 && count(out, n, WF_MSG_ERROR) == 0);
+        const cal_state_t after = cal_state();
+        CHECK(same_cal_state(&before, &after) && wf_host_storage_programs() == 0);
+    }
+}
+
+static void test_read_reports_the_defaults_after_its_ack(void)
+{
+    static wf_host_msg_t out[64];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    run_until(1, 5);
+    board_output(out, 64);
+    const uint16_t seq = send_trim(10, trim_msg(2, WF_TRIM_READ, 0, 0.0f, 0.0f));
+    const size_t n = board_output(out, 64);
+    const size_t a = find_ack(out, n, seq);
+    CHECK(a + 1 < n && out[a].n[2] == 0 && out[a + 1].type == WF_MSG_SERVO_TRIM_REPORT);
+    const wf_host_msg_t *r = &out[a + 1];
+    CHECK(r->n[0] == 2 && r->n[1] == WF_CAL_DEFAULTS && r->n[2] == 1 && r->n[3] == 0);
+    CHECK(r->f[0] == 1500.0f && r->f[1] == 636.619772f && r->f[2] == 500.0f &&
+          r->f[3] == 2500.0f);
+    CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 1);
+}
+
+static void test_set_is_live_at_the_next_pwm_write_and_not_stored(void)
+{
+    static wf_host_msg_t out[64];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    run_until(1, 5);
+    board_output(out, 64);
+    CHECK(wf_host_compare(0) == 1500);
+    const uint16_t seq = send_trim(10, trim_msg(1, WF_TRIM_SET, -1, 1520.0f, 600.0f));
+    CHECK(wf_host_compare(0) == 1520 && wf_host_compare(1) == 1500);
+    const size_t n = board_output(out, 64);
+    const size_t a = find_ack(out, n, seq);
+    CHECK(a + 1 < n && out[a].n[2] == 0 && out[a + 1].type == WF_MSG_SERVO_TRIM_REPORT);
+    CHECK(out[a + 1].n[0] == 1 && out[a + 1].n[1] == WF_CAL_LIVE && out[a + 1].n[2] == -1 &&
+          out[a + 1].f[0] == 1520.0f && out[a + 1].f[1] == 600.0f);
+    /* -1: a positive angle shortens the pulse; the fault path's neutral is the new one. */
+    send_command(20, 0.5f, 0.0f);
+    CHECK(wf_host_compare(0) == 1220);
+    wf_host_fault(0x08001234u, 0, 0, 0);
+    CHECK(wf_host_compare(0) == 1520);
+    CHECK(wf_host_storage_programs() == 0);
+    reboot_board();
+    wf_servo_trim_report_t cal[2];
+    wf_host_board_calibration(cal);
+    CHECK(cal[0].source == WF_CAL_DEFAULTS && cal[0].neutral_us == 1500.0f);
+}
+
+static void test_gait_mode_refuses_changes_with_ack_7_but_reads(void)
+{
+    static wf_host_msg_t out[256];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    const wf_cpg_params_t p = table1_gait();
+    send_gait(1, 7, &p);
+    run_until(2, 5);
+    board_output(out, 256);
+    const cal_state_t before = cal_state();
+    const uint8_t ops[3] = {WF_TRIM_SET, WF_TRIM_SAVE, WF_TRIM_FACTORY};
+    for (unsigned i = 0; i < 3; i++) {
+        const uint16_t seq = send_trim(10 + 2 * i, trim_msg(1, ops[i], 1, 1520.0f, 600.0f));
+        const size_t n = board_output(out, 256);
+        const size_t a = find_ack(out, n, seq);
+        CHECK(a < n && out[a].n[2] == WF_ERR_NOT_NOW);
+        CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 0 && count(out, n, WF_MSG_ERROR) == 0);
+    }
+    const cal_state_t after = cal_state();
+    CHECK(same_cal_state(&before, &after) && wf_host_storage_programs() == 0);
+    CHECK(gait_snap().gait_mode);
+    const uint16_t seq = send_trim(20, trim_msg(2, WF_TRIM_READ, 0, 0.0f, 0.0f));
+    const size_t n = board_output(out, 256);
+    const size_t a = find_ack(out, n, seq);
+    CHECK(a + 1 < n && out[a].n[2] == 0 && out[a + 1].type == WF_MSG_SERVO_TRIM_REPORT &&
+          out[a + 1].n[0] == 2);
+}
+
+static void test_another_hosts_version_gets_ack_5(void)
+{
+    static wf_host_msg_t out[64];
+    fresh_board();
+    send_heartbeat(0, 1);
+    run_until(1, 5);
+    board_output(out, 64);
+    const cal_state_t before = cal_state();
+    const uint16_t seq = send_trim(10, trim_msg(1, WF_TRIM_READ, 0, 0.0f, 0.0f));
+    const size_t n = board_output(out, 64);
+    const size_t a = find_ack(out, n, seq);
+    CHECK(a < n && out[a].n[2] == WF_ERR_VERSION_MISMATCH);
+    CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 0);
+    const cal_state_t after = cal_state();
+    CHECK(same_cal_state(&before, &after));
+}
+
+static void test_save_is_stored_and_a_reboot_runs_on_it(void)
+{
+    static wf_host_msg_t out[64];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    run_until(1, 5);
+    board_output(out, 64);
+    const uint16_t seq = send_trim(10, trim_msg(1, WF_TRIM_SAVE, -1, 1520.0f, 600.0f));
+    size_t n = board_output(out, 64);
+    size_t a = find_ack(out, n, seq);
+    CHECK(a + 1 < n && out[a].n[2] == 0 && out[a + 1].n[1] == WF_CAL_STORED);
+    uint8_t bytes[2 * WF_CAL_RECORD_SIZE];
+    wf_host_storage_peek(0, bytes, sizeof bytes);
+    CHECK(!memcmp(bytes, RECORD_EXAMPLE, WF_CAL_RECORD_SIZE)); /* the documented record */
+    CHECK(bytes[WF_CAL_RECORD_SIZE] == 0xFF && wf_host_storage_programs() == 1);
+    reboot_board();
+    wf_host_board_step(0, NULL, 0, NULL, 0);
+    n = board_output(out, 64);
+    const size_t h = find(out, n, WF_MSG_HEALTH);
+    CHECK(h + 2 < n && out[h + 1].type == WF_MSG_SERVO_TRIM_REPORT &&
+          out[h + 2].type == WF_MSG_SERVO_TRIM_REPORT);
+    CHECK(out[h + 1].n[0] == 1 && out[h + 1].n[1] == WF_CAL_STORED && out[h + 1].n[2] == -1 &&
+          out[h + 1].f[0] == 1520.0f && out[h + 1].f[1] == 600.0f);
+    CHECK(out[h + 2].n[0] == 2 && out[h + 2].n[1] == WF_CAL_DEFAULTS);
+    CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 2);
+    CHECK(wf_host_compare(0) == 1520); /* the stored neutral from the first pulse */
+}
+
+static void test_the_newest_record_wins_and_a_damaged_one_is_skipped(void)
+{
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_trim(10, trim_msg(1, WF_TRIM_SAVE, 1, 1520.0f, 600.0f));
+    send_trim(12, trim_msg(1, WF_TRIM_SAVE, 1, 1480.0f, 600.0f));
+    wf_cal_record_t r;
+    CHECK(wf_cal_store_load(&r) && r.generation == 2 && r.servo[0].neutral_us == 1480.0f);
+    reboot_board();
+    wf_servo_trim_report_t cal[2];
+    wf_host_board_calibration(cal);
+    CHECK(cal[0].source == WF_CAL_STORED && cal[0].neutral_us == 1480.0f);
+    /* A write cut short: the second record's last word never programmed. */
+    const uint8_t erased[4] = {0xFF, 0xFF, 0xFF, 0xFF};
+    wf_host_storage_poke(2 * WF_CAL_RECORD_SIZE - 4, erased, 4);
+    reboot_board();
+    wf_host_board_calibration(cal);
+    CHECK(cal[0].source == WF_CAL_STORED && cal[0].neutral_us == 1520.0f);
+    /* The next record goes after the damaged one, one generation past the winner. */
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_trim(10, trim_msg(2, WF_TRIM_SAVE, 1, 1490.0f, 600.0f));
+    CHECK(wf_cal_store_load(&r) && r.generation == 2 && r.servo[0].neutral_us == 1520.0f &&
+          r.servo[1].neutral_us == 1490.0f && r.servo[1].valid == 1);
+    uint8_t bytes[WF_CAL_RECORD_SIZE];
+    wf_host_storage_peek(2 * WF_CAL_RECORD_SIZE, bytes, sizeof bytes);
+    wf_cal_record_t third;
+    CHECK(wf_cal_record_decode(bytes, &third) && third.generation == 2);
+}
+
+static void test_a_full_unit_is_erased_and_the_record_written_at_0(void)
+{
+    fresh_board();
+    const uint32_t slots = WF_HOST_STORAGE_SIZE / WF_CAL_RECORD_SIZE; /* 455 */
+    wf_cal_record_t r = {.servo = {{1510.0f, 600.0f, 1, 1}, {0.0f, 0.0f, 0, 0}}};
+    for (uint32_t i = 0; i < slots; i++) {
+        CHECK(wf_cal_store_append(&r) && r.generation == i + 1);
+    }
+    CHECK(wf_host_storage_erases() == 0);
+    reboot_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_trim(10, trim_msg(2, WF_TRIM_SAVE, 1, 1490.0f, 600.0f));
+    CHECK(wf_host_storage_erases() == 1);
+    uint8_t bytes[2 * WF_CAL_RECORD_SIZE];
+    wf_host_storage_peek(0, bytes, sizeof bytes);
+    CHECK(wf_cal_record_decode(bytes, &r) && r.generation == slots + 1);
+    CHECK(r.servo[0].valid == 1 && r.servo[0].neutral_us == 1510.0f); /* servo 1 kept */
+    CHECK(r.servo[1].valid == 1 && r.servo[1].neutral_us == 1490.0f);
+    CHECK(bytes[WF_CAL_RECORD_SIZE] == 0xFF);
+    reboot_board();
+    wf_servo_trim_report_t cal[2];
+    wf_host_board_calibration(cal);
+    CHECK(cal[0].source == WF_CAL_STORED && cal[1].source == WF_CAL_STORED &&
+          cal[1].neutral_us == 1490.0f);
+}
+
+static void test_factory_gives_the_defaults_now_and_after_a_reboot(void)
+{
+    static wf_host_msg_t out[64];
+    fresh_board();
+    send_heartbeat(0, WF_PROTOCOL_VERSION);
+    send_trim(10, trim_msg(1, WF_TRIM_SAVE, -1, 1520.0f, 600.0f));
+    send_trim(12, trim_msg(2, WF_TRIM_SAVE, 1, 1480.0f, 600.0f));
+    board_output(out, 64);
+    const uint16_t seq = send_trim(14, trim_msg(1, WF_TRIM_FACTORY, 0, 0.0f, 0.0f));
+    const size_t n = board_output(out, 64);
+    const size_t a = find_ack(out, n, seq);
+    CHECK(a + 1 < n && out[a].n[2] == 0 && out[a + 1].n[0] == 1 &&
+          out[a + 1].n[1] == WF_CAL_DEFAULTS && out[a + 1].f[0] == 1500.0f &&
+          out[a + 1].n[2] == 1);
+    CHECK(wf_host_compare(0) == 1500);
+    wf_cal_record_t r;
+    CHECK(wf_cal_store_load(&r) && r.generation == 3 && r.servo[0].valid == 0 &&
+          r.servo[0].neutral_us == 0.0f && r.servo[1].valid == 1);
+    reboot_board();
+    wf_servo_trim_report_t cal[2];
+    wf_host_board_calibration(cal);
+    CHECK(cal[0].source == WF_CAL_DEFAULTS && cal[0].neutral_us == 1500.0f &&
+          cal[0].direction == 1);
+    CHECK(cal[1].source == WF_CAL_STORED && cal[1].neutral_us == 1480.0f);
+}
+
+static void test_a_failed_storage_write_gets_ack_8_and_changes_nothing(void)
+{
+    static wf_host_msg_t out[64];
+    const int faults[] = {WF_HOST_STORAGE_FAIL_PROGRAM, WF_HOST_STORAGE_CUT_PROGRAM,
+                          WF_HOST_STORAGE_STUCK_BITS, WF_HOST_STORAGE_FAIL_ERASE};
+    for (unsigned i = 0; i < 4; i++) {
+        fresh_board();
+        send_heartbeat(0, WF_PROTOCOL_VERSION);
+        send_trim(2, trim_msg(1, WF_TRIM_SAVE, 1, 1510.0f, 600.0f));
+        send_trim(4, trim_msg(1, WF_TRIM_SET, 1, 1530.0f, 600.0f)); /* live over stored */
+        if (faults[i] == WF_HOST_STORAGE_FAIL_ERASE) {
+            wf_cal_record_t fill = {.servo = {{1510.0f, 600.0f, 1, 1}}};
+            while (wf_host_storage_programs() < WF_HOST_STORAGE_SIZE / WF_CAL_RECORD_SIZE) {
+                CHECK(wf_cal_store_append(&fill));
+            }
+        }
+        board_output(out, 64);
+        const cal_state_t before = cal_state();
+        wf_host_storage_set_fault(faults[i]);
+        const uint8_t ops[2] = {WF_TRIM_SAVE, WF_TRIM_FACTORY};
+        for (unsigned k = 0; k < 2; k++) {
+            const uint16_t seq = send_trim(10 + 2 * k, trim_msg(1, ops[k], -1, 1490.0f, 600.0f));
+            const size_t n = board_output(out, 64);
+            const size_t a = find_ack(out, n, seq);
+            CHECK(a < n && out[a].n[2] == WF_ERR_STORAGE_FAILED);
+            CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 0);
+            wf_servo_trim_report_t cal[2];
+            wf_host_board_calibration(cal);
+            CHECK(!memcmp(cal, before.cal, sizeof cal) && cal[0].source == WF_CAL_LIVE &&
+                  cal[0].neutral_us == 1530.0f && wf_host_compare(0) == 1530);
+        }
+        wf_host_storage_set_fault(WF_HOST_STORAGE_OK);
+        reboot_board();
+        wf_servo_trim_report_t cal[2];
+        wf_host_board_calibration(cal);
+        CHECK(cal[0].source == WF_CAL_STORED && cal[0].neutral_us == 1510.0f);
+    }
+}
+
+static void test_a_stored_calibration_that_does_not_fit_boots_on_the_defaults(void)
+{
+    fresh_board();
+    wf_cal_record_t r = {.servo = {{1000.0f, 600.0f, 1, 1}, {1490.0f, 600.0f, 1, 1}}};
+    CHECK(wf_cal_store_append(&r));
+    reboot_board();
+    wf_servo_trim_report_t cal[2];
+    wf_host_board_calibration(cal);
+    CHECK(cal[0].source == WF_CAL_DEFAULTS && cal[0].neutral_us == 1500.0f);
+    CHECK(cal[1].source == WF_CAL_STORED && cal[1].neutral_us == 1490.0f);
+}
+
+static void test_the_record_codec_and_its_crc(void)
+{
+    CHECK(wf_crc32((const uint8_t *)"123456789", 9) == 0xCBF43926u);
+    wf_cal_record_t r = {.generation = 1, .servo = {{1520.0f, 600.0f, -1, 1}}};
+    uint8_t bytes[WF_CAL_RECORD_SIZE];
+    wf_cal_record_encode(&r, bytes);
+    CHECK(!memcmp(bytes, RECORD_EXAMPLE, sizeof bytes));
+    wf_cal_record_t back;
+    CHECK(wf_cal_record_decode(bytes, &back) && same_record(&back, &r));
+    for (unsigned i = 0; i < WF_CAL_RECORD_SIZE; i++) {
+        bytes[i] ^= 0x01u; /* any one bit: magic or CRC fails */
+        CHECK(!wf_cal_record_decode(bytes, &back));
+        bytes[i] ^= 0x01u;
+    }
+}
+
 int main(void)
 {
     test_crc_check_value();
@@ -1231,6 +1663,20 @@ int main(void)
     test_the_imu_lost_and_found_is_counted();
     test_the_lone_cpg_follows_eq_1();
     test_degenerate_couplings_keep_the_output_finite();
-    printf("test_core: 41 tests, %d checks passed\n", checks);
+    test_servo_trim_and_report_examples_byte_for_byte();
+    test_a_non_finite_servo_trim_is_dropped_with_error_6();
+    test_each_out_of_range_servo_trim_gets_ack_6_and_changes_nothing();
+    test_read_reports_the_defaults_after_its_ack();
+    test_set_is_live_at_the_next_pwm_write_and_not_stored();
+    test_gait_mode_refuses_changes_with_ack_7_but_reads();
+    test_another_hosts_version_gets_ack_5();
+    test_save_is_stored_and_a_reboot_runs_on_it();
+    test_the_newest_record_wins_and_a_damaged_one_is_skipped();
+    test_a_full_unit_is_erased_and_the_record_written_at_0();
+    test_factory_gives_the_defaults_now_and_after_a_reboot();
+    test_a_failed_storage_write_gets_ack_8_and_changes_nothing();
+    test_a_stored_calibration_that_does_not_fit_boots_on_the_defaults();
+    test_the_record_codec_and_its_crc();
+    printf("test_core: 55 tests, %d checks passed\n", checks);
     return 0;
 }

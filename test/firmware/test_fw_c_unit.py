@@ -3,7 +3,10 @@
 The C unit tests of the core (firmware/test/test_core.c).
 
 Link, failsafe and its slew, servo output, and protocol v2: GAIT accepted and refused, ACK,
-LINK_CONFIG, the gap's coast and rest without a step, compact telemetry, HEALTH, the CPG.
+LINK_CONFIG, the gap's coast and rest without a step, compact telemetry, HEALTH, the CPG;
+SERVO_TRIM (every refusal and its code, gait mode, the reports) and the calibration storage
+(append, newest wins, a damaged record skipped, the full unit erased, reload, FACTORY, a failed
+write).
 """
 
 import subprocess

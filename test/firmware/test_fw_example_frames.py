@@ -4,7 +4,8 @@
 from pathlib import Path
 import re
 
-from firmware_host import FirmwareHost, to_record
+from firmware_host import FirmwareHost, MSG_DTYPE, to_record
+import numpy as np
 import pytest
 from wirefish_bridge.codec import StreamDecoder
 from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
@@ -34,6 +35,22 @@ EXAMPLES = [
 NAMES = [type(message).__name__ + str(i) for i, (message, _) in enumerate(EXAMPLES)]
 
 
+def _flat(kind: int, seq: int, ints: tuple[int, ...], floats: tuple[float, ...]) -> np.ndarray:
+    record = np.zeros(1, MSG_DTYPE)
+    record['type'], record['seq'] = kind, seq
+    record['n'][0, :len(ints)] = ints
+    record['f'][0, :len(floats)] = floats
+    return record
+
+
+# The examples PROTOCOL.md prints after those: SERVO_TRIM and SERVO_TRIM_REPORT, as the C
+# core's flat records (wf_host.h: servo, op or source, direction, reserved; the floats).
+CALIBRATION_EXAMPLES = [
+    _flat(0x12, 13, (1, 2, -1, 0), (1520.0, 600.0)),  # SAVE servo 1: -1, 1520 us, 600 us/rad
+    _flat(0x22, 14, (1, 1, -1, 0), (1520.0, 600.0, 500.0, 2500.0)),  # its report: STORED
+]
+
+
 def example_frames() -> list[bytes]:
     """Return the hex blocks of PROTOCOL.md's "Example frames" section, in order."""
     section = PROTOCOL.read_text().split('## Example frames', 1)[1].split('\n## ', 1)[0]
@@ -42,8 +59,20 @@ def example_frames() -> list[bytes]:
 
 
 def test_protocol_md_prints_an_example_of_every_type():
-    assert len(example_frames()) == len(EXAMPLES)
+    assert len(example_frames()) == len(EXAMPLES) + len(CALIBRATION_EXAMPLES)
     assert {type(message).KIND for message, _ in EXAMPLES} == set(MsgType)
+
+
+@pytest.mark.parametrize('index', range(len(CALIBRATION_EXAMPLES)),
+                         ids=['ServoTrim', 'ServoTrimReport'])
+def test_c_core_encodes_and_decodes_the_calibration_examples(host_lib: FirmwareHost,
+                                                             index: int):
+    record = CALIBRATION_EXAMPLES[index]
+    frame = example_frames()[len(EXAMPLES) + index]
+    assert host_lib.encode_stream(record) == frame
+    frames, stats = host_lib.decode_stream(frame)
+    assert frames.tobytes() == record.tobytes()
+    assert stats['frames_ok'] == 1 and stats['resyncs'] == 0
 
 
 @pytest.mark.parametrize('index', range(len(EXAMPLES)), ids=NAMES)

@@ -15,7 +15,8 @@ from firmware_host import FIRMWARE
 README = (FIRMWARE / 'README.md').read_text()
 HAL_H = (FIRMWARE / 'include' / 'wf' / 'hal.h').read_text()
 FAILSAFE_C = (FIRMWARE / 'port' / 'stm32f4' / 'failsafe.c').read_text()
-NUMBERS = {'seven': 7, 'eight': 8, 'nine': 9, 'ten': 10, 'eleven': 11, 'twelve': 12}
+NUMBERS = {'seven': 7, 'eight': 8, 'nine': 9, 'ten': 10, 'eleven': 11, 'twelve': 12,
+           'thirteen': 13, 'fourteen': 14, 'fifteen': 15}
 
 
 def _cube_section() -> str:

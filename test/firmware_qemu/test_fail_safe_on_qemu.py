@@ -9,7 +9,9 @@ just before its reset; the rebooted board's "R" lines and its HEALTH messages on
 why it reset. QEMU 7.2 models no IWDG: the image's stand-in (SysTick interrupts since the last
 feed) takes the same path with the cause IWDG; RCC_CSR is not modelled either, so the emulated
 board's cause is the record's alone (UNKNOWN at its first boot). Those parts are tested on the
-host port (test/firmware/test_fw_fail_safe.py).
+host port (test/firmware/test_fw_fail_safe.py). A servo calibration saved over the link
+(SERVO_TRIM SAVE) outlives the fault's reset in the QEMU build's .noinit unit (QEMU's flash is
+ROM), and the fault path drives its saved neutral.
 
 bridge_node, on the board's link, shows the fault and its PC in /diagnostics (its
 fish_reset_cause and fish_fault_pc). The last test shows with nm that the hardware image holds
@@ -214,6 +216,25 @@ def test_a_stack_overflow_faults_resets_and_the_board_runs_on_unharmed(emulated:
     telemetry = emulated.wait(lambda: [m for m in emulated.frames[frames:]
                                        if isinstance(m, Telemetry)])
     assert (telemetry[-1].servo_1, telemetry[-1].servo_2) == (0.0, 0.0)
+
+
+# PROTOCOL.md's SERVO_TRIM example: SAVE servo 1, direction -1, 1520 us at 0 rad, 600 us/rad.
+SAVE_SERVO_1 = bytes.fromhex('00 03 12 0d 04 01 02 ff 01 01 03 be 44 01 05 16 44 09 ac 00')
+
+
+def test_a_saved_calibration_outlives_a_fault_reset_in_the_noinit_unit(emulated: Board):
+    # QEMU's flash is ROM: the QEMU build's unit is .noinit RAM, which the reset keeps.
+    lines = len(emulated.lines)
+    emulated.send(Heartbeat(PROTOCOL_VERSION, Role.HOST, 0))
+    os.write(emulated.link, SAVE_SERVO_1)
+    saved = [0, 1520000, 600000, -1]
+    assert emulated.wait(lambda: [k for k in emulated.tagged('K', lines) if k[:4] == saved])
+    assert emulated.wait(lambda: (0, 1520) in {(ch, t) for _, ch, t in emulated.tagged('P')})
+    fault, _, _ = _fail(emulated, 'H')
+    assert fault[2:] == [1520, NEUTRAL_TICKS]   # the fault path's neutral is the saved one
+    after = len(emulated.lines)
+    calibration = emulated.wait(lambda: emulated.tagged('K', after)[:2])
+    assert [k[:4] for k in calibration] == [saved, [1, 1500000, 636620, 1]]
 
 
 def _diagnosed(probe, key: str, value: str) -> dict[str, str] | None:

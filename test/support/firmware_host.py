@@ -41,7 +41,8 @@ STATS_FIELDS = ('bytes_in', 'frames_ok', 'cobs_errors', 'short_frames', 'crc_err
                 'seq_gaps', 'seq_resets')
 I2cDevice = Callable[[int, bytes, int], 'bytes | None']
 MESSAGE_TYPES = np.array([int(kind) for kind in MsgType], np.uint8)
-U8, U16, I16, U32 = (0, 0xFF), (0, 0xFFFF), (-0x8000, 0x7FFF), (0, 0xFFFFFFFF)
+U8, I8, U16, I16 = (0, 0xFF), (-0x80, 0x7F), (0, 0xFFFF), (-0x8000, 0x7FFF)
+U32 = (0, 0xFFFFFFFF)
 # The ranges of the integers in ``n`` per type (wire order); a type not named has none there.
 INT_FIELDS: dict[int, tuple[tuple[int, int], ...]] = {
     MsgType.TELEMETRY: (U16,),
@@ -50,9 +51,14 @@ INT_FIELDS: dict[int, tuple[tuple[int, int], ...]] = {
     MsgType.GAIT: (U16,),
     MsgType.TELEMETRY_COMPACT: (U32,) + (I16,) * 11 + (U16,) * 3,
     MsgType.HEALTH: (U8,) * 3 + (U32,) * 5 + (U16,) * 2 + (U32,) * 7 + (U16,) * 3,
+    # SERVO_TRIM, SERVO_TRIM_REPORT (by number: wirefish_bridge.protocol may not name them):
+    # servo, op or source, direction, reserved.
+    0x12: (U8, U8, I8, U8),
+    0x22: (U8, U8, I8, U8),
 }
-# How many of ``f`` each type carries.
-FLOATS = {MsgType.SERVO_CMD: 2, MsgType.GAIT: 10, MsgType.TELEMETRY: 12}
+# How many of ``f`` each type carries (SERVO_TRIM: neutral_us, us_per_rad; SERVO_TRIM_REPORT:
+# those, min_us, max_us).
+FLOATS = {MsgType.SERVO_CMD: 2, MsgType.GAIT: 10, MsgType.TELEMETRY: 12, 0x12: 2, 0x22: 4}
 
 
 def random_messages(rng: np.random.Generator, count: int) -> np.ndarray:
@@ -227,6 +233,15 @@ class HealthRecord(ctypes.Structure):
                 ('imu_recoveries', ctypes.c_uint16), ('i2c_bus_recoveries', ctypes.c_uint16)]
 
 
+class CalibrationReport(ctypes.Structure):
+    """wf_servo_trim_report_t: one servo's calibration in force and its source."""
+
+    _fields_ = [('servo', ctypes.c_uint8), ('source', ctypes.c_uint8),
+                ('direction', ctypes.c_int8), ('reserved', ctypes.c_uint8),
+                ('neutral_us', ctypes.c_float), ('us_per_rad', ctypes.c_float),
+                ('min_us', ctypes.c_float), ('max_us', ctypes.c_float)]
+
+
 class Snapshot(ctypes.Structure):
     """wf_host_snapshot_t: a flat view of the board."""
 
@@ -279,6 +294,12 @@ class FirmwareHost:
                                               ctypes.c_void_p]),
             'wf_host_encode_stream': (_SIZE, [ctypes.c_void_p, _SIZE, ctypes.c_void_p, _SIZE]),
             'wf_config_defaults': (None, [ctypes.POINTER(Config)]),
+            'wf_host_board_calibration': (None, [ctypes.POINTER(CalibrationReport * 2)]),
+            'wf_host_calibration_size': (_SIZE, []),
+            'wf_host_storage_clear': (None, []),
+            'wf_host_storage_set_fault': (None, [ctypes.c_int]),
+            'wf_host_storage_peek': (_SIZE, [ctypes.c_uint32, ctypes.c_void_p, _SIZE]),
+            'wf_host_storage_poke': (_SIZE, [ctypes.c_uint32, _BYTES, _SIZE]),
         }
         for name, (restype, argtypes) in signatures.items():
             function = getattr(lib, name)
@@ -290,7 +311,9 @@ class FirmwareHost:
                                              ctypes.sizeof(GaitSnapshot)),
                  'wf_health_t': (lib.wf_host_health_size(), ctypes.sizeof(HealthRecord)),
                  'wf_host_msg_t': (lib.wf_host_msg_size(), MSG_DTYPE.itemsize),
-                 'wf_cpg_params_t': (lib.wf_host_cpg_params_size(), ctypes.sizeof(CpgParams))}
+                 'wf_cpg_params_t': (lib.wf_host_cpg_params_size(), ctypes.sizeof(CpgParams)),
+                 'wf_servo_trim_report_t': (lib.wf_host_calibration_size(),
+                                            ctypes.sizeof(CalibrationReport))}
         wrong = {name: size for name, size in sizes.items() if size[0] != size[1]}
         if wrong:
             raise RuntimeError(f'firmware_host.py and wf_host.h disagree on {wrong} '
@@ -306,8 +329,10 @@ class FirmwareHost:
         return config
 
     def reset(self, config: Config | None = None, i2c: I2cDevice | None = None,
-              adc_raw: int = 3392, start_ms: int = 0) -> None:
-        """Give a fresh board: HAL reset, the clock at ``start_ms``, devices, then wf_app_init."""
+              adc_raw: int = 3392, start_ms: int = 0, keep_storage: bool = False) -> None:
+        """Give a fresh board (the storage erased unless ``keep_storage``), then wf_app_init."""
+        if not keep_storage:
+            self.lib.wf_host_storage_clear()
         self.lib.wf_host_reset()
         self.lib.wf_host_set_millis(start_ms)
         self.lib.wf_host_set_adc_raw(adc_raw)
@@ -358,6 +383,22 @@ class FirmwareHost:
         record = HealthRecord()
         self.lib.wf_host_board_health(ctypes.byref(record))
         return record
+
+    def calibration(self) -> list[CalibrationReport]:
+        """Return both servos' calibration in force and its source (servo 1 first)."""
+        reports = (CalibrationReport * 2)()
+        self.lib.wf_host_board_calibration(ctypes.byref(reports))
+        return list(reports)
+
+    def storage(self, offset: int = 0, length: int = 16384) -> bytes:
+        """Return ``length`` bytes of the calibration's storage from ``offset``."""
+        out = ctypes.create_string_buffer(length)
+        n = self.lib.wf_host_storage_peek(offset, out, length)
+        return out.raw[:n]
+
+    def set_storage_fault(self, fault: int) -> None:
+        """Make the storage fail (wf_host_storage_fault_t; 0: work again)."""
+        self.lib.wf_host_storage_set_fault(fault)
 
     def compare(self, servo: int) -> int:
         """Return the compare value last written to servo channel 0 or 1."""

@@ -7,9 +7,12 @@
  *   for (;;) wf_app_poll(&app);       -- as often as possible (at least once a millisecond)
  *
  * wf_app_poll steps the board's CPG (gait mode), reads the UART, decodes and acts on frames,
- * answers GAIT and LINK_CONFIG with an ACK, runs the gap rules or the failsafe, updates the
- * servos, samples the IMU and sends telemetry (100 Hz by default, FULL or COMPACT), heartbeats
- * (2 Hz) and HEALTH (at boot, then every 2 s by default) when they are due.
+ * answers GAIT, LINK_CONFIG and SERVO_TRIM with an ACK (an accepted SERVO_TRIM's followed by
+ * its servo's SERVO_TRIM_REPORT), runs the gap rules or the failsafe, updates the servos,
+ * samples the IMU and sends telemetry (100 Hz by default, FULL or COMPACT), heartbeats (2 Hz)
+ * and HEALTH (at boot, with both servos' SERVO_TRIM_REPORT after it, then every 2 s by
+ * default) when they are due. wf_app_init loads the stored calibration (wf/calibration_store.h)
+ * before the first pulse.
  * The full definition of wf_app_t and wf_config_t lives in wf/app_state.h (owned by the core).
  */
 #ifndef WF_APP_H

@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "wf/attitude.h"
+#include "wf/calibration_store.h"
 #include "wf/cpg.h"
 #include "wf/hal.h"
 #include "wf/health.h"
@@ -52,7 +53,8 @@ typedef struct {
 enum { WF_REPORTED_KINDS = 5, WF_ERROR_MIN_INTERVAL_MS = 20 };
 
 /* ACKs wait here and go out one per poll, oldest first (a poll's output stays bounded); a
- * GAIT or LINK_CONFIG that finds the queue full gets no ACK (the host resends it). */
+ * GAIT, LINK_CONFIG or SERVO_TRIM that finds the queue full gets no ACK (the host resends
+ * it). An accepted SERVO_TRIM's ACK takes its SERVO_TRIM_REPORT with it, right after. */
 enum { WF_ACK_QUEUE = 4 };
 
 /* In gait mode a poll steps the CPG at most this many 1 ms steps: a larger backlog (a blocked
@@ -95,7 +97,17 @@ typedef struct {
 
     /* acknowledgements waiting to be sent */
     wf_ack_t acks[WF_ACK_QUEUE];
+    uint8_t ack_report[WF_ACK_QUEUE]; /* the servo (1, 2) whose report follows; 0 none */
     uint8_t ack_count;
+
+    /* calibration: config.servo_cal holds the one in force (the next PWM write uses it) */
+    wf_servo_cal_t cal_defaults[WF_SERVO_COUNT]; /* the build's (wf_app_init's config) */
+    uint8_t cal_source[WF_SERVO_COUNT];          /* wf_cal_source_t */
+    wf_cal_record_t cal_stored;  /* the storage's winning record (all zero: none) */
+    uint32_t neutral_compare[WF_SERVO_COUNT]; /* 0 rad under the calibration in force: what
+                                               * a port's fault path writes */
+    uint32_t trims_accepted;
+    uint32_t trims_refused;
 
     /* outputs */
     float target[WF_SERVO_COUNT];  /* after the failsafe and the clamp: what the PWM shows */

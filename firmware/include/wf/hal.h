@@ -4,8 +4,8 @@
  *
  * Two ports implement it: port/host (POSIX: a pty or stdin/stdout, a simulated clock for
  * tests) and port/stm32f4 (registers of RM0090, interrupt-driven USART, TIM PWM, I2C1, ADC,
- * SysTick). The core never touches a register and never allocates: every buffer it uses is
- * a fixed array inside its own state structures.
+ * SysTick, flash sector 2 for the calibration). The core never touches a register and never
+ * allocates: every buffer it uses is a fixed array inside its own state structures.
  *
  * Calls come from one context (the main loop, or one RTOS task); the ports make the UART
  * queues safe against their own interrupt handlers.
@@ -70,6 +70,19 @@ int32_t wf_hal_adc_battery_raw(void);
  * can be taken from that first call. Cheap enough for every poll (no bus transfer; the stack
  * scan reads at most the stack's 2 KB once), never called from an interrupt. */
 void wf_hal_health_port(wf_health_t *health);
+
+/* The calibration's storage (wf/calibration_store.h): one erase unit of wf_hal_storage_size
+ * bytes (a multiple of 4; 0 when the board has none), read as bytes, erased whole (every byte
+ * 0xFF) and programmed in 32-bit words at word-aligned offsets, words in memory order (the
+ * bytes of a little-endian CPU). Programming only clears bits (flash): the core programs
+ * erased words only and reads each record back. Each call is bounded and returns false when
+ * it failed or the range is outside the unit; a port calls the slow ones (erase: up to
+ * 0.5 s on an STM32F4 sector) only for a SERVO_TRIM SAVE or FACTORY, which the core takes in
+ * stream mode only. */
+size_t wf_hal_storage_size(void);
+bool wf_hal_storage_read(uint32_t offset, uint8_t *buf, size_t len);
+bool wf_hal_storage_erase(void);
+bool wf_hal_storage_program(uint32_t offset, const uint32_t *words, size_t count);
 
 #ifdef __cplusplus
 }

@@ -25,8 +25,10 @@ typedef enum {
     WF_MSG_ACK = 0x03,
     WF_MSG_SERVO_CMD = 0x10,
     WF_MSG_GAIT = 0x11,
+    WF_MSG_SERVO_TRIM = 0x12,
     WF_MSG_TELEMETRY = 0x20,
     WF_MSG_TELEMETRY_COMPACT = 0x21,
+    WF_MSG_SERVO_TRIM_REPORT = 0x22,
     WF_MSG_HEALTH = 0x30,
     WF_MSG_ERROR = 0x7F,
 } wf_msg_type_t;
@@ -40,7 +42,25 @@ typedef enum {
     WF_ERR_BAD_LENGTH = 4,
     WF_ERR_VERSION_MISMATCH = 5,
     WF_ERR_COMMAND_OUT_OF_RANGE = 6,
+    WF_ERR_NOT_NOW = 7,          /* a valid request, refused in the current mode */
+    WF_ERR_STORAGE_FAILED = 8,   /* the storage's erase, program or read-back failed */
 } wf_error_code_t;
+
+/* SERVO_TRIM's operation. */
+typedef enum {
+    WF_TRIM_READ = 0,    /* report the servo's calibration; changes nothing */
+    WF_TRIM_SET = 1,     /* live, not saved */
+    WF_TRIM_SAVE = 2,    /* live, and written to storage */
+    WF_TRIM_FACTORY = 3, /* the build's defaults, live, and the stored values of the servo
+                          * dropped (a new record with valid 0), so a reboot gives them too */
+} wf_trim_op_t;
+
+/* Where a servo's running calibration comes from (SERVO_TRIM_REPORT's source). */
+typedef enum {
+    WF_CAL_DEFAULTS = 0, /* the build's values */
+    WF_CAL_STORED = 1,   /* the values of the record in storage */
+    WF_CAL_LIVE = 2,     /* set, not saved */
+} wf_cal_source_t;
 
 enum {
     WF_STATUS_FAILSAFE_COMMAND = 0x0001,
@@ -85,6 +105,8 @@ enum {
 #define WF_GAIT_SIZE 42u
 #define WF_TELEMETRY_SIZE 56u
 #define WF_TELEMETRY_COMPACT_SIZE 32u
+#define WF_SERVO_TRIM_SIZE 12u
+#define WF_SERVO_TRIM_REPORT_SIZE 20u
 #define WF_HEALTH_SIZE 61u
 #define WF_ERROR_SIZE 3u
 #define WF_MAX_PAYLOAD WF_HEALTH_SIZE
@@ -147,6 +169,26 @@ typedef struct {
 } wf_telemetry_compact_t;
 
 typedef struct {
+    uint8_t servo;      /* 1 or 2 */
+    uint8_t op;         /* wf_trim_op_t */
+    int8_t direction;   /* +1 or -1 (SET, SAVE); READ and FACTORY ignore it */
+    uint8_t reserved;   /* 0 */
+    float neutral_us;   /* SET, SAVE: the pulse at 0 rad */
+    float us_per_rad;   /* SET, SAVE: > 0 */
+} wf_servo_trim_t;
+
+typedef struct {
+    uint8_t servo;      /* 1 or 2 */
+    uint8_t source;     /* wf_cal_source_t */
+    int8_t direction;
+    uint8_t reserved;   /* 0 */
+    float neutral_us;
+    float us_per_rad;
+    float min_us;       /* the build's, read-only */
+    float max_us;       /* the build's, read-only */
+} wf_servo_trim_report_t;
+
+typedef struct {
     uint8_t code;
     uint16_t ref_seq;
 } wf_error_t;
@@ -160,6 +202,8 @@ typedef struct {
         wf_ack_t ack;
         wf_servo_cmd_t servo_cmd;
         wf_gait_t gait;
+        wf_servo_trim_t servo_trim;
+        wf_servo_trim_report_t servo_trim_report;
         wf_telemetry_t telemetry;
         wf_telemetry_compact_t compact;
         wf_health_t health;

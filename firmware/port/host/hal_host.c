@@ -1,8 +1,13 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The POSIX port of wf/hal.h: a settable clock, byte queues for the UART, recorded PWM
- * compares, I2C routed to a pluggable device model, a settable ADC reading, and a model of the
+ * compares, I2C routed to a pluggable device model, a settable ADC reading, a model of the
  * stm32f4 port's reset path (reset flags, the fault record that survives a reset, the fault
- * handler's neutral compares) and of its I2C bus recovery. */
+ * handler's neutral compares) and of its I2C bus recovery, and the calibration's storage: a
+ * 16 KB unit with flash's rules (erased 0xFF, programming clears bits only) in RAM or in a
+ * file, with faults to inject. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdio.h>
 #include <string.h>
 
 #include "wf/fault_record.h"
@@ -259,3 +264,151 @@ bool wf_hal_i2c_transfer(uint8_t address7, const uint8_t *tx, size_t tx_len, uin
 }
 
 int32_t wf_hal_adc_battery_raw(void) { return board.adc_raw; }
+
+/* --- the calibration's storage ---------------------------------------------------------- */
+/* Kept across wf_host_reset (a power cycle keeps flash); wf_host_storage_clear erases it. */
+static struct {
+    bool ready; /* zero-initialised statics are not erased flash: erased on first use */
+    uint8_t bytes[WF_HOST_STORAGE_SIZE];
+    char path[4096];
+    bool has_path;
+    int fault; /* wf_host_storage_fault_t */
+    uint32_t erases;
+    uint32_t programs;
+} storage;
+
+static void storage_ready(void)
+{
+    if (!storage.ready) {
+        memset(storage.bytes, 0xFF, sizeof storage.bytes);
+        storage.ready = true;
+    }
+}
+
+void wf_host_storage_clear(void)
+{
+    memset(&storage, 0, sizeof storage);
+    storage_ready();
+}
+
+/* The whole unit to the file, through a temporary one renamed over it: a crash of the host
+ * program leaves the old file or the new one, as flash keeps each word old or new. */
+static bool storage_flush(void)
+{
+    if (!storage.has_path) {
+        return true;
+    }
+    char tmp[sizeof storage.path + 8];
+    snprintf(tmp, sizeof tmp, "%s.tmp", storage.path);
+    FILE *f = fopen(tmp, "wb");
+    if (f == NULL) {
+        return false;
+    }
+    const bool written = fwrite(storage.bytes, 1, sizeof storage.bytes, f) == sizeof storage.bytes;
+    const bool closed = fclose(f) == 0;
+    if (!written || !closed || rename(tmp, storage.path) != 0) {
+        remove(tmp);
+        return false;
+    }
+    return true;
+}
+
+bool wf_host_storage_use_file(const char *path)
+{
+    wf_host_storage_clear();
+    if (strlen(path) >= sizeof storage.path) {
+        return false;
+    }
+    FILE *f = fopen(path, "rb");
+    if (f != NULL) {
+        /* A short file is erased past its end; a longer one's tail is not the unit's. */
+        const size_t n = fread(storage.bytes, 1, sizeof storage.bytes, f);
+        const bool failed = ferror(f) != 0;
+        fclose(f);
+        if (failed) {
+            return false;
+        }
+        memset(storage.bytes + n, 0xFF, sizeof storage.bytes - n);
+    }
+    strcpy(storage.path, path);
+    storage.has_path = true;
+    return true;
+}
+
+void wf_host_storage_set_fault(int fault) { storage.fault = fault; }
+
+size_t wf_host_storage_peek(uint32_t offset, uint8_t *out, size_t len)
+{
+    storage_ready();
+    if (offset >= sizeof storage.bytes) {
+        return 0;
+    }
+    const size_t n = len < sizeof storage.bytes - offset ? len : sizeof storage.bytes - offset;
+    memcpy(out, storage.bytes + offset, n);
+    return n;
+}
+
+size_t wf_host_storage_poke(uint32_t offset, const uint8_t *data, size_t len)
+{
+    storage_ready();
+    if (offset >= sizeof storage.bytes) {
+        return 0;
+    }
+    const size_t n = len < sizeof storage.bytes - offset ? len : sizeof storage.bytes - offset;
+    memcpy(storage.bytes + offset, data, n);
+    return storage_flush() ? n : 0;
+}
+
+uint32_t wf_host_storage_erases(void) { return storage.erases; }
+
+uint32_t wf_host_storage_programs(void) { return storage.programs; }
+
+size_t wf_hal_storage_size(void) { return WF_HOST_STORAGE_SIZE; }
+
+bool wf_hal_storage_read(uint32_t offset, uint8_t *buf, size_t len)
+{
+    storage_ready();
+    if (offset > sizeof storage.bytes || len > sizeof storage.bytes - offset) {
+        return false;
+    }
+    memcpy(buf, storage.bytes + offset, len);
+    return true;
+}
+
+bool wf_hal_storage_erase(void)
+{
+    storage_ready();
+    if (storage.fault == WF_HOST_STORAGE_FAIL_ERASE) {
+        return false;
+    }
+    memset(storage.bytes, 0xFF, sizeof storage.bytes);
+    storage.erases++;
+    return storage_flush();
+}
+
+bool wf_hal_storage_program(uint32_t offset, const uint32_t *words, size_t count)
+{
+    storage_ready();
+    if (offset % 4u != 0 || offset > sizeof storage.bytes ||
+        count > (sizeof storage.bytes - offset) / 4u) {
+        return false;
+    }
+    if (storage.fault == WF_HOST_STORAGE_FAIL_PROGRAM) {
+        return false;
+    }
+    /* A power cut: the first half of the words programmed, then nothing. */
+    const size_t programmed = storage.fault == WF_HOST_STORAGE_CUT_PROGRAM ? count / 2u : count;
+    for (size_t i = 0; i < programmed; i++) {
+        uint8_t bytes[4];
+        memcpy(bytes, &words[i], sizeof bytes);
+        for (size_t b = 0; b < 4; b++) {
+            storage.bytes[offset + 4u * i + b] &= bytes[b]; /* flash: clears bits only */
+        }
+    }
+    if (storage.fault == WF_HOST_STORAGE_STUCK_BITS && programmed > 0) {
+        storage.bytes[offset] = 0xFFu; /* worn cells: read 1 whatever was programmed */
+    }
+    storage.programs++;
+    const bool flushed = storage_flush();
+    return flushed && storage.fault != WF_HOST_STORAGE_CUT_PROGRAM;
+}

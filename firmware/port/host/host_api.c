@@ -15,8 +15,23 @@ void wf_host_board_init(const wf_config_t *config)
     }
     wf_host_boot();
     wf_app_init(&the_app, config);
-    wf_host_set_failsafe_compares(the_app.compare); /* what a fault handler writes */
+    wf_host_set_failsafe_compares(the_app.neutral_compare); /* what a fault handler writes */
 }
+
+void wf_host_board_calibration(wf_servo_trim_report_t report[2])
+{
+    for (unsigned i = 0; i < 2; i++) {
+        const wf_servo_cal_t *cal = &the_app.config.servo_cal[i];
+        report[i] = (wf_servo_trim_report_t){
+            .servo = (uint8_t)(i + 1u),     .source = the_app.cal_source[i],
+            .direction = cal->direction,    .reserved = 0,
+            .neutral_us = cal->neutral_us,  .us_per_rad = cal->us_per_rad,
+            .min_us = cal->min_us,          .max_us = cal->max_us,
+        };
+    }
+}
+
+size_t wf_host_calibration_size(void) { return sizeof(wf_servo_trim_report_t); }
 
 size_t wf_host_board_step(uint32_t t, const uint8_t *in, size_t len, uint8_t *out, size_t cap)
 {
@@ -25,6 +40,7 @@ size_t wf_host_board_step(uint32_t t, const uint8_t *in, size_t len, uint8_t *ou
         wf_host_feed(in, len);
     }
     wf_app_poll(&the_app);
+    wf_host_set_failsafe_compares(the_app.neutral_compare); /* as the port's main loop does */
     return cap > 0 ? wf_host_take_output(out, cap) : 0;
 }
 
@@ -195,6 +211,18 @@ static size_t ints_of(const wf_msg_t *m, int64_t n[WF_HOST_MSG_INTS])
     case WF_MSG_GAIT:
         n[0] = m->u.gait.gait_id;
         return 1;
+    case WF_MSG_SERVO_TRIM: {
+        const wf_servo_trim_t *t = &m->u.servo_trim;
+        const int64_t v[4] = {t->servo, t->op, t->direction, t->reserved};
+        memcpy(n, v, sizeof v);
+        return 4;
+    }
+    case WF_MSG_SERVO_TRIM_REPORT: {
+        const wf_servo_trim_report_t *r = &m->u.servo_trim_report;
+        const int64_t v[4] = {r->servo, r->source, r->direction, r->reserved};
+        memcpy(n, v, sizeof v);
+        return 4;
+    }
     case WF_MSG_TELEMETRY_COMPACT: {
         const wf_telemetry_compact_t *c = &m->u.compact;
         const int64_t v[15] = {c->board_time_ms, c->roll,     c->pitch,    c->yaw,
@@ -244,6 +272,22 @@ static void ints_to(const int64_t n[WF_HOST_MSG_INTS], wf_msg_t *m)
     case WF_MSG_GAIT:
         m->u.gait.gait_id = (uint16_t)n[0];
         break;
+    case WF_MSG_SERVO_TRIM: {
+        wf_servo_trim_t *t = &m->u.servo_trim;
+        t->servo = (uint8_t)n[0];
+        t->op = (uint8_t)n[1];
+        t->direction = (int8_t)n[2];
+        t->reserved = (uint8_t)n[3];
+        break;
+    }
+    case WF_MSG_SERVO_TRIM_REPORT: {
+        wf_servo_trim_report_t *r = &m->u.servo_trim_report;
+        r->servo = (uint8_t)n[0];
+        r->source = (uint8_t)n[1];
+        r->direction = (int8_t)n[2];
+        r->reserved = (uint8_t)n[3];
+        break;
+    }
     case WF_MSG_TELEMETRY_COMPACT: {
         wf_telemetry_compact_t *c = &m->u.compact;
         int16_t *const fields[11] = {&c->roll,     &c->pitch,    &c->yaw,      &c->gyro[0],
@@ -317,6 +361,16 @@ static void flatten(const wf_msg_t *m, wf_host_msg_t *f)
     case WF_MSG_GAIT:
         gait_floats(&m->u.gait.params, f->f);
         break;
+    case WF_MSG_SERVO_TRIM:
+        f->f[0] = m->u.servo_trim.neutral_us;
+        f->f[1] = m->u.servo_trim.us_per_rad;
+        break;
+    case WF_MSG_SERVO_TRIM_REPORT: {
+        const wf_servo_trim_report_t *r = &m->u.servo_trim_report;
+        const float v[4] = {r->neutral_us, r->us_per_rad, r->min_us, r->max_us};
+        memcpy(f->f, v, sizeof v);
+        break;
+    }
     default:
         break;
     }
@@ -357,6 +411,18 @@ static void unflatten(const wf_host_msg_t *f, wf_msg_t *m)
     case WF_MSG_GAIT:
         gait_from_floats(f->f, &m->u.gait.params);
         break;
+    case WF_MSG_SERVO_TRIM:
+        m->u.servo_trim.neutral_us = f->f[0];
+        m->u.servo_trim.us_per_rad = f->f[1];
+        break;
+    case WF_MSG_SERVO_TRIM_REPORT: {
+        wf_servo_trim_report_t *r = &m->u.servo_trim_report;
+        r->neutral_us = f->f[0];
+        r->us_per_rad = f->f[1];
+        r->min_us = f->f[2];
+        r->max_us = f->f[3];
+        break;
+    }
     default:
         break;
     }

@@ -6,6 +6,10 @@
  *
  *   wirefish-fw-host --pty [--link PATH]     prints "pty: /dev/pts/N" and serves it
  *   wirefish-fw-host                          frames on stdin/stdout (for a pipe or socat)
+ *
+ * The servo calibration's storage is a 16 KB unit in RAM, lost at exit, unless
+ * --calibration-file PATH names a file: read at start (absent: an erased unit) and written
+ * at each SERVO_TRIM SAVE or FACTORY, so a board started again on it boots on what was saved.
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -45,7 +49,8 @@ static int usage(const char *why)
     fprintf(stderr,
             "wirefish-fw-host: %s\n"
             "usage: wirefish-fw-host [--pty [--link PATH]] [--imu synthetic|none]\n"
-            "                        [--command-timeout MS] [--heartbeat-timeout MS]\n",
+            "                        [--command-timeout MS] [--heartbeat-timeout MS]\n"
+            "                        [--calibration-file PATH]\n",
             why);
     return 2;
 }
@@ -98,6 +103,7 @@ int main(int argc, char **argv)
     config.imu_mode = WF_IMU_SYNTHETIC;
     int use_pty = 0;
     const char *link_path = NULL;
+    const char *calibration_path = NULL;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
@@ -105,6 +111,9 @@ int main(int argc, char **argv)
             use_pty = 1;
         } else if (strcmp(arg, "--link") == 0 && value != NULL) {
             link_path = value;
+            i++;
+        } else if (strcmp(arg, "--calibration-file") == 0 && value != NULL) {
+            calibration_path = value;
             i++;
         } else if (strcmp(arg, "--imu") == 0 && value != NULL) {
             if (strcmp(value, "synthetic") == 0) {
@@ -131,6 +140,12 @@ int main(int argc, char **argv)
     }
     if (link_path != NULL && !use_pty) {
         return usage("--link needs --pty");
+    }
+    wf_host_storage_clear();
+    if (calibration_path != NULL && !wf_host_storage_use_file(calibration_path)) {
+        fprintf(stderr, "wirefish-fw-host: cannot read the calibration file %s\n",
+                calibration_path);
+        return 1;
     }
     int keep_slave = -1;
     const int in_fd = use_pty ? open_pty(link_path, &keep_slave) : STDIN_FILENO;

@@ -75,6 +75,31 @@ void wf_host_set_uart_overruns(uint32_t count);
  * HSI_PLL or HSI model the stm32f4 port's fallback from a dead crystal. */
 void wf_host_set_clock_source(uint8_t source);
 
+/* The calibration's storage (wf_hal_storage_*): one 16 KB unit, the size of the stm32f4
+ * port's flash sector, with flash's rules (erase sets every byte 0xFF, programming clears bits
+ * only). It outlives wf_host_reset and wf_host_board_init (a power cycle keeps flash); it lives
+ * in RAM unless wf_host_storage_use_file names a file, which it is then read from (absent:
+ * erased; shorter: erased past its end) and written back to, whole, at each erase and program.
+ * wf_host_storage_clear: an erased unit in RAM, no file, no fault, counts 0. A fault stays
+ * until set back to WF_HOST_STORAGE_OK. peek and poke read and write bytes as they are
+ * (poke: no flash rule, to damage a record); both return how many bytes they moved. */
+enum { WF_HOST_STORAGE_SIZE = 16384 };
+typedef enum {
+    WF_HOST_STORAGE_OK = 0,
+    WF_HOST_STORAGE_FAIL_ERASE = 1,   /* erase returns false, nothing erased */
+    WF_HOST_STORAGE_FAIL_PROGRAM = 2, /* program returns false, nothing programmed */
+    WF_HOST_STORAGE_CUT_PROGRAM = 3,  /* the first half of the words programmed, then false */
+    WF_HOST_STORAGE_STUCK_BITS = 4,   /* program returns true but the first byte stays
+                                       * 0xFF: only a read-back finds it */
+} wf_host_storage_fault_t;
+void wf_host_storage_clear(void);
+bool wf_host_storage_use_file(const char *path);
+void wf_host_storage_set_fault(int fault);
+size_t wf_host_storage_peek(uint32_t offset, uint8_t *out, size_t len);
+size_t wf_host_storage_poke(uint32_t offset, const uint8_t *data, size_t len);
+uint32_t wf_host_storage_erases(void);
+uint32_t wf_host_storage_programs(void);
+
 /* A flat view of a board for tests. */
 typedef struct {
     uint32_t now_ms;
@@ -99,8 +124,10 @@ typedef struct {
     uint8_t config_rejected;
 } wf_host_snapshot_t;
 
-/* The process's one board (for ctypes): init with config (NULL: the defaults), then step:
- * feed len bytes at time t, poll once, move up to cap output bytes to out (returns how many). */
+/* The process's one board (for ctypes): init with config (NULL: the defaults; the storage as
+ * it is), then step: feed len bytes at time t, poll once, hand the neutral compares of the
+ * calibration in force to the fault model (as the port's main loop does), move up to cap
+ * output bytes to out (returns how many). */
 void wf_host_board_init(const wf_config_t *config);
 size_t wf_host_board_step(uint32_t t, const uint8_t *in, size_t len, uint8_t *out, size_t cap);
 void wf_host_board_snapshot(wf_host_snapshot_t *snapshot);
@@ -135,6 +162,10 @@ typedef struct {
 
 void wf_host_board_gait(wf_host_gait_snapshot_t *snapshot);
 size_t wf_host_gait_snapshot_size(void);
+/* Each servo's calibration in force and its source, as a SERVO_TRIM_REPORT would give them
+ * (report[0] servo 1, report[1] servo 2). */
+void wf_host_board_calibration(wf_servo_trim_report_t report[2]);
+size_t wf_host_calibration_size(void);
 /* The board's wf_health_t as last sent (the core fills its fields when it sends HEALTH). */
 void wf_host_board_health(wf_health_t *health);
 size_t wf_host_health_size(void);
@@ -154,7 +185,9 @@ size_t wf_host_cpg_params_size(void);
  * n holds the integer fields the first part has no place for, each widened, in wire order:
  * TELEMETRY gait_id; LINK_CONFIG period, form, health period, link timeout, coast; ACK
  * acked_type, acked_seq, result; GAIT gait_id (its floats in f[0..9], wire order);
- * TELEMETRY_COMPACT all 15 fields; HEALTH all 20 fields. */
+ * TELEMETRY_COMPACT all 15 fields; HEALTH all 20 fields; SERVO_TRIM servo, op, direction,
+ * reserved (neutral_us, us_per_rad in f[0], f[1]); SERVO_TRIM_REPORT servo, source,
+ * direction, reserved (neutral_us, us_per_rad, min_us, max_us in f[0..3]). */
 enum { WF_HOST_MSG_INTS = 20 };
 typedef struct {
     uint8_t type;

@@ -35,6 +35,9 @@ void board_boot(void);
 void board_bor_init(void);
 void board_watchdog_start(void);
 void board_watchdog_feed(void);
+/* true: the watchdog's period stretched to ~2.4 s for a flash sector erase (storage.c); false:
+ * back to 150 ms. Both restart the count. */
+void board_watchdog_slow(bool slow);
 void board_clock_init(void);
 void board_systick_init(void);
 /* Busy-waits at least `us` microseconds on SysTick's counter (no interrupt needed). */

@@ -130,6 +130,22 @@ void board_watchdog_feed(void)
 #endif
 }
 
+/* The one wait that may hold the CPU beyond the watchdog's period: a flash sector erase
+ * (storage.c: up to 0.5 s, every fetch from flash stalled, this loop's too). For its length
+ * the prescaler is 64 (2.4 s nominal, 1.6 s at the LSI's fastest), then 4 again; each change
+ * waits (bounded) for the IWDG to take it, and the count restarts from the reload. */
+enum { IWDG_PRESCALER_DIV64 = 4u };
+
+void board_watchdog_slow(bool slow)
+{
+    IWDG_KR = IWDG_KEY_RELOAD;
+    IWDG_KR = IWDG_KEY_UNLOCK;
+    IWDG_PR = slow ? IWDG_PRESCALER_DIV64 : IWDG_PRESCALER_DIV4;
+    for (uint32_t i = 0u; i < IWDG_UPDATE_LOOPS && IWDG_SR != 0u; i++) {
+    }
+    IWDG_KR = IWDG_KEY_RELOAD;
+}
+
 /* --- the fault path --------------------------------------------------------------------- */
 __attribute__((noreturn)) void board_fail(uint8_t cause, uint32_t pc, uint32_t lr)
 {

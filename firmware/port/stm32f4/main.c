@@ -4,7 +4,8 @@
  * the clocks, the millisecond clock, the link UART, I2C1 and the ADC; then the portable core
  * (wf/app.h), polled for ever with the watchdog fed once per complete poll. The core starts
  * the servo timer itself (wf_hal_pwm_init with its configured frame rate) and writes the
- * neutral compares, which the fault path then reuses.
+ * neutral compares of the calibration in force (stored, or the build's), which the fault
+ * path then reuses: handed over again after each poll, as a SERVO_TRIM may change them.
  */
 #include "board.h"
 #include "debug_console.h"
@@ -29,11 +30,12 @@ int main(void)
      * the driver from probing a bus that is not there, and says so in every status. */
     config.imu_mode = WF_IMU_SYNTHETIC;
 #endif
-    debug_console_init(&config);
+    debug_console_init(&app.config);   /* its "K" lines: the calibration in force */
     wf_app_init(&app, &config);
-    board_pwm_set_failsafe(app.compare);   /* the neutral pulses wf_app_init wrote */
+    board_pwm_set_failsafe(app.neutral_compare);   /* the neutral pulses wf_app_init wrote */
     for (;;) {
         wf_app_poll(&app);
+        board_pwm_set_failsafe(app.neutral_compare);   /* a SERVO_TRIM may have moved them */
         trace_poll(&app);   /* the QEMU build: "G" and "J" lines */
         debug_console_poll();
         board_watchdog_feed();   /* here only: a poll that never ends is never fed */

@@ -78,13 +78,28 @@
 
 /* --- Flash interface (RM0090 3.9) -------------------------------------------------------- */
 #define FLASH_ACR WF_REG(0x40023C00u)
+#define FLASH_KEYR WF_REG(0x40023C04u)
 #define FLASH_OPTKEYR WF_REG(0x40023C08u)
 #define FLASH_SR WF_REG(0x40023C0Cu)
+#define FLASH_CR WF_REG(0x40023C10u)
 #define FLASH_OPTCR WF_REG(0x40023C14u)
+#define FLASH_KEY1 0x45670123u
+#define FLASH_KEY2 0xCDEF89ABu
 #define FLASH_OPTKEY1 0x08192A3Bu
 #define FLASH_OPTKEY2 0x4C5D6E7Fu
+#define FLASH_SR_EOP (1u << 0)
 #define FLASH_SR_BSY (1u << 16)
 #define FLASH_SR_ERRORS 0xF2u          /* OPERR, WRPERR, PGAERR, PGPERR, PGSERR */
+#define FLASH_CR_PG (1u << 0)
+#define FLASH_CR_SER (1u << 1)
+#define FLASH_CR_SNB(n) ((uint32_t)(n) << 3)
+#define FLASH_CR_SNB_MASK (0x1Fu << 3)
+#define FLASH_CR_PSIZE_X32 (2u << 8)   /* 32-bit parallelism: VDD 2.7-3.6 V */
+#define FLASH_CR_PSIZE_MASK (3u << 8)
+#define FLASH_CR_STRT (1u << 16)
+#define FLASH_CR_LOCK (1u << 31)
+#define FLASH_ACR_ICRST (1u << 11)
+#define FLASH_ACR_DCRST (1u << 12)
 #define FLASH_OPTCR_OPTLOCK (1u << 0)
 #define FLASH_OPTCR_OPTSTRT (1u << 1)
 #define FLASH_OPTCR_BOR_LEV_MASK (3u << 2)
