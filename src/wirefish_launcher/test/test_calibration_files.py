@@ -3,8 +3,8 @@
 
 from pathlib import Path
 
-from wirefish_bringup.graph import fish_graph
 from wirefish_bringup.fleet import fleet_graph
+from wirefish_bringup.graph import fish_graph
 from wirefish_launcher.launcher import with_calibration_files
 
 LOGS = Path('/run/x/logs')
