@@ -33,6 +33,7 @@ setup(
             'mission = wirefish_operator.mission',
             'topic = wirefish_operator.topic_command',
             'param = wirefish_operator.param_command',
+            'calibrate = wirefish_operator.calibrate',
         ],
     },
 )

@@ -67,7 +67,8 @@ def test_not_now_tells_how_to_switch_to_stream_mode():
     exchange.sent(3, 0.0)
     exchange.on_ack(Ack(MsgType.SERVO_TRIM, 3, ErrorCode.NOT_NOW))
     assert exchange.outcome is Outcome.REFUSED
-    assert 'gait mode' in exchange.reason() and 'drive_mode stream' in exchange.reason()
+    words = exchange.reason('/x/bridge_node')
+    assert 'gait mode' in words and 'ros2 param set /x/bridge_node drive_mode stream' in words
 
 
 def test_no_answer_within_the_timeout_says_so():

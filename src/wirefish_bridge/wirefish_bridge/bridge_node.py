@@ -81,7 +81,7 @@ from wirefish_bridge.protocol import (Ack, ErrorReport, Health, Heartbeat, LinkC
                                       TelemetryCompact, TrimOp)
 from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, servo_state_message)
-from wirefish_bridge.servo_trim_link import (CalibrationState, GAIT_MODE_HINT, Outcome,
+from wirefish_bridge.servo_trim_link import (CalibrationState, gait_mode_hint, Outcome,
                                              ServoSweep, sweep_problem, trim_request,
                                              TrimExchange)
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
@@ -233,7 +233,7 @@ class BridgeNode(Node):
             finally:
                 self._trim = None
         response.accepted = exchange.outcome is Outcome.ACCEPTED
-        response.reason = exchange.reason()
+        response.reason = exchange.reason(self.get_fully_qualified_name())
         if exchange.report is not None:
             response.calibration = report_message(exchange.report)
         level = self.get_logger().info if response.accepted else self.get_logger().warn
@@ -251,7 +251,8 @@ class BridgeNode(Node):
         if self._gait_mode:
             response.accepted = False
             response.reason = ('the bridge is in gait mode: the board runs the gait and takes '
-                               'no SERVO_CMD; ' + GAIT_MODE_HINT)
+                               'no SERVO_CMD of a sweep; '
+                               + gait_mode_hint(self.get_fully_qualified_name()))
             return response
         problem = sweep_problem(request.servo, request.amplitude_rad, request.period_s,
                                 self._values['servo_limit_rad'])

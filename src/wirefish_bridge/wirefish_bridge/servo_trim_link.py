@@ -29,8 +29,8 @@ from wirefish_bridge.protocol import (Ack, ErrorCode, MsgType, SERVOS, ServoTrim
                                       ServoTrimReport, TrimOp)
 
 # The fish's refusals of a SERVO_TRIM in words (ErrorCode -> reason); ``reason`` adds the rest.
-GAIT_MODE_HINT = ('switch the bridge to stream mode first: ros2 param set <namespace>/bridge_node '
-                  'drive_mode stream')
+GAIT_MODE_HINT = ('switch the bridge to stream mode first: ros2 param set {bridge} drive_mode '
+                  'stream')
 REFUSALS = {
     ErrorCode.COMMAND_OUT_OF_RANGE: 'out of range: the fish refused the values (direction +-1, '
                                     'us_per_rad > 0, and neutral_us +- us_per_rad x the servo '
@@ -43,8 +43,15 @@ REFUSALS = {
 SWEEP_PERIOD_RANGE_S = (1.0, 120.0)
 
 
-def reason(code: int) -> str:
-    """Return the words of the fish's refusal ``code`` (an ErrorCode)."""
+def gait_mode_hint(bridge: str) -> str:
+    """Return how to put the bridge ``bridge`` (its full node name) in stream mode."""
+    return GAIT_MODE_HINT.format(bridge=bridge)
+
+
+def reason(code: int, bridge: str = '/wirefish/bridge_node') -> str:
+    """Return the words of the fish's refusal ``code`` (an ErrorCode) to bridge ``bridge``."""
+    if code == ErrorCode.NOT_NOW:
+        return REFUSALS[ErrorCode.NOT_NOW].format(bridge=bridge)
     if code in REFUSALS:
         return REFUSALS[ErrorCode(code)]
     name = ErrorCode(code).name if code in set(ErrorCode) else 'unknown'
@@ -136,10 +143,10 @@ class TrimExchange:
         self.outcome = Outcome.ACCEPTED
         return True
 
-    def reason(self) -> str:
+    def reason(self, bridge: str = '/wirefish/bridge_node') -> str:
         """Return why the call did not succeed, in words ('' when accepted)."""
         if self.outcome is Outcome.REFUSED and self.result is not None:
-            return reason(self.result)
+            return reason(self.result, bridge)
         if self.outcome is Outcome.NO_ANSWER:
             if self.result == 0:
                 return 'the fish accepted it but its report did not arrive; read it again'
