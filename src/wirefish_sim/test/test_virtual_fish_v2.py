@@ -13,7 +13,7 @@ from wirefish_bridge.protocol import (Ack, CalibrationSource, ClockSource, Error
                                       Status, Telemetry, TelemetryCompact, TelemetryForm, TrimOp)
 from wirefish_bridge.telemetry_limits import telemetry_problem
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters, OFFSET
-from wirefish_sim.servo_calibration import FileStorage, RamStorage
+from wirefish_sim.servo_trim_store import FileStorage, RamStorage
 from wirefish_sim.virtual_fish import Gap, ImuNoise, SimConfig, VirtualFish
 
 TABLE_1 = Gait(1, 1.0, 0.38, 0.47, 0.0, 0.0, -0.41, 0.64, 1.76, 1.06, 20.0)

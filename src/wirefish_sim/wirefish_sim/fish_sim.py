@@ -59,8 +59,8 @@ from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.lockstep import clock_origin_ns, DEFAULT_GRACE_S, LockstepClock
 from wirefish_sim.pty_device import PtyDevice
-from wirefish_sim.servo_calibration import FileStorage
 from wirefish_sim.servo_model import ServoParameters
+from wirefish_sim.servo_trim_store import FileStorage
 from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
 from wirefish_sim.virtual_fleet import VirtualFleet
 

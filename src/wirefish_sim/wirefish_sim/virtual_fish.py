@@ -18,7 +18,7 @@ telemetry (full or compact), heartbeats, HEALTH and SERVO_TRIM_REPORT as encoded
 (``take_output``).
 
 Servo calibration (SERVO_TRIM): the firmware's pulse mapping per servo, kept in a record log
-(``servo_calibration``: in RAM, or a file that outlives the process); the physical servo is the
+(``servo_trim_store``: in RAM, or a file that outlives the process); the physical servo is the
 build's default servo, so a trimmed calibration moves the reel (``reel_setpoint``). The
 telemetry's servo angles are, as ever, the modelled reel angles: after a trim they show where
 the reel sits (neutral_us 1550 at a command of 0: +0.0785 rad), where the board (which has no
@@ -50,8 +50,8 @@ from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust, rea
                                            tail_tip_lateral_positions)
 from wirefish_sim.fish_dynamics import (GRAVITY, surge_acceleration, wrap_angle,
                                         yaw_acceleration)
-from wirefish_sim.servo_calibration import Calibration, RamStorage, reel_map, Storage
 from wirefish_sim.servo_model import Servo, ServoParameters
+from wirefish_sim.servo_trim_store import Calibration, RamStorage, reel_map, Storage
 
 # The decoder's drops that an ERROR reports: one ERROR per kind seen since that kind's last
 # one, with ref_seq 0 (a dropped frame's seq is not to be trusted), at most one per kind per

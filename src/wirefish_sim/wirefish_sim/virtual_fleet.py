@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from wirefish_kinematics.geometry import FishGeometry
-from wirefish_sim.servo_calibration import Storage
+from wirefish_sim.servo_trim_store import Storage
 from wirefish_sim.virtual_fish import physics_steps, SimConfig, swim, VirtualFish
 
 

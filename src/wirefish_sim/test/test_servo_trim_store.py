@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The virtual fish's calibration store: the board's fit check, reel map and record log."""
+"""The virtual fish's servo trim store: the board's fit check, reel map and record log."""
 
 from dataclasses import replace
 import math
@@ -8,9 +8,9 @@ import zlib
 
 import pytest
 from wirefish_bridge.protocol import CalibrationSource
-from wirefish_sim.servo_calibration import (Calibration, DEFAULT, ERASE_UNIT, f32, FileStorage,
-                                            fits, RamStorage, Record, RECORD_SIZE, reel_map,
-                                            ServoCal, StoredServo, winning_record)
+from wirefish_sim.servo_trim_store import (Calibration, DEFAULT, ERASE_UNIT, f32, FileStorage,
+                                           fits, RamStorage, Record, RECORD_SIZE, reel_map,
+                                           ServoCal, StoredServo, winning_record)
 
 LIMIT = math.pi / 2
 FRAME = 1e6 / 333.0
