@@ -480,11 +480,11 @@ class ServoTrimReport(ProtocolMessage, kind=MsgType.SERVO_TRIM_REPORT, layout='<
     @classmethod
     def from_wire(cls, values: tuple[Any, ...]) -> ServoTrimReport | None:
         """Return the report, or None if a float is not finite."""
-        servo, source, direction, reserved = values[:4]
-        if not _finite(values[4:]):
+        servo, source, direction, reserved, neutral, per_rad, low, high = values
+        if not _finite((neutral, per_rad, low, high)):
             return None
         return cls(servo, CalibrationSource(source) if source in _SOURCES else source,
-                   direction, *values[4:], reserved=reserved)
+                   direction, neutral, per_rad, low, high, reserved)
 
 
 @dataclass(frozen=True)

@@ -361,7 +361,8 @@ class VirtualFish:
         return 0
 
     def _update_reel_maps(self) -> None:
-        self._reel_maps = tuple(reel_map(cal) for cal in self.calibration.cals)
+        cals = self.calibration.cals
+        self._reel_maps = (reel_map(cals[0]), reel_map(cals[1]))
         self._reel_identity = self._reel_maps == ((0.0, 1.0), (0.0, 1.0))
 
     def reel_setpoint(self) -> tuple[float, float]:
