@@ -71,6 +71,12 @@ def test_not_now_tells_how_to_switch_to_stream_mode():
     assert 'gait mode' in words and 'ros2 param set /x/bridge_node drive_mode stream' in words
 
 
+def test_a_request_that_could_not_be_sent_says_the_link_is_down():
+    exchange = TrimExchange(SET, 0.0, 0.4, 2.0)
+    assert not exchange.due(2.0)
+    assert 'link to the fish is down' in exchange.reason()
+
+
 def test_no_answer_within_the_timeout_says_so():
     exchange = TrimExchange(SET, 0.0, 0.4, 2.0)
     exchange.sent(3, 0.0)

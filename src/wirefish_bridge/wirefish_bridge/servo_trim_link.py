@@ -150,6 +150,9 @@ class TrimExchange:
         if self.outcome is Outcome.NO_ANSWER:
             if self.result == 0:
                 return 'the fish accepted it but its report did not arrive; read it again'
+            if self.sends == 0:
+                return ('nothing could be sent: the link to the fish is down or the fish has '
+                        'not identified itself yet (see /diagnostics)')
             return (f'no answer from the fish ({self.sends} SERVO_TRIM sent): is the link up, '
                     'and does its firmware know SERVO_TRIM (protocol 2 with calibration)?')
         return ''
