@@ -211,11 +211,8 @@ class BridgeNode(Node):
         if frame is None:
             response.accepted, response.reason = False, why
             return response
+        # One call at a time: the services' executor is single-threaded, a second call waits.
         with self._trim_cond:
-            if self._trim is not None:
-                response.accepted = False
-                response.reason = 'busy: another servo_trim call waits for the fish; retry'
-                return response
             exchange = self._trim = TrimExchange(frame, time.monotonic(),
                                                  self._values['gait_resend_s'],
                                                  SERVO_TRIM_TIMEOUT_S)
