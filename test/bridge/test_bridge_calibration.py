@@ -7,7 +7,7 @@ domain of its own), shared by the tests in file order: a live trim moves the vir
 is reported LIVE (service answer and latched servo_calibration); a refused request changes
 nothing; a saved one is STORED after fish_sim starts again on its file; FACTORY gives the
 defaults; a sweep turns the servo both ways and is refused in gait mode; `wirefish calibrate
-show` prints both servos.
+show` prints both servos, and names what it waited for when no bridge answers.
 """
 
 from collections.abc import Iterator
@@ -256,3 +256,14 @@ def test_the_verb_show_prints_both_servos(graph: Graph):
     assert done.returncode == 0, done.stderr
     rows = [line.split() for line in done.stdout.splitlines()]
     assert [row[:2] for row in rows[1:]] == [['1', 'DEFAULTS'], ['2', 'DEFAULTS']]
+
+
+def test_the_verb_names_what_it_waited_for_when_no_bridge_answers(graph: Graph):
+    wirefish = shutil.which('wirefish')
+    assert wirefish is not None
+    done = subprocess.run([wirefish, 'calibrate', '--namespace', '/nobody_here', '--timeout',
+                           '1', 'show'], env=graph.env, capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 1
+    assert ('no bridge found in /nobody_here: waited 1 s for its /nobody_here/servo_trim'
+            in done.stderr), done.stderr
