@@ -33,6 +33,7 @@ setup(
             'mission = wirefish_operator.verb.mission',
             'topic = wirefish_operator.verb.topic',
             'param = wirefish_operator.verb.param',
+            'calibrate = wirefish_operator.verb.calibrate',
         ],
     },
 )

@@ -72,5 +72,5 @@ def test_an_undescribed_option_is_found():
 def test_every_verb_of_the_workspace_is_registered_by_its_package():
     assert set(api.verbs()) == {
         'up', 'qemu', 'compose', 'twohost', 'record', 'bag', 'play', 'report', 'retune',
-        'hand-back', 'gaits', 'drive', 'mission', 'topic', 'param', 'sweep',
+        'hand-back', 'gaits', 'drive', 'mission', 'topic', 'param', 'sweep', 'calibrate',
         'identify-geometry', 'view'}

@@ -11,14 +11,15 @@ from wirefish_bridge.codec import (crc16, DecoderStats, encode_body, encode_fram
                                    MAX_BODY, MAX_ENCODED_FRAME, StreamDecoder)
 from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
                                       Heartbeat, LinkConfig, message_class, MsgType,
-                                      ResetCause, Role, ServoCommand, Status, Telemetry,
-                                      TelemetryCompact)
+                                      ResetCause, Role, ServoCommand, ServoTrim,
+                                      ServoTrimReport, Status, Telemetry, TelemetryCompact)
 
 f32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
 u8 = st.integers(0, 0xFF)
 u16 = st.integers(0, 0xFFFF)
 i16 = st.integers(-0x8000, 0x7FFF)
 u32 = st.integers(0, 0xFFFFFFFF)
+i8 = st.integers(-0x80, 0x7F)
 # One strategy per registered message class (a test below keeps it complete).
 STRATEGIES = {
     Heartbeat: st.builds(Heartbeat, version=st.integers(0, 255), role=st.sampled_from(Role),
@@ -38,6 +39,11 @@ STRATEGIES = {
                                 battery_mv=u16, status=u16, gait_id=u16),
     Health: st.builds(Health, u8, u8, u8, u32, u32, u32, u32, u32, u16, u16,
                       *[u32] * 7, u16, u16, u16),
+    ServoTrim: st.builds(ServoTrim, servo=u8, op=u8, direction=i8, neutral_us=f32,
+                         us_per_rad=f32, reserved=u8),
+    ServoTrimReport: st.builds(ServoTrimReport, servo=u8, source=u8, direction=i8,
+                               neutral_us=f32, us_per_rad=f32, min_us=f32, max_us=f32,
+                               reserved=u8),
 }
 messages = st.one_of(*STRATEGIES.values())
 TELEMETRY = Telemetry(board_time_ms=1234, roll=0.1, pitch=-0.2, yaw=3.0, gyro=(0.0, 0.5, -1.0),

@@ -7,8 +7,9 @@ import pytest
 from wirefish_bridge.codec import encode_frame
 from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat, LinkConfig,
                                       message_class, message_type, MsgType, pack_payload,
-                                      PAYLOAD_SIZES, ProtocolMessage, ServoCommand, Telemetry,
-                                      TelemetryCompact, UnknownMessageError, unpack_payload)
+                                      PAYLOAD_SIZES, ProtocolMessage, ServoCommand, ServoTrim,
+                                      ServoTrimReport, Telemetry, TelemetryCompact,
+                                      UnknownMessageError, unpack_payload)
 
 
 @pytest.mark.parametrize('kind, cls, size', [   # the sizes of PROTOCOL.md's message table
@@ -16,6 +17,7 @@ from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat,
     (MsgType.ACK, Ack, 4), (MsgType.SERVO_CMD, ServoCommand, 8), (MsgType.GAIT, Gait, 42),
     (MsgType.TELEMETRY, Telemetry, 56), (MsgType.TELEMETRY_COMPACT, TelemetryCompact, 32),
     (MsgType.HEALTH, Health, 61), (MsgType.ERROR, ErrorReport, 3),
+    (MsgType.SERVO_TRIM, ServoTrim, 12), (MsgType.SERVO_TRIM_REPORT, ServoTrimReport, 20),
 ])
 def test_each_type_byte_has_its_one_class_and_documented_size(kind, cls, size):
     assert message_class(kind) is cls and cls.KIND is kind
@@ -47,7 +49,7 @@ def test_a_message_needs_a_type_byte_and_a_layout():
             pass
 
 
-@pytest.mark.parametrize('kind', [0x00, 0x04, 0x12, 0x55, 0xFF])
+@pytest.mark.parametrize('kind', [0x00, 0x04, 0x13, 0x55, 0xFF])
 def test_an_unregistered_type_byte_decodes_to_nothing(kind):
     assert message_class(kind) is None
     assert unpack_payload(kind, bytes(PAYLOAD_SIZES[MsgType.ERROR])) is None

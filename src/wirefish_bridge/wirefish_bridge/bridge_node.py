@@ -19,10 +19,18 @@ accepts it, in gait mode or whenever it differs from the fish's boot defaults.
 Publishes (sensor-data QoS, stamped on receipt with the node clock)
     ``imu/data`` (sensor_msgs/Imu, frame ``imu_frame_id``), ``attitude``
     (geometry_msgs/Vector3Stamped: roll, pitch, yaw rad), ``servo_state`` (sensor_msgs/JointState,
-    measured angles), ``battery`` (sensor_msgs/BatteryState, at ``battery_rate_hz`` and at once
-    when the low-battery flag changes); and ``/diagnostics``
+    the servo angles the fish reports: the board's commanded angle after its clamp, the
+    virtual fish's modelled reel angle), ``battery`` (sensor_msgs/BatteryState, at
+    ``battery_rate_hz`` and at once when the low-battery flag changes); and ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, reliable) at ``diagnostics_rate_hz``: one status named
     ``<namespace>/bridge_node: serial link <port>``, hardware_id ``<node> on <port> (<device>)``.
+Servo calibration (``servo_trim_link``): the services ``servo_trim``
+(wirefish_msgs/ServoTrim: one SERVO_TRIM, judged here first, resent until the fish answers) and
+``servo_sweep`` (wirefish_msgs/ServoSweep: the wiring check, stream mode only), and the latched
+``servo_calibration`` (wirefish_msgs/ServoCalibration: both servos' last SERVO_TRIM_REPORT; the
+bridge READs both at link-up). The services wait for the fish, so they are served by a second
+node, ``<name>_calibration``, spun on a thread of its own: the wait never holds up servo_cmd,
+heartbeats or the command tick (a coroutine callback would, on the events executor, not run).
 Only the fish it was started for: a virtual fish's link whose owner record says it is stale,
 or a device that is some process's controlling terminal, is not opened (``link_owner``); the
 port is locked (a second bridge on it cannot open it and keeps retrying); nothing is written to
@@ -50,6 +58,7 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Vector3Stamped
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.timer import Timer
 from sensor_msgs.msg import BatteryState, Imu, JointState
@@ -64,11 +73,15 @@ from wirefish_bridge.graph_clock import GraphTime
 from wirefish_bridge.link_health import identifies_fish, Level, LinkHealth
 from wirefish_bridge.link_owner import open_refusal
 from wirefish_bridge.protocol import (Ack, ErrorReport, Health, Heartbeat, LinkConfig,
-                                      PROTOCOL_VERSION, ProtocolMessage, Role, ServoCommand,
-                                      Status, Telemetry, telemetry_of,
-                                      TelemetryCompact)
+                                      MsgType, PROTOCOL_VERSION, ProtocolMessage, Role,
+                                      ServoCommand, SERVOS, ServoTrim as ServoTrimFrame,
+                                      ServoTrimReport, Status, Telemetry, telemetry_of,
+                                      TelemetryCompact, TrimOp)
 from wirefish_bridge.ros_messages import (attitude_message, battery_message,
                                           diagnostic_status, imu_message, servo_state_message)
+from wirefish_bridge.servo_trim_link import (CalibrationState, gait_mode_hint, Outcome,
+                                             ServoSweep, sweep_problem, trim_request,
+                                             TrimExchange)
 from wirefish_bridge.transport import (LinkDown, LinkState, LinkWriteError, PeerNotIdentified,
                                        SerialLink)
 from wirefish_common.cdr_views import CdrError, read_joint_state
@@ -78,7 +91,8 @@ from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
 from wirefish_common.servo_joints import JointProblem, servo_angles
-from wirefish_msgs.msg import CpgParams
+from wirefish_msgs.msg import CpgParams, ServoCalibration, ServoTrimReport as ReportMsg
+from wirefish_msgs.srv import ServoSweep as ServoSweepSrv, ServoTrim as ServoTrimSrv
 
 
 # Rate of the command tick (Hz): the failsafe and held commands (see _make_timers).
@@ -87,6 +101,20 @@ COMMAND_TICK_HZ = 20.0
 # rf433's round trip is 0.2-0.4 s and a GAIT is resent every gait_resend_s (0.4 s): twice the
 # slowest of a working link.
 UNACKNOWLEDGED_WARN_S = 1.0
+# servo_trim: how long a call waits for the fish's answer (s); a copy goes every gait_resend_s.
+SERVO_TRIM_TIMEOUT_S = 2.0
+# At link-up the bridge READs each servo's calibration this many times at most (every
+# gait_resend_s) until its report comes: a firmware without SERVO_TRIM is not asked forever.
+CALIBRATION_READS = 3
+
+
+def report_message(report: ServoTrimReport | None) -> ReportMsg:
+    """Return the ROS form of a SERVO_TRIM_REPORT (servo 0: none)."""
+    if report is None:
+        return ReportMsg()
+    return ReportMsg(servo=report.servo, source=int(report.source), direction=report.direction,
+                     neutral_us=report.neutral_us, us_per_rad=report.us_per_rad,
+                     min_us=report.min_us, max_us=report.max_us)
 
 
 class BridgeNode(Node):
@@ -118,6 +146,15 @@ class BridgeNode(Node):
         self._config = ConfigLink(link_config(self._values), self._values['gait_resend_s'])
         self._watch = OscillatorWatch(self._values['divergence_window_s'],
                                       self._values['divergence_bound_rad'])
+        # Servo calibration: the reader thread takes the answers, the service thread waits on
+        # them (the condition), the executor sends the sweep and the link-up READs.
+        self._send_lock = threading.Lock()   # the encoder's seq and the link: two senders
+        self._trim_cond = threading.Condition()
+        self._trim: TrimExchange | None = None
+        self._calibration = CalibrationState()
+        self._reads_left = {servo: 0 for servo in SERVOS}
+        self._last_read_s = -math.inf
+        self._sweep: ServoSweep | None = None
 
         self._imu_pub = self.create_publisher(Imu, 'imu/data', SENSOR_DATA)
         self._attitude_pub = self.create_publisher(Vector3Stamped, 'attitude',
@@ -127,6 +164,8 @@ class BridgeNode(Node):
         self._battery_pub = self.create_publisher(BatteryState, 'battery',
                                                   SENSOR_DATA)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
+        self._calibration_pub = self.create_publisher(ServoCalibration, 'servo_calibration',
+                                                      LATCHED)
         # Raw: the pair is read from the bytes (cdr_views), no Python message is built.
         self.create_subscription(JointState, 'servo_cmd', self._on_servo_cmd,
                                  SENSOR_DATA, raw=True)
@@ -135,6 +174,142 @@ class BridgeNode(Node):
         self._make_timers()
         self._link = self._make_link()
         self._link.start()
+        self._start_calibration_services()
+
+    # --- servo calibration services (their own node and thread) -----------------------------
+    def _start_calibration_services(self) -> None:
+        # No global arguments: the process's node-name remap would name it bridge_node too.
+        self._service_node = Node(f'{self.get_name()}_calibration',
+                                  namespace=self.get_namespace(), context=self.context,
+                                  use_global_arguments=False, start_parameter_services=False)
+        self._service_node.create_service(ServoTrimSrv, 'servo_trim', self._on_servo_trim)
+        self._service_node.create_service(ServoSweepSrv, 'servo_sweep', self._on_servo_sweep)
+        self._service_executor = SingleThreadedExecutor(context=self.context)
+        self._service_executor.add_node(self._service_node)
+        self._services_stop = threading.Event()
+        self._service_thread = threading.Thread(target=self._spin_services,
+                                                name='calibration services', daemon=True)
+        self._service_thread.start()
+
+    def _spin_services(self) -> None:
+        try:
+            while not self._services_stop.is_set() and self.context.ok():
+                self._service_executor.spin_once(timeout_sec=0.1)
+        except (ExternalShutdownException, RuntimeError):
+            pass   # the context went down under the loop: the process is stopping
+
+    def _on_servo_trim(self, request, response):
+        """Send one SERVO_TRIM and wait for the fish's answer (the service thread)."""
+        frame, why = trim_request(request.servo, request.op, request.direction,
+                                  request.neutral_us, request.us_per_rad)
+        known = self._calibration.reports.get(request.servo)
+        response.calibration = report_message(known)
+        if frame is None:
+            response.accepted, response.reason = False, why
+            return response
+        # One call at a time: the services' executor is single-threaded, a second call waits.
+        with self._trim_cond:
+            exchange = self._trim = TrimExchange(frame, time.monotonic(),
+                                                 self._values['gait_resend_s'],
+                                                 SERVO_TRIM_TIMEOUT_S)
+            try:
+                while True:
+                    now = time.monotonic()
+                    due = exchange.due(now)
+                    if exchange.done:
+                        break
+                    if due:   # sent under the condition: its ACK cannot overtake its seq
+                        seq = self._send(frame)
+                        if seq is not None:
+                            exchange.sent(seq, now)
+                    self._trim_cond.wait(timeout=0.05)
+            finally:
+                self._trim = None
+        response.accepted = exchange.outcome is Outcome.ACCEPTED
+        response.reason = exchange.reason(self.get_fully_qualified_name())
+        if exchange.report is not None:
+            response.calibration = report_message(exchange.report)
+        level = self.get_logger().info if response.accepted else self.get_logger().warn
+        level(f'servo_trim servo {frame.servo} {TrimOp(frame.op).name}: '
+              + ('accepted' if response.accepted else response.reason))
+        return response
+
+    def _on_servo_sweep(self, request, response):
+        """Start (or with amplitude 0 stop) a wiring sweep (the service thread)."""
+        if request.amplitude_rad == 0.0:
+            with self._trim_cond:
+                self._sweep = None
+            response.accepted, response.reason = True, ''
+            return response
+        if self._gait_mode:
+            response.accepted = False
+            response.reason = ('the bridge is in gait mode: the board runs the gait and takes '
+                               'no SERVO_CMD of a sweep; '
+                               + gait_mode_hint(self.get_fully_qualified_name()))
+            return response
+        problem = sweep_problem(request.servo, request.amplitude_rad, request.period_s,
+                                self._values['servo_limit_rad'])
+        now = time.monotonic()
+        with self._trim_cond:
+            running = self._sweep
+            if problem is None and running is not None and not running.over(now):
+                problem = (f'a sweep of servo {running.servo} runs for another '
+                           f'{running.start_s + running.period_s - now:.1f} s (amplitude 0 '
+                           'stops it)')
+            if problem is None:
+                self._sweep = ServoSweep(request.servo, float(request.amplitude_rad),
+                                         float(request.period_s), now)
+        response.accepted, response.reason = problem is None, problem or ''
+        if problem is None:
+            self.get_logger().info(f'servo_sweep: servo {request.servo} 0 -> '
+                                   f'+{request.amplitude_rad:g} -> -{request.amplitude_rad:g} '
+                                   f'-> 0 rad over {request.period_s:g} s; servo_cmd ignored '
+                                   'meanwhile')
+        return response
+
+    def _sweep_command(self) -> tuple[float, float] | None:
+        """Return the sweep's SERVO_CMD angles of now, or None when no sweep runs."""
+        with self._trim_cond:
+            sweep = self._sweep
+            if sweep is None:
+                return None
+            now = time.monotonic()
+            if sweep.over(now):
+                self._sweep = None
+                self.get_logger().info(f'servo_sweep of servo {sweep.servo} done: forwarding '
+                                       'servo_cmd again')
+                return NEUTRAL
+            return sweep.command(now)
+
+    def _on_trim_answer(self, message: Ack | ServoTrimReport) -> None:
+        """Take a SERVO_TRIM's ACK or a report (the reader thread); wake the waiting call."""
+        with self._trim_cond:
+            if isinstance(message, Ack):
+                if self._trim is not None:
+                    self._trim.on_ack(message)
+            else:
+                if self._trim is not None:
+                    self._trim.on_report(message)
+                if self._calibration.on_report(message):
+                    self._reads_left[message.servo] = 0
+                    reports = dict(self._calibration.reports)
+                    state = ServoCalibration(servo_1=report_message(reports[1]),
+                                             servo_2=report_message(reports[2]))
+                    state.header.stamp = self.get_clock().now().to_msg()
+                    self._calibration_pub.publish(state)
+            self._trim_cond.notify_all()
+
+    def _send_calibration_reads(self) -> None:
+        """READ each servo not reported since link-up (at most CALIBRATION_READS times)."""
+        now = time.monotonic()
+        with self._trim_cond:
+            servos = [servo for servo, left in self._reads_left.items() if left > 0]
+            if not servos or now - self._last_read_s < self._values['gait_resend_s']:
+                return
+            self._last_read_s = now
+            for servo in servos:
+                if self._send(ServoTrimFrame(servo, TrimOp.READ)) is not None:
+                    self._reads_left[servo] -= 1
 
     # --- parameters -------------------------------------------------------------------------
     def _apply(self, names: frozenset[str]) -> None:
@@ -154,6 +329,9 @@ class BridgeNode(Node):
                 self._config.set_config(link_config(self._values), self._now_s())
         if 'drive_mode' in names:
             self.get_logger().info(f'drive mode {self._values["drive_mode"]}')
+            if self._gait_mode:
+                with self._trim_cond:
+                    self._sweep = None   # the board runs the gait: no SERVO_CMD of ours
             self._on_command_tick()   # gait mode: the current gait goes out now
         if names & {'heartbeat_rate_hz', 'diagnostics_rate_hz'}:
             self._make_timers()
@@ -194,6 +372,10 @@ class BridgeNode(Node):
                 self._link.identify_peer()
             if isinstance(frame.message, (Telemetry, TelemetryCompact)):
                 self._publish_from_reader(frame.message)
+            elif isinstance(frame.message, ServoTrimReport) or (
+                    isinstance(frame.message, Ack)
+                    and frame.message.acked_type == MsgType.SERVO_TRIM):
+                self._on_trim_answer(frame.message)
             else:
                 others.append(frame)
         if others:
@@ -318,6 +500,9 @@ class BridgeNode(Node):
             with self._gait_lock:
                 self._watch.add_host(self._now_s(), angles)
             return
+        sweep = self._sweep_command()
+        if sweep is not None:   # the wiring sweep's angles go instead (at servo_cmd's pace)
+            angles = sweep
         # The gate counts the wire's time, not the graph's: its rate limit is about the serial
         # link, and on the lockstep road a command that came before this node heard its step's
         # /clock found no credit on the graph's clock and was held for the next tick, which
@@ -337,11 +522,15 @@ class BridgeNode(Node):
             self._send_gait_mode_frames()
 
     def _reconfigure_fish(self) -> None:
-        """Make LINK_CONFIG and the current gait due: the fish may not have them."""
+        """Make LINK_CONFIG, the current gait and the calibration READs due."""
         with self._gait_lock:
             self._config.link_up(self._now_s())
             self._gait.on_fish_restart()
+        with self._trim_cond:
+            self._reads_left = {servo: CALIBRATION_READS for servo in SERVOS}
+            self._last_read_s = -math.inf
         self._send_gait_mode_frames()
+        self._send_calibration_reads()
 
     def _send_gait_mode_frames(self) -> None:
         """Send a LINK_CONFIG and a GAIT that are due (the gait in gait mode only)."""
@@ -398,8 +587,15 @@ class BridgeNode(Node):
 
     def _on_command_tick(self) -> None:
         self._send_gait_mode_frames()
+        self._send_calibration_reads()
         if self._gait_mode:
             return   # no SERVO_CMD: one would put the board back in stream mode
+        sweep = self._sweep_command()
+        if sweep is not None:
+            to_send = self._gate.on_command(sweep, time.monotonic())
+            if to_send is not None:
+                self._send(ServoCommand(*to_send))
+            return
         was_failsafe = self._gate.failsafe
         to_send = self._gate.on_tick(time.monotonic())
         if self._gate.failsafe and not was_failsafe:
@@ -414,17 +610,18 @@ class BridgeNode(Node):
 
     def _send(self, message: ProtocolMessage) -> int | None:
         """Send ``message``; return its sequence number, or None when it did not go out."""
-        seq = self._encoder.next_seq
-        frame = self._encoder.encode(message)
-        try:
-            self._link.write(frame)
-        except PeerNotIdentified:
-            return None   # not a fish (yet): counted by the link as withheld
-        except (LinkDown, LinkWriteError):
-            self._health.out.dropped += 1  # the link's state is in /diagnostics
-            return None
-        self._health.out.sent += 1
-        return seq
+        with self._send_lock:   # the executor and the calibration services' thread
+            seq = self._encoder.next_seq
+            frame = self._encoder.encode(message)
+            try:
+                self._link.write(frame)
+            except PeerNotIdentified:
+                return None   # not a fish (yet): counted by the link as withheld
+            except (LinkDown, LinkWriteError):
+                self._health.out.dropped += 1  # the link's state is in /diagnostics
+                return None
+            self._health.out.sent += 1
+            return seq
 
     def _publish_diagnostics(self) -> None:
         self._drain_inbox()  # heartbeats first, so the status is up to date
@@ -459,6 +656,10 @@ class BridgeNode(Node):
         else:
             # The fish would otherwise hold the last angle until its own command timeout.
             self._send(ServoCommand(*NEUTRAL))
+        self._services_stop.set()
+        self._service_thread.join(timeout=2.0)
+        self._service_executor.shutdown(timeout_sec=1.0)
+        self._service_node.destroy_node()
         self._link.stop()
         super().destroy_node()
 

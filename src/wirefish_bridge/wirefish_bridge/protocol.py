@@ -43,8 +43,10 @@ class MsgType(enum.IntEnum):
     ACK = 0x03
     SERVO_CMD = 0x10
     GAIT = 0x11
+    SERVO_TRIM = 0x12
     TELEMETRY = 0x20
     TELEMETRY_COMPACT = 0x21
+    SERVO_TRIM_REPORT = 0x22
     HEALTH = 0x30
     ERROR = 0x7F
 
@@ -65,6 +67,8 @@ class ErrorCode(enum.IntEnum):
     BAD_LENGTH = 4
     VERSION_MISMATCH = 5
     COMMAND_OUT_OF_RANGE = 6
+    NOT_NOW = 7          # a valid request refused in the fish's current mode (SERVO_TRIM)
+    STORAGE_FAILED = 8   # the calibration could not be written: nothing changed
 
 
 class Status(enum.IntFlag):
@@ -252,7 +256,7 @@ _FORMS = frozenset(int(form) for form in TelemetryForm)
 @dataclass(frozen=True)
 class Ack(ProtocolMessage, kind=MsgType.ACK, layout='<BHB'):
     """
-    Fish -> host: the answer to a GAIT or LINK_CONFIG with sequence ``acked_seq``.
+    Fish -> host: the answer to a GAIT, LINK_CONFIG or SERVO_TRIM with sequence ``acked_seq``.
 
     ``result`` 0: accepted; else the ErrorCode of the refusal (nothing changed).
     """
@@ -370,6 +374,117 @@ class Gait(ProtocolMessage, kind=MsgType.GAIT, layout='<H' + 'f' * 10):
         if not 0.0 < self.alpha <= GAIT_MAX_ALPHA:
             return f'alpha {self.alpha:g} outside (0, {GAIT_MAX_ALPHA:g}]'
         return None
+
+
+class TrimOp(enum.IntEnum):
+    """What a SERVO_TRIM asks of the fish."""
+
+    READ = 0      # report the servo's calibration, change nothing
+    SET = 1       # use the given calibration now, not saved
+    SAVE = 2      # use it now and write it to the board's storage
+    FACTORY = 3   # back to the build's defaults, now and after a reboot
+
+
+class CalibrationSource(enum.IntEnum):
+    """Where a servo's calibration in force comes from (SERVO_TRIM_REPORT)."""
+
+    DEFAULTS = 0  # the build's values
+    STORED = 1    # equal to the record in the board's storage
+    LIVE = 2      # set by SERVO_TRIM, not saved
+
+
+SERVOS = (1, 2)  # servo_1 drives reel phi_D1, servo_2 reel phi_D2
+_OPS = frozenset(int(op) for op in TrimOp)
+_SOURCES = frozenset(int(source) for source in CalibrationSource)
+
+
+@dataclass(frozen=True)
+class ServoTrim(ProtocolMessage, kind=MsgType.SERVO_TRIM, layout='<BBbBff'):
+    """
+    Host -> fish: read, set, save or reset one servo's calibration; ACKed, then reported.
+
+    ``servo`` 1 or 2, ``op`` a TrimOp, ``direction`` +1/-1 (SET/SAVE; READ and FACTORY send
+    0), ``reserved`` 0, ``neutral_us`` the pulse at 0 rad, ``us_per_rad`` the pulse change per
+    rad of reel angle (> 0). Any finite values decode (``problem`` says which the fish
+    refuses, ACK 6).
+    """
+
+    servo: int
+    op: int = TrimOp.READ
+    direction: int = 0
+    neutral_us: float = 0.0
+    us_per_rad: float = 0.0
+    reserved: int = 0
+
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return servo, op, direction, reserved, neutral_us, us_per_rad."""
+        return (self.servo, int(self.op), self.direction, self.reserved, self.neutral_us,
+                self.us_per_rad)
+
+    @classmethod
+    def from_wire(cls, values: tuple[Any, ...]) -> ServoTrim | None:
+        """Return the request, or None if a float is not finite (ranges: ``problem``)."""
+        servo, op, direction, reserved, neutral, per_rad = values
+        if not _finite((neutral, per_rad)):
+            return None
+        return cls(servo, TrimOp(op) if op in _OPS else op, direction, neutral, per_rad,
+                   reserved)
+
+    def problem(self) -> str | None:
+        """
+        Return why the fish refuses this request whatever its state (ACK 6), or None.
+
+        The fit of the calibration to the board's pulse range is the board's to judge
+        (``wf_servo_cal_fits``): the host does not know its min_us/max_us before a report.
+        """
+        if self.servo not in SERVOS:
+            return f'servo {self.servo} is neither 1 nor 2'
+        if self.op not in _OPS:
+            return f'op {self.op} is not a TrimOp'
+        if self.reserved != 0:
+            return f'reserved byte {self.reserved} is not 0'
+        if self.op in (TrimOp.SET, TrimOp.SAVE):
+            if self.direction not in (1, -1):
+                return f'direction {self.direction} is neither +1 nor -1'
+            if not _finite((self.neutral_us, self.us_per_rad)):
+                return 'neutral_us and us_per_rad must be finite'
+            if not self.us_per_rad > 0.0:
+                return f'us_per_rad {self.us_per_rad:g} is not > 0'
+        return None
+
+
+@dataclass(frozen=True)
+class ServoTrimReport(ProtocolMessage, kind=MsgType.SERVO_TRIM_REPORT, layout='<BBbBffff'):
+    """
+    Fish -> host: one servo's calibration in force and where it comes from.
+
+    Sent after the ACK of an accepted SERVO_TRIM (that servo) and for both servos after boot.
+    ``source`` a CalibrationSource; ``min_us``/``max_us`` the build's pulse range (read-only).
+    Any finite values decode.
+    """
+
+    servo: int
+    source: int
+    direction: int
+    neutral_us: float
+    us_per_rad: float
+    min_us: float
+    max_us: float
+    reserved: int = 0
+
+    def to_wire(self) -> tuple[Any, ...]:
+        """Return servo, source, direction, reserved and the four floats in order."""
+        return (self.servo, int(self.source), self.direction, self.reserved, self.neutral_us,
+                self.us_per_rad, self.min_us, self.max_us)
+
+    @classmethod
+    def from_wire(cls, values: tuple[Any, ...]) -> ServoTrimReport | None:
+        """Return the report, or None if a float is not finite."""
+        servo, source, direction, reserved, neutral, per_rad, low, high = values
+        if not _finite((neutral, per_rad, low, high)):
+            return None
+        return cls(servo, CalibrationSource(source) if source in _SOURCES else source,
+                   direction, neutral, per_rad, low, high, reserved)
 
 
 @dataclass(frozen=True)

@@ -2,16 +2,18 @@
 """The virtual fish's firmware rules of protocol version 2 (no ROS, no pty, simulated time)."""
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
-                                      Heartbeat, LinkConfig, MsgType, ResetCause, Role,
-                                      ServoCommand, Status, Telemetry, TelemetryCompact,
-                                      TelemetryForm)
+from wirefish_bridge.protocol import (Ack, CalibrationSource, ClockSource, ErrorCode,
+                                      ErrorReport, Gait, Health, Heartbeat, LinkConfig, MsgType,
+                                      ResetCause, Role, ServoCommand, ServoTrim, ServoTrimReport,
+                                      Status, Telemetry, TelemetryCompact, TelemetryForm, TrimOp)
 from wirefish_bridge.telemetry_limits import telemetry_problem
 from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters, OFFSET
+from wirefish_sim.servo_trim_store import FileStorage, RamStorage
 from wirefish_sim.virtual_fish import Gap, ImuNoise, SimConfig, VirtualFish
 
 TABLE_1 = Gait(1, 1.0, 0.38, 0.47, 0.0, 0.0, -0.41, 0.64, 1.76, 1.06, 20.0)
@@ -281,3 +283,112 @@ def test_each_millisecond_emits_at_most_one_of_each_kind():
     for t, m in host.frames:
         by_ms.setdefault((t, type(m)), []).append(m)
     assert max(len(ms) for (_, kind), ms in by_ms.items() if kind is not ErrorReport) == 1
+
+
+# --- SERVO_TRIM: the spec's judging order, ACK then report, the reel it moves -------------
+HOST = Heartbeat(role=Role.HOST)
+TRIM = ServoTrim(1, TrimOp.SET, 1, 1550.0, 600.0)
+
+
+def _streaming_host(**config) -> Host:
+    host = Host(**config)
+    host.run(20, HOST, ServoCommand(0.0, 0.0))
+    return host
+
+
+def test_boot_sends_both_reports_right_after_the_boot_health():
+    host = Host()
+    host.run(5)
+    health = [t for t, m in host.frames if isinstance(m, Health)][0]
+    reports = [(t, m) for t, m in host.frames if isinstance(m, ServoTrimReport)]
+    assert [t for t, _ in reports] == [health, health + 1]   # one of a kind per millisecond
+    reports = [m for _, m in reports]
+    assert [(r.servo, r.source) for r in reports] == [(1, CalibrationSource.DEFAULTS),
+                                                      (2, CalibrationSource.DEFAULTS)]
+    first = reports[0]
+    assert (first.neutral_us, first.min_us, first.max_us) == (1500.0, 500.0, 2500.0)
+
+
+def test_an_accepted_set_is_acked_then_reported_live():
+    host = _streaming_host()
+    frames = host.run(5, TRIM)
+    seq = host.last_seqs[0]
+    ack = [i for i, m in enumerate(frames) if isinstance(m, Ack)][0]
+    assert frames[ack] == Ack(MsgType.SERVO_TRIM, seq, 0)
+    report = frames[ack + 1]
+    assert isinstance(report, ServoTrimReport)
+    assert (report.servo, report.source, report.neutral_us, report.us_per_rad) == (
+        1, CalibrationSource.LIVE, 1550.0, 600.0)
+
+
+def test_a_live_trim_moves_the_reel_by_the_pulse_it_gets():
+    host = _streaming_host()
+    host.run(300, TRIM, every_ms={20: ServoCommand(0.0, 0.0), 400: HOST})
+    # 50 us of neutral on a 636.62 us/rad servo: the reel sits 0.0785 rad off; servo 2 at 0.
+    assert host.fish.servos.angle[0] == pytest.approx(50.0 / 636.619772, abs=1e-5)
+    assert abs(host.fish.servos.angle[1]) < 1e-9
+
+
+def test_a_reversed_direction_turns_the_reel_the_other_way():
+    host = _streaming_host()
+    host.run(400, ServoTrim(2, TrimOp.SET, -1, 1500.0, 600.0),
+             every_ms={20: ServoCommand(0.0, 0.3), 400: HOST})
+    assert host.fish.servos.angle[1] == pytest.approx(-0.3 * 600.0 / 636.619772, abs=1e-5)
+
+
+def test_refusals_get_ack_6_no_report_and_change_nothing():
+    host = _streaming_host()
+    bad = [ServoTrim(3, TrimOp.SET, 1, 1550.0, 600.0), ServoTrim(1, TrimOp.SET, 0, 1550.0, 600.0),
+           ServoTrim(1, TrimOp.SET, 1, 1550.0, 636.62), ServoTrim(1, 4),
+           ServoTrim(1, TrimOp.READ, reserved=1), ServoTrim(1, TrimOp.SET, 1, 1500.0, -1.0)]
+    frames = []
+    for trim in bad:
+        frames += host.run(3, trim)
+    assert [a.result for a in of(frames, Ack)] == [ErrorCode.COMMAND_OUT_OF_RANGE] * len(bad)
+    assert not of(frames, ServoTrimReport)
+    assert host.fish.calibration.sources == [CalibrationSource.DEFAULTS] * 2
+
+
+def test_a_non_finite_trim_is_dropped_with_error_6_ref_0_and_no_ack():
+    host = _streaming_host()
+    frames = host.run(30, ServoTrim(1, TrimOp.SET, 1, math.nan, 600.0))
+    assert ErrorReport(ErrorCode.COMMAND_OUT_OF_RANGE, 0) in frames
+    assert not of(frames, Ack) and not of(frames, ServoTrimReport)
+
+
+def test_in_gait_mode_a_change_is_not_now_and_a_read_is_answered():
+    host = _streaming_host()
+    host.run(5, TABLE_1)
+    frames = host.run(5, TRIM, ServoTrim(2, TrimOp.FACTORY), ServoTrim(2, TrimOp.READ))
+    assert [a.result for a in of(frames, Ack) if a.acked_type == MsgType.SERVO_TRIM] == [
+        ErrorCode.NOT_NOW, ErrorCode.NOT_NOW, 0]
+    assert [(r.servo, r.source) for r in of(frames, ServoTrimReport)] == [
+        (2, CalibrationSource.DEFAULTS)]
+
+
+def test_a_failed_storage_write_is_storage_failed_and_nothing_changes():
+    storage = RamStorage()
+    storage.fail = True
+    fish = VirtualFish(SimConfig(imu_noise=ImuNoise().scaled(0.0)), storage=storage)
+    assert fish.trim(ServoTrim(1, TrimOp.SAVE, 1, 1550.0, 600.0)) == ErrorCode.STORAGE_FAILED
+    assert fish.calibration.sources[0] is CalibrationSource.DEFAULTS
+    assert fish.reel_setpoint() == (0.0, 0.0)
+
+
+def test_a_saved_trim_is_stored_after_a_restart_and_factory_undoes_it(tmp_path):
+    path = tmp_path / 'calibration.bin'
+    fish = VirtualFish(storage=FileStorage(path))
+    assert fish.trim(ServoTrim(1, TrimOp.SAVE, -1, 1550.0, 600.0)) == 0
+    restarted = VirtualFish(storage=FileStorage(path))
+    assert restarted.calibration.report(1) == ServoTrimReport(
+        1, CalibrationSource.STORED, -1, 1550.0, 600.0, 500.0, 2500.0)
+    assert restarted.trim(ServoTrim(1, TrimOp.FACTORY)) == 0
+    again = VirtualFish(storage=FileStorage(path))
+    assert again.calibration.report(1).source is CalibrationSource.DEFAULTS
+
+
+def test_a_full_ack_queue_drops_the_ack_and_its_report():
+    fish = VirtualFish(SimConfig(imu_noise=ImuNoise().scaled(0.0)))
+    encoder = FrameEncoder()
+    fish.receive(b''.join(encoder.encode(ServoTrim(1, TrimOp.READ)) for _ in range(6)))
+    assert fish.acks_dropped == 2

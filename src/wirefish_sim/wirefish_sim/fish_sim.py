@@ -15,6 +15,9 @@ which kinematics_node, tuner_node and planner_node read too; read at start). Wit
 ``--ros`` it swims with ``FishGeometry``'s defaults. Fault flags: ``--corrupt-fraction``,
 ``--drop-fraction``, ``--stall-every/--stall-for`` (firmware freezes: no output, input lost),
 ``--reopen-every/--reopen-count/--reopen-delay`` (close the device, wait, open a new one).
+``--calibration FILE`` (once per fish, in the order of ``--link``) keeps each fish's servo
+calibration record log (SERVO_TRIM's SAVE and FACTORY) in a file: a fish_sim started again on
+it boots with the saved calibration; without it the log lives in RAM.
 Disturbances of the water: ``--yaw-disturbance`` (rad/s, a current that turns the fish) and
 ``--surge-disturbance`` (N along the body, + forward); see ``faults.Disturbance``. Faults and
 disturbances apply to every fish, each fish with its own device, schedule state and
@@ -57,6 +60,7 @@ from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.lockstep import clock_origin_ns, DEFAULT_GRACE_S, LockstepClock
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.servo_model import ServoParameters
+from wirefish_sim.servo_trim_store import FileStorage
 from wirefish_sim.virtual_fish import ImuNoise, SimConfig, VirtualFish
 from wirefish_sim.virtual_fleet import VirtualFleet
 
@@ -115,6 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
                    'fish (rad/s, + turns left)')
     p.add_argument('--surge-disturbance', type=float, default=0.0,
                    help='constant surge force of a current (N, + pushes forward)')
+    p.add_argument('--calibration', type=Path, action='append', default=None, metavar='FILE',
+                   help="file of a fish's servo calibration record log (once per fish, in "
+                   '--link order; absent file: erased); without it: in RAM')
     p.add_argument('--speed', type=_speed, default=None, metavar='X',
                    help="own the clock: simulated time in lockstep with the host's SERVO_CMD, "
                    'paced at X times real time (1 = real time when the machine keeps up; max = '
@@ -292,7 +299,9 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
         return 1
     fleet = VirtualFleet([np.random.default_rng(args.seed + 2 * k) for k in range(len(names))],
                          config_from(args),
-                         ground_truth.geometry if ground_truth is not None else None)
+                         ground_truth.geometry if ground_truth is not None else None,
+                         [FileStorage(path) for path in args.calibration]
+                         if args.calibration else None)
     print(f'fish_sim: geometry ({"ROS parameters" if ground_truth else "defaults"}) '
           + ', '.join(f'{f.name} {getattr(fleet.geometry, f.name):g}'
                       for f in fields(fleet.geometry))
@@ -492,6 +501,8 @@ def flags_problem(args: argparse.Namespace) -> str | None:
         return 'every fish of several needs its --link'
     if len({str(link) for link in links}) < len(links):
         return 'each fish needs a --link of its own'
+    if args.calibration is not None and len(args.calibration) != len(links):
+        return f'{len(args.calibration)} --calibration files for {len(links)} fish (--link)'
     if args.fish is not None:
         if len(args.fish) != len(links):
             return f'{len(args.fish)} --fish names for {len(links)} fish (--link)'

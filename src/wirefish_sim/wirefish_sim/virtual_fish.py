@@ -13,8 +13,16 @@ frames (``receive``); in stream mode it drives the servos to each SERVO_CMD and 
 neutral at a bounded rate when commands or host heartbeats stop; in gait mode (an accepted
 GAIT) it integrates eq 1 itself with ``wirefish_cpg.oscillator.CpgIntegrator`` (RK4, 1 ms
 steps of its clock, from the angles stream mode held), coasts when the link is lost and comes
-to rest after the coast; it answers GAIT and LINK_CONFIG with ACKs and emits telemetry (full
-or compact), heartbeats and HEALTH as encoded frames (``take_output``).
+to rest after the coast; it answers GAIT, LINK_CONFIG and SERVO_TRIM with ACKs and emits
+telemetry (full or compact), heartbeats, HEALTH and SERVO_TRIM_REPORT as encoded frames
+(``take_output``).
+
+Servo calibration (SERVO_TRIM): the firmware's pulse mapping per servo, kept in a record log
+(``servo_trim_store``: in RAM, or a file that outlives the process); the physical servo is the
+build's default servo, so a trimmed calibration moves the reel (``reel_setpoint``). The
+telemetry's servo angles are, as ever, the modelled reel angles: after a trim they show where
+the reel sits (neutral_us 1550 at a command of 0: +0.0785 rad), where the board (which has no
+angle sensor) reports its commanded angle.
 
 Clocks: a frame received at time t acts on the physics step that starts at t (its rules run
 at t, as the board's poll at the end of that millisecond runs them); what the step emits is
@@ -33,8 +41,8 @@ import numpy as np
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
                                       Heartbeat, LinkConfig, MsgType, PROTOCOL_VERSION,
-                                      ResetCause, Role, ServoCommand, Status, Telemetry,
-                                      TelemetryCompact, TelemetryForm)
+                                      ResetCause, Role, ServoCommand, SERVOS, ServoTrim, Status,
+                                      Telemetry, TelemetryCompact, TelemetryForm, TrimOp)
 from wirefish_cpg.oscillator import (at_rest, CpgIntegrator, CpgParameters, initial_state,
                                      OFFSET)
 from wirefish_kinematics.geometry import FishGeometry
@@ -43,6 +51,7 @@ from wirefish_kinematics.lighthill import (drag_force, instantaneous_thrust, rea
 from wirefish_sim.fish_dynamics import (GRAVITY, surge_acceleration, wrap_angle,
                                         yaw_acceleration)
 from wirefish_sim.servo_model import Servo, ServoParameters
+from wirefish_sim.servo_trim_store import Calibration, RamStorage, reel_map, Storage
 
 # The decoder's drops that an ERROR reports: one ERROR per kind seen since that kind's last
 # one, with ref_seq 0 (a dropped frame's seq is not to be trusted), at most one per kind per
@@ -76,8 +85,9 @@ _NEUTRAL_FLAGS = _FAILSAFE_COMMAND | _FAILSAFE_HEARTBEAT | _VERSION_MISMATCH
 # The flags the failsafe check leaves as they are (it sets every other one anew).
 _KEPT_FLAGS = 0xFFFF & ~(_NEUTRAL_FLAGS | _SERVO_CLAMPED | _LOW_BATTERY | _COASTING | _RESTING
                          | _GAIT_MODE)
-# ACKs wait in a queue of this many and leave one per millisecond, oldest first; a GAIT or
-# LINK_CONFIG that finds it full gets none (the host resends). The board's rule (app.c).
+# ACKs wait in a queue of this many and leave one per millisecond, oldest first; a GAIT,
+# LINK_CONFIG or SERVO_TRIM that finds it full gets none (the host resends). The board's rule
+# (app.c).
 ACK_QUEUE = 4
 # In gait mode the firmware steps its CPG at most this many ms at once: a longer backlog (a
 # stalled poll loop, see ``stall``) is dropped and the oscillator goes on from its state, a
@@ -169,8 +179,14 @@ class VirtualFish:
     """The fish's firmware and physics, advanced by ``step(dt)``."""
 
     def __init__(self, config: SimConfig | None = None, geometry: FishGeometry | None = None,
-                 rng: np.random.Generator | None = None) -> None:
-        """Build a fish at rest; ``rng`` draws the IMU biases and noise (seedable)."""
+                 rng: np.random.Generator | None = None, storage: Storage | None = None
+                 ) -> None:
+        """
+        Build a fish at rest; ``rng`` draws the IMU biases and noise (seedable).
+
+        ``storage`` holds its calibration record log (None: in RAM, erased); the fish boots
+        with the calibration it holds.
+        """
         self.config = config or SimConfig()
         self.geometry = geometry or FishGeometry()
         self.rng = rng if rng is not None else np.random.default_rng(0)
@@ -203,7 +219,14 @@ class VirtualFish:
         self._next_health = 0.0  # once right after boot, then every period from then
         self._health_sent = False
         self._reschedule = False  # a LINK_CONFIG's periods start at the next emission
-        self._acks: deque[Ack] = deque()
+        # Each ACK with the servo whose SERVO_TRIM_REPORT follows it (0: none).
+        self._acks: deque[tuple[Ack, int]] = deque()
+        self.calibration = Calibration(storage if storage is not None else RamStorage(),
+                                       c.servo.limit_rad, 1e6 / c.servo.update_hz)
+        self._boot_reports: deque[int] = deque()  # servos whose boot report is still due
+        self._reel_maps = ((0.0, 1.0), (0.0, 1.0))
+        self._reel_identity = True
+        self._update_reel_maps()
         self.acks_dropped = 0
         self.gait: Gait | None = None  # the last accepted GAIT (None in stream mode)
         self.cpg: CpgIntegrator | None = None
@@ -246,6 +269,10 @@ class VirtualFish:
                 self._queue_ack(MsgType.GAIT, frame.seq, self.set_gait(message, frame.seq))
             elif isinstance(message, LinkConfig):
                 self._queue_ack(MsgType.LINK_CONFIG, frame.seq, self.configure_link(message))
+            elif isinstance(message, ServoTrim):
+                result = self.trim(message)
+                self._queue_ack(MsgType.SERVO_TRIM, frame.seq, result,
+                                message.servo if result == 0 else 0)
 
     def command(self, servo_1: float, servo_2: float) -> None:
         """Register servo targets (rad) now, as a SERVO_CMD frame would (stream mode)."""
@@ -306,6 +333,51 @@ class VirtualFish:
         self._reschedule = True
         return 0
 
+    def trim(self, request: ServoTrim) -> int:
+        """
+        Judge and apply a SERVO_TRIM now as the board does; return the ACK's result.
+
+        In the spec's order: a bad field or a calibration that does not fit the board (6),
+        a change in gait mode (7: READ is always allowed), a failed storage write (8); in
+        every refusal nothing changes. Accepted, the next PWM write uses it.
+        """
+        self._host_frame()
+        if request.problem() is not None:
+            return ErrorCode.COMMAND_OUT_OF_RANGE
+        op = request.op
+        cal = self.calibration.with_values(request.neutral_us, request.us_per_rad,
+                                           request.direction)
+        if op in (TrimOp.SET, TrimOp.SAVE) and not self.calibration.fits(cal):
+            return ErrorCode.COMMAND_OUT_OF_RANGE
+        if op != TrimOp.READ and self.cpg is not None:
+            return ErrorCode.NOT_NOW
+        if op == TrimOp.SET:
+            self.calibration.set_live(request.servo, cal)
+        elif op == TrimOp.SAVE and not self.calibration.save(request.servo, cal):
+            return ErrorCode.STORAGE_FAILED
+        elif op == TrimOp.FACTORY and not self.calibration.factory(request.servo):
+            return ErrorCode.STORAGE_FAILED
+        self._update_reel_maps()
+        return 0
+
+    def _update_reel_maps(self) -> None:
+        cals = self.calibration.cals
+        self._reel_maps = (reel_map(cals[0]), reel_map(cals[1]))
+        self._reel_identity = self._reel_maps == ((0.0, 1.0), (0.0, 1.0))
+
+    def reel_setpoint(self) -> tuple[float, float]:
+        """
+        Return where the reels go (rad): the firmware's targets through its pulse mapping.
+
+        The board writes each servo's calibrated pulse of its target; the physical servo (the
+        build's default) turns the reel by that pulse.
+        """
+        target = self.firmware_target()
+        if self._reel_identity:
+            return target
+        (o1, g1), (o2, g2) = self._reel_maps
+        return o1 + g1 * target[0], o2 + g2 * target[1]
+
     @property
     def gait_id(self) -> int:
         """Return the id of the gait the fish runs (0 in stream mode)."""
@@ -321,20 +393,28 @@ class VirtualFish:
                 self._drop_report_due_ms[i] = now_ms + _ERROR_MIN_INTERVAL_MS
                 self._outbox.append(self.encoder.encode(ErrorReport(code, 0)))
 
-    def _queue_ack(self, kind: MsgType, seq: int, result: int) -> None:
+    def _queue_ack(self, kind: MsgType, seq: int, result: int, report_servo: int = 0) -> None:
         if len(self._acks) < ACK_QUEUE:
-            self._acks.append(Ack(kind, seq, int(result)))
+            self._acks.append((Ack(kind, seq, int(result)), report_servo))
         else:
             self.acks_dropped += 1
 
-    def _send_ack(self) -> None:
-        """Send the oldest waiting ACK; a refused GAIT's ERROR (its code and seq) just before."""
+    def _send_ack(self) -> bool:
+        """
+        Send the oldest waiting ACK; a refused GAIT's ERROR (its code and seq) just before.
+
+        An accepted SERVO_TRIM's ACK is followed by its servo's SERVO_TRIM_REPORT; return True
+        when one went.
+        """
         if not self._acks:
-            return
-        ack = self._acks.popleft()
+            return False
+        ack, report_servo = self._acks.popleft()
         if ack.acked_type == MsgType.GAIT and ack.result != 0:
             self._outbox.append(self.encoder.encode(ErrorReport(ack.result, ack.acked_seq)))
         self._outbox.append(self.encoder.encode(ack))
+        if report_servo:
+            self._outbox.append(self.encoder.encode(self.calibration.report(report_servo)))
+        return bool(report_servo)
 
     def _host_frame(self) -> None:
         """Register a valid host frame now: the link is alive; a gap ends, the gait resumes."""
@@ -474,7 +554,7 @@ class VirtualFish:
             self._reschedule = False
             self._next_telemetry = now + self._telemetry_period_s
             self._next_health = now + self._health_period_s if self._health_period_s else math.inf
-        self._send_ack()
+        reported = self._send_ack()
         if now + 1e-9 >= self._next_telemetry:
             self._next_telemetry += self._telemetry_period_s
             telemetry = self.telemetry(servo_angles)
@@ -488,8 +568,14 @@ class VirtualFish:
         if now + 1e-9 >= self._next_health:
             base = self._next_health if self._health_sent else now
             self._next_health = base + self._health_period_s if self._health_period_s else math.inf
+            if not self._health_sent:  # the boot reports: from the boot HEALTH's poll on
+                self._boot_reports.extend(SERVOS)
             self._health_sent = True
             self._outbox.append(self.encoder.encode(self.health()))
+        if self._boot_reports and not reported:
+            # One report a poll, as of every kind: servo 1 with the boot HEALTH, servo 2 next.
+            self._outbox.append(self.encoder.encode(
+                self.calibration.report(self._boot_reports.popleft())))
 
     def telemetry(self, servo_angles: np.ndarray | None = None) -> Telemetry:
         """Return the telemetry message of now: the IMU model applied to the ground truth."""
@@ -561,7 +647,7 @@ def swim(school: Sequence[VirtualFish], count: int) -> None:
     targets = np.empty((len(school), 2))
     for i in range(count):
         for f, fish in enumerate(school):
-            targets[f] = fish.firmware_target()
+            targets[f] = fish.reel_setpoint()
         servos.step(targets, h)
         angles[:, i], rates[:, i] = servos.angle, servos.rate
         for f, fish in enumerate(school):

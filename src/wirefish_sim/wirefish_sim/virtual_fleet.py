@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from wirefish_kinematics.geometry import FishGeometry
+from wirefish_sim.servo_trim_store import Storage
 from wirefish_sim.virtual_fish import physics_steps, SimConfig, swim, VirtualFish
 
 
@@ -23,13 +24,21 @@ class VirtualFleet:
     """``len(rngs)`` virtual fish of one config and geometry, advanced together."""
 
     def __init__(self, rngs: Sequence[np.random.Generator], config: SimConfig | None = None,
-                 geometry: FishGeometry | None = None) -> None:
-        """Build one fish at rest per Generator (its IMU biases and noise)."""
+                 geometry: FishGeometry | None = None,
+                 storages: Sequence[Storage | None] | None = None) -> None:
+        """
+        Build one fish at rest per Generator (its IMU biases and noise).
+
+        ``storages``: each fish's calibration storage (None, or a None of it: in RAM).
+        """
         if not rngs:
             raise ValueError('a fleet has at least one fish')
+        if storages is not None and len(storages) != len(rngs):
+            raise ValueError(f'{len(storages)} calibration storages for {len(rngs)} fish')
         config = config or SimConfig()
         geometry = geometry or FishGeometry()
-        self.fish = tuple(VirtualFish(config, geometry, rng) for rng in rngs)
+        self.fish = tuple(VirtualFish(config, geometry, rng, storage)
+                          for rng, storage in zip(rngs, storages or [None] * len(rngs)))
         self.config, self.geometry = config, geometry
         self._remainder = 0.0
 

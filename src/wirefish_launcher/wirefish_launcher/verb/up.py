@@ -11,6 +11,7 @@ nodes are already discovered on this ROS domain refuses to start (--allow-duplic
 import argparse
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from datetime import datetime
 import enum
 import importlib.util
@@ -138,6 +139,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--allow-duplicate', action='store_true',
                         help='start even if nodes of the graph already run in this namespace '
                         '(e.g. a graph that just died is still discovered)')
+
+
+def with_calibration_files(specs: list[NodeSpec], directory: Path) -> list[NodeSpec]:
+    """
+    Return ``specs`` with each fish_sim given a calibration file per fish under ``directory``.
+
+    The virtual fish keeps its servo calibration record log there (``--calibration``): a
+    fish_sim that the supervisor restarts boots with what was saved, as a board does.
+    """
+    out = []
+    for spec in specs:
+        if (spec.package, spec.executable) == ('wirefish_sim', 'fish_sim'):
+            count = max(spec.arguments.count('--link'), 1)
+            extra = [arg for k in range(count) for arg in
+                     ('--calibration', str(directory / f'{spec.name}-calibration-{k + 1}.bin'))]
+            spec = replace(spec, arguments=(*spec.arguments, *extra))
+        out.append(spec)
+    return out
 
 
 def port_number(text: str) -> int:
@@ -453,6 +472,8 @@ def _run(args: argparse.Namespace) -> int:
                 specs = with_radio(specs, Radio(args.radio), stats=run_dir / 'radio.json',
                                    control=run_dir / 'radio-control',
                                    tap=run_dir / 'radio-fish.tap')
+        # Each virtual fish's servo calibration outlives a restart of fish_sim within the run.
+        specs = with_calibration_files(specs, run_dir / 'logs')
         clock_topic = None
         if on_simulated_time_road(args):
             from wirefish_bringup.graph import on_simulated_time, simulated_clock_of
