@@ -6,13 +6,21 @@ launch/wirefish.launch.py, checked without the launch packages (pure: stand-ins,
 what the launch file builds: every ``Node(...)`` and its parameters. Each value is checked
 against the type the node declares for it, since launch_ros writes a ``parameters`` dict into
 YAML as it is and a node refuses a string where it declares a bool (rclpy does not convert).
+Loading the file also changes how the launch process's asyncio signals its children: that is
+checked on real child processes, through asyncio as launch drives them.
 """
 
+import asyncio
+from asyncio.base_subprocess import BaseSubprocessTransport
+import asyncio.unix_events
 from dataclasses import dataclass, field
 import importlib
 import importlib.util
+import os
 from pathlib import Path
+import signal
 import sys
+import threading
 import types
 
 from declared_parameters import declared_specs
@@ -107,6 +115,9 @@ def launched_nodes(monkeypatch, recorded: Recorded | None = None, **overrides: s
                    ) -> list[dict]:
     """Return the Node(...) keyword arguments of `ros2 launch ... key:=value ...`."""
     recorded = Recorded() if recorded is None else recorded
+    # Loading the file changes the signalling of asyncio's subprocess transports: undone after.
+    for name in ('send_signal', 'terminate', 'kill'):
+        monkeypatch.setattr(BaseSubprocessTransport, name, getattr(BaseSubprocessTransport, name))
     for name, module in _stand_ins(recorded).items():
         monkeypatch.setitem(sys.modules, name, module)
     spec = importlib.util.spec_from_file_location('wirefish_launch_under_test', LAUNCH_FILE)
@@ -203,6 +214,80 @@ def test_every_node_starts_with_its_stop_signals_held(monkeypatch, overrides):
     nodes = launched_nodes(monkeypatch, **overrides)
     assert nodes and {performed_prefix(node) for node in nodes} == {held_start_prefix()}
     assert held_start_prefix() is not None
+
+
+class _StarvedWatcher:
+    """asyncio's ``os`` with the child watcher's thread kept off the CPU until ``release``."""
+
+    def __init__(self) -> None:
+        self.release = threading.Event()
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(os, name)
+
+    def waitpid(self, pid: int, options: int) -> tuple[int, int]:
+        if threading.current_thread() is not threading.main_thread():
+            self.release.wait(timeout=30.0)
+        return os.waitpid(pid, options)
+
+
+class _Exit(asyncio.SubprocessProtocol):
+    def __init__(self) -> None:
+        self.exited = asyncio.get_running_loop().create_future()
+
+    def process_exited(self) -> None:
+        self.exited.set_result(None)
+
+
+def _zombie(pid: int) -> bool:
+    """Whether ``pid`` has exited and is waiting to be collected by its parent."""
+    stat = Path(f'/proc/{pid}/stat').read_text()
+    return stat[stat.rindex(')') + 2] == 'Z'
+
+
+async def _signalled_exit_code(command: list[str], stop, *, after_exit: bool) -> int:
+    """Return the exit code asyncio reports for ``command`` stopped with ``stop(transport)``."""
+    loop = asyncio.get_running_loop()
+    transport, protocol = await loop.subprocess_exec(_Exit, *command, stdin=None, stdout=None,
+                                                     stderr=None)
+    try:
+        if after_exit:  # a Ctrl-C ended it; launch's own signal comes before the watcher looks
+            deadline = loop.time() + 10.0
+            while not _zombie(transport.get_pid()):
+                assert loop.time() < deadline, 'the child did not exit'
+                await asyncio.sleep(0.01)
+        stop(transport)
+        asyncio.unix_events.os.release.set()
+        await asyncio.wait_for(protocol.exited, timeout=30.0)
+        return transport.get_returncode()
+    finally:
+        transport.close()
+
+
+STOPS = {
+    'SIGINT': lambda transport: transport.send_signal(signal.SIGINT),
+    'SIGTERM': lambda transport: transport.send_signal(signal.SIGTERM),
+    'SIGKILL': lambda transport: transport.kill(),
+}
+
+
+@pytest.mark.parametrize('stop', STOPS.values(), ids=STOPS.keys())
+def test_launch_signalling_a_node_that_already_exited_reports_its_own_exit_code(
+        monkeypatch, stop):
+    # A Ctrl-C reaches the whole process group: a node ends on it while launch, on a loaded
+    # machine, still sends its own SIGINT (noninteractive), SIGTERM or SIGKILL. That signal
+    # must not collect the exit itself, or asyncio's watcher finds no child: exit code 255.
+    launched_nodes(monkeypatch, **LAUNCHES['sim'])
+    monkeypatch.setattr(asyncio.unix_events, 'os', _StarvedWatcher())
+    code = asyncio.run(_signalled_exit_code(['sh', '-c', 'exit 3'], stop, after_exit=True))
+    assert code == 3
+
+
+def test_launch_still_stops_a_running_node(monkeypatch):
+    launched_nodes(monkeypatch, **LAUNCHES['sim'])
+    monkeypatch.setattr(asyncio.unix_events, 'os', _StarvedWatcher())
+    code = asyncio.run(_signalled_exit_code(['sleep', '30'], STOPS['SIGINT'], after_exit=False))
+    assert code == -signal.SIGINT
 
 
 def performed_prefix(node: dict, **configurations: str) -> str:

@@ -16,7 +16,9 @@ Each process is named after its node in launch's output (``[cpg_node-3]``: ``exe
 would name it after the first word of its command, the held start's ``env``). ``ros2 launch
 --launch-prefix 'nice -n 7'`` (gdb, valgrind, xterm ...) and ``--launch-prefix-filter`` work as
 for any package: the user's prefix follows the held start's (``_UserPrefix``), whereas a
-prefix set in a launch file otherwise replaces the user's.
+prefix set in a launch file otherwise replaces the user's. Loading the file makes the launch
+process signal its nodes without polling them (``wirefish_bringup.launch_signals``): a node
+that stopped on a Ctrl-C is reported with its own exit code, not 255, however loaded the machine.
 """
 
 import os
@@ -31,6 +33,7 @@ from wirefish_bringup.dds_profile import (profile_path, PROFILES_VARIABLE, TRANS
                                           TRANSPORTS_VARIABLE)
 from wirefish_bringup.graph import (DEFAULT_NAMESPACE, default_params_file, fish_graph,
                                     on_simulated_time, Role)
+from wirefish_bringup.launch_signals import signal_children_without_reaping
 from wirefish_common.input_checks import parse_speed
 from wirefish_common.startup_signals import held_start_prefix
 
@@ -149,6 +152,9 @@ def _nodes(context):
 
 
 def generate_launch_description():
+    # launch's SIGINT/SIGTERM to a node that a Ctrl-C has already ended must leave its exit
+    # code to asyncio's watcher: a loaded machine would otherwise see it "died" with 255.
+    signal_children_without_reaping()
     return LaunchDescription([
         # The reply writers' wait for a new client (config/fastdds.xml); a profile file the
         # user set is kept.
