@@ -10,11 +10,12 @@ from hypothesis import given, strategies as st
 import numpy as np
 import pytest
 from wirefish_bridge.codec import encode_frame, StreamDecoder
-from wirefish_bridge.protocol import (Ack, ANGLE_LSB_RAD, ClockSource, ErrorCode, ErrorReport,
-                                      Gait, Health, HealthFlags, Heartbeat, LinkConfig, MsgType,
-                                      PROTOCOL_VERSION, quantize, ResetCause, Role,
-                                      ServoCommand, Status, Telemetry, telemetry_of,
-                                      TelemetryCompact, TelemetryForm)
+from wirefish_bridge.protocol import (Ack, ANGLE_LSB_RAD, CalibrationSource, ClockSource,
+                                      ErrorCode, ErrorReport, Gait, Health, HealthFlags,
+                                      Heartbeat, LinkConfig, MsgType, PROTOCOL_VERSION, quantize,
+                                      ResetCause, Role, ServoCommand, ServoTrim, ServoTrimReport,
+                                      Status, Telemetry, telemetry_of, TelemetryCompact,
+                                      TelemetryForm, TrimOp)
 
 PROTOCOL = Path(__file__).resolve().parents[1] / 'PROTOCOL.md'
 TELEMETRY = Telemetry(board_time_ms=1234, roll=0.1, pitch=-0.2, yaw=3.0, gyro=(0.0, 0.5, -1.0),
@@ -35,6 +36,8 @@ EXAMPLES = [
             0xFFFFFFF9, 0x00000400, 0x40000000, 123456, 612, 2048, 0, 0, 3, 1, 0, 0, 2, 1, 1,
             1), 0x0104),
     (ErrorReport(ErrorCode.BAD_CRC, 42), 3),
+    (ServoTrim(1, TrimOp.SAVE, -1, 1520.0, 600.0), 13),
+    (ServoTrimReport(1, CalibrationSource.STORED, -1, 1520.0, 600.0, 500.0, 2500.0), 14),
 ]
 
 

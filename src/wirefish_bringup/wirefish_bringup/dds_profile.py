@@ -15,12 +15,12 @@ for ``ros2 launch`` in another namespace:
 Over a radio (``wirefish up --role fish|shore``) the graph's own profile also has a default
 participant that announces itself every ANNOUNCE_S (lease LEASE_S) instead of Fast DDS's 3 s
 (20 s): the fish's and the shore's participants announcing to each other every 3 s saturated a
-100 kbit/s radio (test/launcher/test_two_hosts.py: fish->shore 12.4 kB/s and 26-41 packets dropped by the bucket
-in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped). A 10 s radio cut stays inside the lease. That
-participant names its UDPv4 transport itself: a default participant profile otherwise brings
-the builtin transports (shared memory) back. On one host (role all) there is no such
-participant: there a 10 s period slowed discovery (a full run: topics and an action not found
-in their tests' time).
+100 kbit/s radio (test/launcher/test_two_hosts.py: fish->shore 12.4 kB/s and 26-41 packets
+dropped by the bucket in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped). A 10 s radio cut stays
+inside the lease. That participant names its UDPv4 transport itself: a default participant
+profile otherwise brings the builtin transports (shared memory) back. On one host (role all)
+there is no such participant: there a 10 s period slowed discovery (a full run: topics and an
+action not found in their tests' time).
 
 Why no shared memory: with it, a publisher whose subscriber was SIGKILLed and restarted stalls in
 ``publish()``: the writer reopens the dead reader's shared-memory port and waits out the port's

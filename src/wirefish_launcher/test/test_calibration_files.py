@@ -5,7 +5,7 @@ from pathlib import Path
 
 from wirefish_bringup.fleet import fleet_graph
 from wirefish_bringup.graph import fish_graph
-from wirefish_launcher.launcher import with_calibration_files
+from wirefish_launcher.verb.up import with_calibration_files
 
 LOGS = Path('/run/x/logs')
 
