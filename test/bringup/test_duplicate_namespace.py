@@ -11,6 +11,7 @@ test_whole_graph.py is also checked against a second start).
 import signal
 import subprocess
 
+from e2e_utils import lines_until_running
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
@@ -55,11 +56,7 @@ def test_up_in_a_namespace_in_use_refuses_with_one_line_and_starts_nothing(
 def test_allow_duplicate_starts_the_graph_anyway(occupied, python, ros_env, spawn, tmp_path):
     launcher = spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                       '--allow-duplicate', '--namespace', occupied, '--out', str(tmp_path)])
-    seen = []
-    for line in launcher.stdout:
-        seen.append(line)
-        if line.startswith('running:'):
-            break
+    seen = lines_until_running(launcher, 120.0)
     assert seen and seen[-1].startswith('running:'), ''.join(seen)
     launcher.send_signal(signal.SIGINT)
     assert stop_process(launcher, timeout_s=20.0) == 0

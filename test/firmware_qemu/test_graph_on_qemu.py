@@ -15,7 +15,7 @@ import subprocess
 import sys
 import time
 
-from e2e_utils import descendants
+from e2e_utils import descendants, lines_until_running
 import psutil
 import pytest
 import rclpy
@@ -76,17 +76,9 @@ def qemu_graph(tmp_path_factory) -> Iterator[QemuGraph]:
          '--namespace', NAMESPACE, '--out', str(tmp_path_factory.mktemp('qemu_run'))],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
-    seen = []
     graph = QemuGraph(launcher, domain_id, set())
     try:
-        deadline = time.monotonic() + 90.0
-        while time.monotonic() < deadline:
-            line = launcher.stdout.readline()
-            if not line:
-                break
-            seen.append(line)
-            if line.startswith('running:'):
-                break
+        seen = lines_until_running(launcher, 90.0)
         assert seen and seen[-1].startswith('running:'), ''.join(seen)
         graph.qemu_processes()
         yield graph

@@ -13,9 +13,8 @@ Before the fix it never printed "running:" (it hung closing its probe after star
 import signal
 import subprocess
 import sys
-import time
 
-from e2e_utils import descendants
+from e2e_utils import descendants, lines_until_running
 import pytest
 
 HANGING_TEARDOWN = """
@@ -44,16 +43,9 @@ def test_a_dds_teardown_that_hangs_never_blocks_the_stop(ros_env, tmp_path):
          '/h24_hanging_teardown', '--out', str(tmp_path)],
         env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
-    seen = []
+    seen: list[str] = []
     try:
-        deadline = time.monotonic() + START_TIMEOUT_S
-        while time.monotonic() < deadline:
-            line = launcher.stdout.readline()
-            if not line:
-                break
-            seen.append(line)
-            if line.startswith('running:'):
-                break
+        seen = lines_until_running(launcher, START_TIMEOUT_S)
         assert seen and seen[-1].startswith('running:'), ''.join(seen)
         children = descendants(launcher.pid)
         launcher.send_signal(signal.SIGINT)

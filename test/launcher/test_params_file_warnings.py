@@ -3,9 +3,9 @@
 
 import subprocess
 import sys
-import time
 
 from declared_parameters import declared_specs
+from e2e_utils import lines_until_running
 import pytest
 from ros_utils import stop_process
 
@@ -42,16 +42,8 @@ def test_a_bad_params_file_is_said_on_the_terminal_and_not_restarted(ros_env, tm
          '--out', str(tmp_path / 'out'), '--params-file', str(params)],
         env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
-    lines: list[str] = []
     try:
-        deadline = time.monotonic() + 120.0
-        while time.monotonic() < deadline:
-            line = up.stdout.readline()
-            if not line:
-                break
-            lines.append(line)
-            if line.startswith('running:'):
-                break
+        lines = lines_until_running(up, 120.0)
         text = ''.join(lines)
         assert "'cpg_node' matches no node" in text and '/**/cpg_node' in text, text
         assert "'l9' is no parameter" in text, text

@@ -48,21 +48,35 @@ def start_graph(domain_id: int, out_dir: Path, *options: str,
          '--namespace', namespace, '--out', str(out_dir), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
-    deadline = time.monotonic() + 60.0
-    seen = []
     try:
-        while time.monotonic() < deadline:
-            line = launcher.stdout.readline()
-            if not line:
-                break
-            seen.append(line)
-            if line.startswith(('running:', 'recording to ')):  # up, or up --duration
-                return RunningGraph(launcher, env, domain_id, namespace, out_dir)
+        seen = lines_until_running(launcher, 60.0, ('running:', 'recording to '))
+        if seen and seen[-1].startswith(('running:', 'recording to ')):  # up, up --duration
+            return RunningGraph(launcher, env, domain_id, namespace, out_dir)
     except BaseException:  # Ctrl-C or a timeout while waiting: leave no graph behind
         stop_process(launcher)
         raise
     stop_process(launcher)
     raise RuntimeError('wirefish up did not start:\n' + ''.join(seen) + launcher.stdout.read())
+
+
+def lines_until_running(launcher: subprocess.Popen, timeout_s: float,
+                        markers: tuple[str, ...] = ('running:',)) -> list[str]:
+    """
+    Return `wirefish up`'s output lines up to its first "running:" (or another marker).
+
+    The last line holds the marker when the graph got there; otherwise the output ended or
+    ``timeout_s`` passed (judged between two lines) and the lines say how far it got.
+    """
+    deadline = time.monotonic() + timeout_s
+    seen: list[str] = []
+    while time.monotonic() < deadline:
+        line = launcher.stdout.readline()
+        if not line:
+            break
+        seen.append(line)
+        if line.startswith(markers):
+            break
+    return seen
 
 
 @contextmanager

@@ -5,12 +5,12 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 import os
 from pathlib import Path
-import shutil
 import socket
 import time
 
 from e2e_utils import RunningGraph, start_graph, stopped_on_exit
 from foxglove_client import free_port
+from headless_chromium import headless_chromium
 import pytest
 from wirefish_bringup.graph import default_params_file
 import yaml
@@ -111,21 +111,8 @@ class DashboardPage:
 
 
 @pytest.fixture(scope='module')
-def dashboard(view_graph: ViewGraph) -> Iterator[DashboardPage]:
+def dashboard(view_graph: ViewGraph,
+              tmp_path_factory: pytest.TempPathFactory) -> Iterator[DashboardPage]:
     """Yield the module's graph's dashboard in a headless chromium (1400 x 1300); quit it after."""
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    chromium, chromedriver = shutil.which('chromium'), shutil.which('chromedriver')
-    assert chromium and chromedriver, 'apt-get install chromium chromium-driver'
-    options = webdriver.ChromeOptions()
-    options.binary_location = chromium
-    for argument in ('--headless=new', '--no-sandbox', '--disable-gpu',
-                     '--disable-dev-shm-usage', '--window-size=1400,1300'):
-        options.add_argument(argument)
-    driver = webdriver.Chrome(options=options, service=Service(chromedriver))
-    try:
-        driver.get(view_graph.http_url)
+    with headless_chromium(view_graph.http_url, tmp_path_factory.mktemp('chromium')) as driver:
         yield DashboardPage(driver)
-    finally:
-        driver.quit()

@@ -25,12 +25,11 @@ import time
 import urllib.request
 
 from geometry_msgs.msg import Twist
+from headless_chromium import headless_chromium
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from ros_utils import spin_until
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 from sensor_msgs.msg import JointState
 from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
@@ -38,7 +37,6 @@ from wirefish_msgs.msg import CpgParams, PlannerState, SpeedEstimate
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
 
-CHROMIUM, CHROMEDRIVER = shutil.which('chromium'), shutil.which('chromedriver')
 ROOT = Path(__file__).resolve().parents[2]
 SCREENSHOT = ROOT / 'out' / 'dashboard.png'
 DOCS_SCREENSHOT = ROOT / 'docs' / 'dashboard.png'
@@ -47,20 +45,10 @@ DONE = "window.wirefish.retune && window.wirefish.retune.state === 'done'"
 
 
 @pytest.fixture(scope='module')
-def browser(view_graph):
+def browser(view_graph, tmp_path_factory):
     """Yield a headless chromium on the dashboard page; quit it (and its driver) afterwards."""
-    assert CHROMIUM and CHROMEDRIVER, 'apt-get install chromium chromium-driver'
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM
-    for argument in ('--headless=new', '--no-sandbox', '--disable-gpu',
-                     '--disable-dev-shm-usage', '--window-size=1400,1300'):
-        options.add_argument(argument)
-    driver = webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
-    try:
-        driver.get(view_graph.http_url)
+    with headless_chromium(view_graph.http_url, tmp_path_factory.mktemp('chromium')) as driver:
         yield driver
-    finally:
-        driver.quit()
 
 
 def _live(browser, expression: str):
