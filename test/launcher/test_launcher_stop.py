@@ -6,8 +6,8 @@ Seen with eight graphs starting at once: the launcher's main thread sat in
 ``Node.destroy_node`` -> ``Publisher.destroy`` of its graph probe for good, SIGINT and SIGTERM
 caught and never acted on, nothing stopped. Here every ``Node.destroy_node`` in the launcher's
 process blocks forever (its graph nodes are processes of their own and stop normally): the
-launcher must still get to "running:", and stop everything with exit code 0 on one SIGINT.
-Before the fix it never printed "running:" (it hung closing its probe after start-up).
+launcher must still get to "running:", and stop everything with exit code 0 on one SIGINT. A
+launcher that closed its probe after start-up would hang there and never print "running:".
 """
 
 import signal
