@@ -4,14 +4,14 @@
 from pathlib import Path
 import re
 
-from firmware_host import FirmwareHost, MSG_DTYPE, to_record
-import numpy as np
+from firmware_host import FirmwareHost, to_record
 import pytest
 from wirefish_bridge.codec import StreamDecoder
-from wirefish_bridge.protocol import (Ack, ClockSource, ErrorCode, ErrorReport, Gait, Health,
-                                      Heartbeat, LinkConfig, MsgType, ResetCause, Role,
-                                      ServoCommand, Status, Telemetry, TelemetryCompact,
-                                      TelemetryForm)
+from wirefish_bridge.protocol import (Ack, CalibrationSource, ClockSource, ErrorCode,
+                                      ErrorReport, Gait, Health, Heartbeat, LinkConfig, MsgType,
+                                      ResetCause, Role, ServoCommand, ServoTrim,
+                                      ServoTrimReport, Status, Telemetry, TelemetryCompact,
+                                      TelemetryForm, TrimOp)
 
 PROTOCOL = Path(__file__).resolve().parents[2] / 'src' / 'wirefish_bridge' / 'PROTOCOL.md'
 STATUS = int(Status.LOW_BATTERY | Status.GAIT_MODE)
@@ -31,24 +31,10 @@ EXAMPLES = [
     (Health(ResetCause.FAULT, ClockSource.HSE_PLL, 0x0F, 0x08001234, 0xFFFFFFF9, 0x00000400,
             0x40000000, 123456, 612, 2048, 0, 0, 3, 1, 0, 0, 2, 1, 1, 1), 0x0104),
     (ErrorReport(ErrorCode.BAD_CRC, 42), 3),
+    (ServoTrim(1, TrimOp.SAVE, -1, 1520.0, 600.0), 13),
+    (ServoTrimReport(1, CalibrationSource.STORED, -1, 1520.0, 600.0, 500.0, 2500.0), 14),
 ]
 NAMES = [type(message).__name__ + str(i) for i, (message, _) in enumerate(EXAMPLES)]
-
-
-def _flat(kind: int, seq: int, ints: tuple[int, ...], floats: tuple[float, ...]) -> np.ndarray:
-    record = np.zeros(1, MSG_DTYPE)
-    record['type'], record['seq'] = kind, seq
-    record['n'][0, :len(ints)] = ints
-    record['f'][0, :len(floats)] = floats
-    return record
-
-
-# The examples PROTOCOL.md prints after those: SERVO_TRIM and SERVO_TRIM_REPORT, as the C
-# core's flat records (wf_host.h: servo, op or source, direction, reserved; the floats).
-CALIBRATION_EXAMPLES = [
-    _flat(0x12, 13, (1, 2, -1, 0), (1520.0, 600.0)),  # SAVE servo 1: -1, 1520 us, 600 us/rad
-    _flat(0x22, 14, (1, 1, -1, 0), (1520.0, 600.0, 500.0, 2500.0)),  # its report: STORED
-]
 
 
 def example_frames() -> list[bytes]:
@@ -59,20 +45,8 @@ def example_frames() -> list[bytes]:
 
 
 def test_protocol_md_prints_an_example_of_every_type():
-    assert len(example_frames()) == len(EXAMPLES) + len(CALIBRATION_EXAMPLES)
+    assert len(example_frames()) == len(EXAMPLES)
     assert {type(message).KIND for message, _ in EXAMPLES} == set(MsgType)
-
-
-@pytest.mark.parametrize('index', range(len(CALIBRATION_EXAMPLES)),
-                         ids=['ServoTrim', 'ServoTrimReport'])
-def test_c_core_encodes_and_decodes_the_calibration_examples(host_lib: FirmwareHost,
-                                                             index: int):
-    record = CALIBRATION_EXAMPLES[index]
-    frame = example_frames()[len(EXAMPLES) + index]
-    assert host_lib.encode_stream(record) == frame
-    frames, stats = host_lib.decode_stream(frame)
-    assert frames.tobytes() == record.tobytes()
-    assert stats['frames_ok'] == 1 and stats['resyncs'] == 0
 
 
 @pytest.mark.parametrize('index', range(len(EXAMPLES)), ids=NAMES)

@@ -27,7 +27,8 @@ POOL = 4096
 KNOWN_SIZES = {int(kind): size for kind, size in PAYLOAD_SIZES.items()}
 KINDS = sorted(KNOWN_SIZES)
 # Where a type's binary32 fields start in its payload (4-byte steps from there).
-FLOATS_AT = {MsgType.SERVO_CMD: 0, MsgType.GAIT: 2, MsgType.TELEMETRY: 4}
+FLOATS_AT = {MsgType.SERVO_CMD: 0, MsgType.GAIT: 2, MsgType.TELEMETRY: 4, MsgType.SERVO_TRIM: 4,
+             MsgType.SERVO_TRIM_REPORT: 4}
 NON_FINITE = (b'\x00\x00\x80\x7f', b'\x00\x00\x80\xff', b'\x00\x00\xc0\x7f', b'\x01\x00\x80\xff')
 
 

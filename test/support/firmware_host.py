@@ -20,8 +20,8 @@ import subprocess
 
 import numpy as np
 from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat, LinkConfig,
-                                      MsgType, ProtocolMessage, Role, ServoCommand, Telemetry,
-                                      TelemetryCompact)
+                                      MsgType, ProtocolMessage, Role, ServoCommand, ServoTrim,
+                                      ServoTrimReport, Telemetry, TelemetryCompact)
 
 WORKSPACE = Path(__file__).resolve().parents[2]
 FIRMWARE = WORKSPACE / 'firmware'
@@ -51,14 +51,14 @@ INT_FIELDS: dict[int, tuple[tuple[int, int], ...]] = {
     MsgType.GAIT: (U16,),
     MsgType.TELEMETRY_COMPACT: (U32,) + (I16,) * 11 + (U16,) * 3,
     MsgType.HEALTH: (U8,) * 3 + (U32,) * 5 + (U16,) * 2 + (U32,) * 7 + (U16,) * 3,
-    # SERVO_TRIM, SERVO_TRIM_REPORT (by number: wirefish_bridge.protocol may not name them):
-    # servo, op or source, direction, reserved.
-    0x12: (U8, U8, I8, U8),
-    0x22: (U8, U8, I8, U8),
+    # SERVO_TRIM, SERVO_TRIM_REPORT: servo, op or source, direction, reserved.
+    MsgType.SERVO_TRIM: (U8, U8, I8, U8),
+    MsgType.SERVO_TRIM_REPORT: (U8, U8, I8, U8),
 }
 # How many of ``f`` each type carries (SERVO_TRIM: neutral_us, us_per_rad; SERVO_TRIM_REPORT:
 # those, min_us, max_us).
-FLOATS = {MsgType.SERVO_CMD: 2, MsgType.GAIT: 10, MsgType.TELEMETRY: 12, 0x12: 2, 0x22: 4}
+FLOATS = {MsgType.SERVO_CMD: 2, MsgType.GAIT: 10, MsgType.TELEMETRY: 12, MsgType.SERVO_TRIM: 2,
+          MsgType.SERVO_TRIM_REPORT: 4}
 
 
 def random_messages(rng: np.random.Generator, count: int) -> np.ndarray:
@@ -123,7 +123,15 @@ def to_python(record: np.void) -> ProtocolMessage:
                                 n[11], n[12], n[13], n[14])
     if kind == MsgType.HEALTH:
         return Health(*n[:20])
-    return ErrorReport(int(record['code']), int(record['ref']))
+    if kind == MsgType.SERVO_TRIM:
+        return ServoTrim(servo=n[0], op=n[1], direction=n[2], neutral_us=f[0],
+                         us_per_rad=f[1], reserved=n[3])
+    if kind == MsgType.SERVO_TRIM_REPORT:
+        return ServoTrimReport(servo=n[0], source=n[1], direction=n[2], neutral_us=f[0],
+                               us_per_rad=f[1], min_us=f[2], max_us=f[3], reserved=n[3])
+    if kind == MsgType.ERROR:
+        return ErrorReport(int(record['code']), int(record['ref']))
+    raise ValueError(f'to_python: no message for type 0x{kind:02x}')
 
 
 def to_record(message: ProtocolMessage, seq: int) -> np.ndarray:
@@ -147,6 +155,10 @@ def to_record(message: ProtocolMessage, seq: int) -> np.ndarray:
     elif isinstance(m, Gait):
         record['f'][0, :10] = m.to_wire()[1:]
         ints = [m.gait_id]
+    elif isinstance(m, (ServoTrim, ServoTrimReport)):  # servo, op or source, direction, reserved
+        wire = m.to_wire()
+        ints = [int(v) for v in wire[:4]]
+        record['f'][0, :len(wire) - 4] = wire[4:]
     else:  # LINK_CONFIG, ACK, TELEMETRY_COMPACT, HEALTH: integers only, in wire order
         ints = [int(v) for v in _flat(m.to_wire())]
     record['n'][0, :len(ints)] = ints
