@@ -15,7 +15,8 @@
  * chunk, up to 512), act on each valid frame, send one ERROR per kind of drop not yet reported
  * (at most one per kind per 20 ms); send one waiting ACK; sample the sensors; run the gap
  * rules and the failsafe and set the servos; send the telemetry, the heartbeat and the HEALTH
- * that are due, in that order: at most one of each per poll.
+ * that are due, in that order, then a boot SERVO_TRIM_REPORT when one is due: at most one
+ * frame of each kind per poll (ERROR aside).
  */
 #include "wf/app.h"
 
@@ -214,11 +215,11 @@ static void send_trim_report(wf_app_t *app, unsigned servo)
 }
 
 /* The oldest waiting ACK; a refused GAIT's ERROR (its code, the GAIT's seq) goes just before
- * it, an accepted SERVO_TRIM's SERVO_TRIM_REPORT just after it. */
-static void send_ack(wf_app_t *app)
+ * it, an accepted SERVO_TRIM's SERVO_TRIM_REPORT just after it. True when a report went. */
+static bool send_ack(wf_app_t *app)
 {
     if (app->ack_count == 0) {
-        return;
+        return false;
     }
     wf_msg_t msg = {.type = WF_MSG_ACK};
     msg.u.ack = app->acks[0];
@@ -233,6 +234,7 @@ static void send_ack(wf_app_t *app)
     if (report != 0) {
         send_trim_report(app, report - 1u);
     }
+    return report != 0;
 }
 
 /* report: the servo (1, 2) whose SERVO_TRIM_REPORT follows the ACK, 0 for none. */
@@ -758,7 +760,7 @@ void wf_app_poll(wf_app_t *app)
     app->now_ms = wf_hal_millis();
     advance_cpg(app); /* with the parameters in force until now */
     receive(app);
-    send_ack(app);
+    const bool reported = send_ack(app);
     sample_imu(app);
     sample_battery(app);
     update_gap(app);
@@ -775,14 +777,18 @@ void wf_app_poll(wf_app_t *app)
         (app->config.health_period_ms != 0 && due(app->now_ms, app->next_health_ms))) {
         app->next_health_ms = app->health_sent ? app->next_health_ms + app->config.health_period_ms
                                                : app->now_ms + app->config.health_period_ms;
-        const bool boot = !app->health_sent;
+        if (!app->health_sent) {
+            app->boot_report = 1; /* from this poll on, after the boot HEALTH */
+        }
         app->health_sent = true;
         send_health(app);
-        if (boot) {
-            /* Where each servo's calibration comes from after this boot, right after its
-             * HEALTH (a stored one may not fit this build: then DEFAULTS). */
-            send_trim_report(app, 0);
-            send_trim_report(app, 1);
-        }
+    }
+    if (app->boot_report != 0 && !reported) {
+        /* Where each servo's calibration comes from after this boot (a stored one may not
+         * fit this build: then DEFAULTS), servo 1 first. Last in the poll and one a poll, as
+         * every kind but ERROR: an ACK's report in this poll puts it off to the next. */
+        send_trim_report(app, app->boot_report - 1u);
+        app->boot_report = app->boot_report < WF_SERVO_COUNT ? (uint8_t)(app->boot_report + 1u)
+                                                             : 0u;
     }
 }

@@ -218,11 +218,11 @@ static void test_hello_with_our_version_lets_commands_through(void)
 static void test_other_version_answers_error_5_and_stays_neutral(void)
 {
     fresh_board();
-    run_until(0, 0);
+    run_until(0, 1); /* the boot HEALTH and both servos' reports out */
     wf_host_msg_t out[64];
     board_output(out, 64);
-    send_heartbeat(1, 1); /* a version-1 host */
-    send_command(2, 0.25f, 0.25f);
+    send_heartbeat(2, 1); /* a version-1 host */
+    send_command(3, 0.25f, 0.25f);
     const size_t n = board_output(out, 64);
     CHECK(n == 1 && out[0].type == WF_MSG_ERROR && out[0].version_or_code == 5);
     CHECK(out[0].ref_seq_or_status == 0); /* the heartbeat was the host's frame 0 */
@@ -235,6 +235,7 @@ static void test_bad_crc_answers_one_error_and_applies_nothing(void)
 {
     fresh_board();
     send_heartbeat(1, WF_PROTOCOL_VERSION);
+    run_until(2, 2); /* the second boot report out */
     wf_msg_t msg = {.type = WF_MSG_SERVO_CMD, .seq = 9};
     msg.u.servo_cmd.servo[0] = 0.5f;
     uint8_t wire[WF_MAX_WIRE];
@@ -242,7 +243,7 @@ static void test_bad_crc_answers_one_error_and_applies_nothing(void)
     wire[3] ^= 0x10; /* one bit of the seq: COBS still decodes, the CRC fails */
     wf_host_msg_t out[64];
     board_output(out, 64);
-    wf_host_board_step(2, wire, len, NULL, 0);
+    wf_host_board_step(3, wire, len, NULL, 0);
     const size_t n = board_output(out, 64);
     CHECK(n == 1 && out[0].type == WF_MSG_ERROR && out[0].version_or_code == WF_ERR_BAD_CRC);
     CHECK(snap().commands_applied == 0 && snap().decoder[4] == 1);
@@ -258,9 +259,9 @@ static void test_unknown_type_answers_error_3(void)
     uint8_t wire[16] = {0};
     const size_t n = wf_cobs_encode(body, 5, wire + 1, sizeof wire - 2);
     wf_host_msg_t out[64];
-    run_until(0, 0); /* the power-up heartbeat */
+    run_until(0, 1); /* the power-up heartbeat, HEALTH and boot reports */
     board_output(out, 64);
-    wf_host_board_step(1, wire, n + 2, NULL, 0);
+    wf_host_board_step(2, wire, n + 2, NULL, 0);
     CHECK(board_output(out, 64) == 1 && out[0].version_or_code == WF_ERR_UNKNOWN_TYPE);
 }
 
@@ -1463,13 +1464,47 @@ static void test_save_is_stored_and_a_reboot_runs_on_it(void)
     wf_host_board_step(0, NULL, 0, NULL, 0);
     n = board_output(out, 64);
     const size_t h = find(out, n, WF_MSG_HEALTH);
-    CHECK(h + 2 < n && out[h + 1].type == WF_MSG_SERVO_TRIM_REPORT &&
-          out[h + 2].type == WF_MSG_SERVO_TRIM_REPORT);
+    CHECK(h + 2 == n && out[h + 1].type == WF_MSG_SERVO_TRIM_REPORT); /* servo 1, last */
     CHECK(out[h + 1].n[0] == 1 && out[h + 1].n[1] == WF_CAL_STORED && out[h + 1].n[2] == -1 &&
           out[h + 1].f[0] == 1520.0f && out[h + 1].f[1] == 600.0f);
-    CHECK(out[h + 2].n[0] == 2 && out[h + 2].n[1] == WF_CAL_DEFAULTS);
-    CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 2);
+    wf_host_board_step(1, NULL, 0, NULL, 0);
+    n = board_output(out, 64);
+    CHECK(n >= 1 && out[n - 1].type == WF_MSG_SERVO_TRIM_REPORT); /* servo 2, the next poll */
+    CHECK(out[n - 1].n[0] == 2 && out[n - 1].n[1] == WF_CAL_DEFAULTS);
+    CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 1);
+    run_until(2, 50);
+    n = board_output(out, 64);
+    CHECK(n > 0 && count(out, n, WF_MSG_SERVO_TRIM_REPORT) == 0);
     CHECK(wf_host_compare(0) == 1520); /* the stored neutral from the first pulse */
+}
+
+/* A SERVO_TRIM that reaches the board before its first poll: its ACK and report go out in the
+ * boot poll, so the boot reports are put off a poll each (one SERVO_TRIM_REPORT a poll). */
+static void test_an_acks_report_puts_the_boot_reports_off_by_a_poll(void)
+{
+    static wf_host_msg_t out[64];
+    uint8_t reports[8] = {0};
+    uint32_t at[8] = {0};
+    size_t k = 0;
+    fresh_board();
+    wf_msg_t read = trim_msg(2, WF_TRIM_READ, 0, 0.0f, 0.0f);
+    send_msg(0, &read);
+    for (uint32_t t = 0; t < 5; t++) {
+        if (t > 0) {
+            wf_host_board_step(t, NULL, 0, NULL, 0);
+        }
+        const size_t n = board_output(out, 64);
+        CHECK(count(out, n, WF_MSG_SERVO_TRIM_REPORT) <= 1);
+        for (size_t i = 0; i < n && k < 8; i++) {
+            if (out[i].type == WF_MSG_SERVO_TRIM_REPORT) {
+                reports[k] = (uint8_t)out[i].n[0];
+                at[k++] = t;
+            }
+        }
+    }
+    /* The READ's report of servo 2 at 0 (after its ACK), then the boot's servo 1, servo 2. */
+    CHECK(k == 3 && reports[0] == 2 && reports[1] == 1 && reports[2] == 2);
+    CHECK(at[0] == 0 && at[1] == 1 && at[2] == 2);
 }
 
 static void test_the_newest_record_wins_and_a_damaged_one_is_skipped(void)
@@ -1676,7 +1711,8 @@ int main(void)
     test_factory_gives_the_defaults_now_and_after_a_reboot();
     test_a_failed_storage_write_gets_ack_8_and_changes_nothing();
     test_a_stored_calibration_that_does_not_fit_boots_on_the_defaults();
+    test_an_acks_report_puts_the_boot_reports_off_by_a_poll();
     test_the_record_codec_and_its_crc();
-    printf("test_core: 55 tests, %d checks passed\n", checks);
+    printf("test_core: 56 tests, %d checks passed\n", checks);
     return 0;
 }

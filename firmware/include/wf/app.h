@@ -10,8 +10,8 @@
  * answers GAIT, LINK_CONFIG and SERVO_TRIM with an ACK (an accepted SERVO_TRIM's followed by
  * its servo's SERVO_TRIM_REPORT), runs the gap rules or the failsafe, updates the servos,
  * samples the IMU and sends telemetry (100 Hz by default, FULL or COMPACT), heartbeats (2 Hz)
- * and HEALTH (at boot, with both servos' SERVO_TRIM_REPORT after it, then every 2 s by
- * default) when they are due. wf_app_init loads the stored calibration (wf/calibration_store.h)
+ * and HEALTH (at boot, then every 2 s by default) when they are due; from the boot HEALTH's
+ * poll on, each servo's SERVO_TRIM_REPORT once, servo 1 first, one a poll. wf_app_init loads the stored calibration (wf/calibration_store.h)
  * before the first pulse.
  * The full definition of wf_app_t and wf_config_t lives in wf/app_state.h (owned by the core).
  */

@@ -121,6 +121,8 @@ typedef struct {
     uint32_t next_heartbeat_ms;
     uint32_t next_health_ms;
     bool health_sent;              /* the boot HEALTH is out */
+    uint8_t boot_report;           /* the servo (1, 2) whose boot SERVO_TRIM_REPORT is due
+                                    * next; 0: none (before the boot HEALTH, or all out) */
     uint32_t next_imu_ms;
     uint32_t next_imu_probe_ms;
     uint32_t last_imu_ms;
