@@ -7,14 +7,13 @@ from pathlib import Path
 import shlex
 import signal
 import subprocess
-import time
 
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
-from ros_utils import spin_until
+from ros_utils import spin_until, stop_signals_blocked_soon
 from wirefish_bringup.graph import composable_entries, COMPOSED_NAME, fish_graph, Role
-from wirefish_common.startup_signals import held_start_prefix, stop_signals_blocked
+from wirefish_common.startup_signals import held_start_prefix
 from wirefish_launcher.supervisor import Supervisor
 
 pytestmark = pytest.mark.ros
@@ -86,16 +85,6 @@ def test_a_stop_sent_as_the_launcher_starts_a_process_ends_it_with_0_and_no_trac
         assert 'Traceback' not in log and 'KeyboardInterrupt' not in log, (key, log[-800:])
 
 
-def _wait_until_blocked(pid: int, timeout_s: float = 10.0) -> bool:
-    """Wait until process ``pid`` has the stop signals blocked (env did it, execs the node)."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if stop_signals_blocked(Path(f'/proc/{pid}/status').read_text()):
-            return True
-        time.sleep(0.0005)
-    return False
-
-
 def test_a_stop_sent_as_ros2_launch_starts_a_process_ends_it_with_0_and_no_trace(
         ros_env, tmp_path):
     # The launch file's way: each node through held_start_prefix (env blocking the signals),
@@ -110,7 +99,7 @@ def test_a_stop_sent_as_ros2_launch_starts_a_process_ends_it_with_0_and_no_trace
                 [*prefix, str(spec.executable_path()), *spec.command_arguments()],
                 env=ros_env, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                 start_new_session=True)
-        assert _wait_until_blocked(procs[spec.name].pid), spec.name
+        assert stop_signals_blocked_soon(procs[spec.name].pid), spec.name
         os.killpg(procs[spec.name].pid, signal.SIGINT)
     try:
         codes = {name: proc.wait(timeout=30.0) for name, proc in procs.items()}

@@ -10,7 +10,6 @@ graph within 2 s of its exit, instead of the ~20 s of its participant's lease.
 """
 
 import os
-from pathlib import Path
 import shlex
 import signal
 import subprocess
@@ -19,9 +18,9 @@ import time
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
-from ros_utils import spin_until
+from ros_utils import spin_until, stop_signals_blocked_soon
 from wirefish_bringup.graph import composable_entries, fish_graph
-from wirefish_common.startup_signals import held_start_prefix, stop_signals_blocked
+from wirefish_common.startup_signals import held_start_prefix
 
 pytestmark = pytest.mark.ros
 
@@ -31,15 +30,6 @@ NODES = [spec for spec in fish_graph(NAMESPACE, sim=False, port=DEVICE)
          if spec.name in {e.name for e in composable_entries()}]
 SIGTERM_TIMEOUT_S = 5.0  # launch's ExecuteProcess default: SIGTERM after that
 LEFT_GRAPH_S = 2.0
-
-
-def _blocked(pid: int, timeout_s: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if stop_signals_blocked(Path(f'/proc/{pid}/status').read_text()):
-            return True
-        time.sleep(0.0005)
-    return False
 
 
 def test_a_stop_soon_after_start_ends_each_node_before_launch_escalates(ros_env, tmp_path):
@@ -53,7 +43,7 @@ def test_a_stop_soon_after_start_ends_each_node_before_launch_escalates(ros_env,
                                     stdin=subprocess.DEVNULL, stdout=out,
                                     stderr=subprocess.STDOUT, start_new_session=True)
         try:
-            assert _blocked(proc.pid), spec.name
+            assert stop_signals_blocked_soon(proc.pid), spec.name
             os.killpg(proc.pid, signal.SIGINT)
             sent = time.monotonic()
             codes[spec.name] = proc.wait(timeout=30.0)

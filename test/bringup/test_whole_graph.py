@@ -17,10 +17,8 @@ import sys
 from e2e_utils import measure_simulated_rates, rate_problem, SimulatedTime
 import numpy as np
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
-from ros_utils import spin_until
+from ros_utils import probe_node, spin_until
 from sensor_msgs.msg import JointState
 from wirefish_bag.bagfile import read_bag
 from wirefish_bag.report import topic_stats
@@ -46,12 +44,8 @@ def _full(namespace: str, topic: str) -> str:
 
 @pytest.fixture
 def graph_node(graph_context):
-    node = rclpy.create_node('e2e_probe', context=graph_context)
-    executor = SingleThreadedExecutor(context=graph_context)
-    executor.add_node(node)
-    yield node, executor
-    executor.shutdown()
-    node.destroy_node()
+    with probe_node('e2e_probe', graph_context) as node_and_executor:
+        yield node_and_executor
 
 
 def test_every_topic_arrives_at_its_rate(running_graph, graph_node):

@@ -10,9 +10,7 @@ its profile kept for it.
 import time
 
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from ros_utils import spin_until
+from ros_utils import probe_node, spin_until
 from std_msgs.msg import Int32
 from wirefish_common.qos import COMMAND, LATCHED, RELIABLE, reliable, SENSOR_DATA
 
@@ -24,12 +22,8 @@ QUIET_S = 0.5  # a reader that took nothing for this long has taken everything i
 
 @pytest.fixture
 def probe(ros_context):
-    node = rclpy.create_node('qos_probe', context=ros_context)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    yield node, executor
-    executor.shutdown()
-    node.destroy_node()
+    with probe_node('qos_probe', ros_context) as node_and_executor:
+        yield node_and_executor
 
 
 def _take_all(executor, heard: list[int]) -> list[int]:

@@ -5,9 +5,8 @@ from collections.abc import Iterator
 
 from kinematics_probe import KINEMATICS_NODE, LATCHED, Probe
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+from ros_utils import probe_node
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate
@@ -16,21 +15,19 @@ from wirefish_msgs.msg import BodyWave, BodyWaveSpec, SpeedEstimate
 @pytest.fixture
 def probe(ros_context) -> Iterator[Probe]:
     """Yield a probe publishing servo_cmd/servo_state/target_wave and recording the outputs."""
-    node = rclpy.create_node('kinematics_probe', context=ros_context)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    p = Probe(node, executor)
-    for topic in ('servo_cmd', 'servo_state'):
-        p.publishers[topic] = node.create_publisher(JointState, topic, qos_profile_sensor_data)
-    p.publishers['target_wave'] = node.create_publisher(BodyWaveSpec, 'target_wave', LATCHED)
-    node.create_subscription(BodyWave, 'body_wave', p.body.append, qos_profile_sensor_data)
-    node.create_subscription(SpeedEstimate, 'speed_estimate', p.speed.append,
-                             QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
-    node.create_subscription(MarkerArray, 'body_wave_markers', p.markers.append,
-                             qos_profile_sensor_data)
-    yield p
-    executor.shutdown()
-    node.destroy_node()
+    with probe_node('kinematics_probe', ros_context) as (node, executor):
+        p = Probe(node, executor)
+        for topic in ('servo_cmd', 'servo_state'):
+            p.publishers[topic] = node.create_publisher(JointState, topic,
+                                                        qos_profile_sensor_data)
+        p.publishers['target_wave'] = node.create_publisher(BodyWaveSpec, 'target_wave',
+                                                            LATCHED)
+        node.create_subscription(BodyWave, 'body_wave', p.body.append, qos_profile_sensor_data)
+        node.create_subscription(SpeedEstimate, 'speed_estimate', p.speed.append,
+                                 QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+        node.create_subscription(MarkerArray, 'body_wave_markers', p.markers.append,
+                                 qos_profile_sensor_data)
+        yield p
 
 
 @pytest.fixture

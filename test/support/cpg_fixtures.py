@@ -6,9 +6,8 @@ from pathlib import Path
 
 from cpg_probe import LATCHED, Probe, TUNER_NODE
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
+from ros_utils import probe_node
 from sensor_msgs.msg import JointState
 from wirefish_msgs.msg import CpgParams
 
@@ -16,15 +15,12 @@ from wirefish_msgs.msg import CpgParams
 @pytest.fixture
 def probe(ros_context) -> Iterator[Probe]:
     """Yield a probe subscribed to servo_cmd and the latched cpg_params."""
-    node = rclpy.create_node('cpg_probe', context=ros_context)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    p = Probe(node, executor)
-    node.create_subscription(JointState, 'servo_cmd', p.servo.append, qos_profile_sensor_data)
-    node.create_subscription(CpgParams, 'cpg_params', p.cpg_params.append, LATCHED)
-    yield p
-    executor.shutdown()
-    node.destroy_node()
+    with probe_node('cpg_probe', ros_context) as (node, executor):
+        p = Probe(node, executor)
+        node.create_subscription(JointState, 'servo_cmd', p.servo.append,
+                                 qos_profile_sensor_data)
+        node.create_subscription(CpgParams, 'cpg_params', p.cpg_params.append, LATCHED)
+        yield p
 
 
 @pytest.fixture

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Helpers for tests that drive ROS nodes and child processes."""
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 import os
 from pathlib import Path
 import signal
@@ -10,6 +11,34 @@ import time
 
 # The helper processes of the cross-process tests (a BodyWave talker, a RetuneGait server).
 PEERS = str(Path(__file__).with_name('ros_peers.py'))
+
+
+@contextmanager
+def probe_node(name: str, context) -> Iterator[tuple]:
+    """Yield (node, executor): a test's own node on ``context``, spun by hand; closed after."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    node = rclpy.create_node(name, context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    try:
+        yield node, executor
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+
+
+def stop_signals_blocked_soon(pid: int, timeout_s: float = 10.0) -> bool:
+    """Wait until process ``pid`` has SIGINT and SIGTERM blocked; return whether it did."""
+    from wirefish_common.startup_signals import stop_signals_blocked
+
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if stop_signals_blocked(Path(f'/proc/{pid}/status').read_text()):
+            return True
+        time.sleep(0.0005)
+    return False
 
 
 def spin_until(executor, predicate: Callable[[], bool], timeout_s: float) -> bool:

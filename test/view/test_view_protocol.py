@@ -14,9 +14,7 @@ import time
 
 from foxglove_client import FoxgloveClient
 import pytest
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
-from ros_utils import spin_until
+from ros_utils import probe_node, spin_until
 from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import Imu, JointState
 from wirefish_common.qos import RELIABLE, SENSOR_DATA
@@ -58,12 +56,8 @@ def client(view_graph):
 
 @pytest.fixture
 def probe(graph_context):
-    node = rclpy.create_node('view_probe', context=graph_context)
-    executor = SingleThreadedExecutor(context=graph_context)
-    executor.add_node(node)
-    yield node, executor
-    executor.shutdown()
-    node.destroy_node()
+    with probe_node('view_probe', graph_context) as node_and_executor:
+        yield node_and_executor
 
 
 def test_every_registry_topic_is_a_channel_with_its_schema(view_graph, client):
