@@ -31,7 +31,13 @@ the angles held, so the switch's millisecond moves no servo at all; and GAITs ju
 just beyond the coupling and phase-bias bounds, accepted and refused alike; and stalls of the
 firmware's poll loop (``VirtualFish.stall``; the board not polled): in gait mode the first poll
 after a stall steps the CPG ``CPG_MAX_LAG_MS`` and drops the rest of the backlog on both, in
-stream mode the slew takes the whole gap, and the schedules catch up alike.
+stream mode the slew takes the whole gap, and the schedules catch up alike. And the servo
+calibration (SERVO_TRIM): a storage that already holds records (a tie of generations, a damaged
+slot, a stored servo that does not fit), a READ before the first poll whose report puts the
+two boot reports off, SET, SAVE, FACTORY and READ accepted, each refusal (6 on every field and
+on the fit, 7 in gait mode, 8 with the storage failing, 5 from a host of another version), a
+non-finite one dropped and a burst past the ACK queue: every millisecond both run the same
+calibration from the same source, and at the end their storage holds the same bytes.
 """
 
 from collections.abc import Iterator
@@ -43,10 +49,14 @@ from mpu6050_model import Mpu6050Model, sensor_from_flu, specific_force_at_rest
 import numpy as np
 import pytest
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
-from wirefish_bridge.protocol import (ANGLE_LSB_RAD, Gait, Heartbeat, LinkConfig,
-                                      PROTOCOL_VERSION, ProtocolMessage, quantize, Role,
-                                      ServoCommand, Status, Telemetry, TelemetryCompact,
-                                      TelemetryForm)
+from wirefish_bridge.protocol import (Ack, ANGLE_LSB_RAD, CalibrationSource, ErrorCode, Gait,
+                                      Heartbeat, LinkConfig, MsgType, PROTOCOL_VERSION,
+                                      ProtocolMessage, quantize, Role, ServoCommand, ServoTrim,
+                                      ServoTrimReport, Status, Telemetry, TelemetryCompact,
+                                      TelemetryForm, TrimOp)
+from wirefish_sim.servo_trim_store import (RamStorage, Record, RECORD_SIZE, StoredServo,
+                                           winning_record)
+from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.virtual_fish import CPG_MAX_LAG_MS, ImuNoise, SimConfig, VirtualFish
 
 TOLERANCE_RAD = 1e-4
@@ -54,6 +64,7 @@ ADC_8_2_V = 3392
 ADC_6_0_V = 2482
 TABLE_1 = Gait(1, 1.0, 0.38, 0.47, 0.0, 0.0, -0.41, 0.64, 1.76, 1.06, 20.0)
 GAP_FLAGS = Status.COASTING | Status.RESTING
+STORAGE_FAIL_PROGRAM = 2   # wf_host_storage_fault_t: programming returns false, nothing written
 
 
 @dataclass(frozen=True)
@@ -76,6 +87,8 @@ class Scenario:
     command: tuple[float, float] | None = None  # every SERVO_CMD's angles (else random)
     # Stalls of the firmware's poll loop: start -> length (ms); the host is silent meanwhile.
     stalls: dict[int, int] = field(default_factory=dict)
+    stored: bytes = b''               # the calibration storage's first bytes at boot
+    storage_fails: tuple[int, int] = (0, 0)  # a window in which every storage write fails
 
 
 GAIT_EVENTS = {
@@ -108,6 +121,49 @@ HELD_EVENTS = {
            replace(TABLE_1, gait_id=5, phi21=-ABOVE_2PI),
            replace(TABLE_1, gait_id=6, w21=-100.0, phi12=BELOW_2PI)),
 }
+# The storage at boot: generation 1, then two records of generation 2 (a tie, which no writer
+# makes: the later wins, servo 1 at 1530 us), then a record of generation 3 with a wrong CRC
+# (skipped, but its slot is used: the next record goes after it). The winner's servo 2 has a
+# negative gain (its pulses 1500 -+ 15.7 us lie within the range, yet the board refuses it):
+# it boots on the defaults and stays in the record until a SAVE or FACTORY of servo 2.
+_DAMAGED = bytearray(Record(3, (StoredServo(1400.0, 600.0, 1, True), StoredServo())).encode())
+_DAMAGED[12] ^= 0x01
+STORED_RECORDS = b''.join((
+    Record(1, (StoredServo(1510.0, 600.0, 1, True), StoredServo())).encode(),
+    Record(2, (StoredServo(1520.0, 600.0, -1, True),
+               StoredServo(2400.0, 600.0, 1, True))).encode(),
+    Record(2, (StoredServo(1530.0, 600.0, -1, True),
+               StoredServo(1500.0, -10.0, 1, True))).encode(),
+    bytes(_DAMAGED)))
+# The widest gain that fits 1500 us within 500..2500 over +-the limit (binary32, one step
+# above the build's 636.619772), and the next binary32 beyond it, which does not.
+WIDEST_GAIN = np.nextafter(np.float32(636.619772), np.float32(1e4))
+BEYOND_GAIN = float(np.nextafter(WIDEST_GAIN, np.float32(1e4)))
+TRIM_EVENTS: dict[int, tuple] = {
+    0: (ServoTrim(2, TrimOp.READ),),   # before the first poll: its report goes first
+    100: (ServoTrim(1, TrimOp.SET, 1, 1550.0, 600.0),),
+    120: (ServoTrim(2, TrimOp.SAVE, -1, 1480.0, 620.0),),
+    # ACK 6: servo, op, reserved, direction, gain <= 0, and just beyond the fit.
+    140: (ServoTrim(3, TrimOp.READ), ServoTrim(1, 4), ServoTrim(1, TrimOp.READ, reserved=1),
+          ServoTrim(1, TrimOp.SET, 0, 1500.0, 600.0)),
+    160: (ServoTrim(1, TrimOp.SET, 1, 1500.0, -600.0),
+          ServoTrim(1, TrimOp.SAVE, 1, 1500.0, BEYOND_GAIN),
+          ServoTrim(2, TrimOp.SET, -1, 1000.0, 600.0)),
+    180: (ServoTrim(1, TrimOp.SET, -1, 1500.0, float(WIDEST_GAIN)),),   # just within
+    # Six in one chunk against a queue of four: all applied, two ACKs (and reports) dropped.
+    200: tuple(ServoTrim(2, TrimOp.SET, 1, 1490.0 + i, 600.0) for i in range(6)),
+    260: (ServoTrim(2, TrimOp.READ),),
+    300: (ServoTrim(2, TrimOp.FACTORY),),
+    320: (ServoTrim(1, TrimOp.SAVE, -1, 1520.0, 600.0),),
+    340: (ServoTrim(1, TrimOp.SET, 1, float('nan'), 600.0),),   # dropped: ERROR 6 ref 0
+    362: (ServoTrim(2, TrimOp.SAVE, 1, 1505.0, 610.0), ServoTrim(1, TrimOp.FACTORY)),  # 8, 8
+    400: (TABLE_1,),
+    420: (ServoTrim(1, TrimOp.SET, 1, 1550.0, 600.0), ServoTrim(2, TrimOp.READ),
+          ServoTrim(2, TrimOp.FACTORY), ServoTrim(1, TrimOp.SAVE, 1, 1550.0, -1.0)),  # 7 0 7 6
+    500: (Heartbeat(1, Role.HOST, 500),),   # another version: ERROR 5, out of gait mode
+    510: (ServoTrim(1, TrimOp.READ), ServoTrim(1, TrimOp.SET, 0, 0.0, 0.0)),   # 5 before 6
+    610: (ServoTrim(1, TrimOp.READ), ServoTrim(2, TrimOp.SAVE, 1, 1505.0, 610.0)),
+}
 SCENARIOS = [
     Scenario('nominal'),
     Scenario('version_mismatch', version=1, version_until_ms=400),
@@ -139,6 +195,9 @@ SCENARIOS = [
              events={1000: (TABLE_1,), 1800: (replace(TABLE_1, gait_id=2, frequency_hz=2.0),)},
              stalls={300: 40, 920: 50, 1400: CPG_MAX_LAG_MS - 1, 1500: CPG_MAX_LAG_MS,
                      1601: 157, 2000: 200, 2400: 1600}),
+    Scenario('servo_trim', duration_ms=700, commands_until_ms=390, heartbeats_until_ms=700,
+             resume_at_ms=700, events=TRIM_EVENTS, command=(0.2, -0.1),
+             stored=STORED_RECORDS, storage_fails=(360, 370)),
 ]
 
 
@@ -198,6 +257,13 @@ def damage(chunk: bytes, rng: np.random.Generator) -> tuple[bytes, bytes]:
     return chunk + bytes.fromhex('00 03 10 07 01 01 03 80 3e 01 00'), b''  # cut short
 
 
+def calibration_of(report) -> ServoTrimReport:
+    """Return the board's calibration of one servo (wf_host_board_calibration) as a report."""
+    return ServoTrimReport(report.servo, CalibrationSource(report.source), report.direction,
+                           report.neutral_us, report.us_per_rad, report.min_us, report.max_us,
+                           report.reserved)
+
+
 @dataclass
 class Deviation:
     """The largest servo-angle difference seen (rad), and where."""
@@ -239,10 +305,15 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     rng = np.random.default_rng(zlib.crc32(scenario.name.encode()))
     config = SimConfig(imu_noise=ImuNoise().scaled(0.0),
                        battery_full_v=6.0 if scenario.low_battery else 8.2)
-    fish = VirtualFish(config, rng=np.random.default_rng(1))
+    storage = RamStorage()
+    storage.unit[:len(scenario.stored)] = scenario.stored
+    fish = VirtualFish(config, rng=np.random.default_rng(1), storage=storage)
     mpu = Mpu6050Model()
     mpu.accel_m_s2 = sensor_from_flu(specific_force_at_rest(0.0, 0.0), (2, -1, 3))
-    board.reset(i2c=mpu.transfer, adc_raw=ADC_6_0_V if scenario.low_battery else ADC_8_2_V)
+    board.reset()   # an erased storage, then the scenario's records in it
+    board.poke_storage(0, scenario.stored)
+    board.reset(i2c=mpu.transfer, adc_raw=ADC_6_0_V if scenario.low_battery else ADC_8_2_V,
+                keep_storage=True)
     fish_frames, board_frames = StreamDecoder(), StreamDecoder()
     seen: set[str] = set()
     statuses: set[int] = set()
@@ -251,7 +322,13 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
     board_held = (0.0, 0.0)
     stall_end = 0
     moves: list[tuple[int, float]] = []   # (stall, how far the targets moved over it)
+    trim_acks: set[int] = set()
+    reports: list[tuple[int, int]] = []   # (ms, servo) of each SERVO_TRIM_REPORT
     for k, chunk in enumerate(host_stream(scenario, rng)):
+        if k in scenario.storage_fails:   # its start and end: every write fails in between
+            failing = k == scenario.storage_fails[0]
+            storage.fail = failing
+            board.set_storage_fault(STORAGE_FAIL_PROGRAM if failing else 0)
         if k in scenario.stalls:
             fish.stall(scenario.stalls[k] * 1e-3)
             stall_end, before_stall = k + scenario.stalls[k], fish.target
@@ -274,6 +351,12 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
         board_out = board_frames.feed(board.step(k + 1, chunk))
         same_frames(board_out, fish_out, fish.target, k + 1, worst)
         seen.update(type(f.message).__name__ for f in fish_out)
+        trim_acks.update(f.message.result for f in fish_out if isinstance(f.message, Ack)
+                         and f.message.acked_type == MsgType.SERVO_TRIM)
+        reports += [(k + 1, f.message.servo) for f in fish_out
+                    if isinstance(f.message, ServoTrimReport)]
+        assert [calibration_of(r) for r in board.calibration()] == [
+            fish.calibration.report(servo) for servo in (1, 2)], f'at {k + 1} ms'
         state, gait = board.snapshot(), board.gait()
         assert state.status == fish.status, f'at {k + 1} ms'
         assert (gait.gait_mode, gait.gait_id, gait.gap) == (
@@ -294,6 +377,10 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
               + ', '.join(f'{m:.4f} rad by {k + 1} ms' for k, m in moves))
         assert len(moves) == len(scenario.stalls)
     assert board.gait().acks_dropped == fish.acks_dropped
+    assert board.storage() == storage.read()   # the same record log, byte for byte
+    # The boot reports: servo 1 then 2, one a millisecond from the boot HEALTH's (at 1 ms).
+    boot = [(t, servo) for t, servo in reports if t <= 3]
+    assert boot == ([(1, 2), (2, 1), (3, 2)] if 0 in scenario.events else [(1, 1), (2, 2)])
     if len(scenario.events.get(900, ())) == 6 and not scenario.damage:
         assert fish.acks_dropped == 2   # a burst of six GAITs against a queue of four
     assert fish_frames.stats.resyncs == board_frames.stats.resyncs == 0
@@ -316,7 +403,32 @@ def test_virtual_fish_and_c_core_emit_the_same_frames_and_states(board: Firmware
         print(f'{scenario.name}: into gait mode at {entries}')
         assert [held != (0.0, 0.0) for _, held in entries] == [True] * 3
         assert fish.gait_id == 6 and board.gait().gaits_refused == 2
+    if scenario.events is TRIM_EVENTS:
+        print(f'{scenario.name}: SERVO_TRIM ACK results {sorted(trim_acks)}, '
+              f'{len(reports)} reports, calibration in force {fish.calibration.cals}')
+        assert trim_acks == {0, ErrorCode.VERSION_MISMATCH, ErrorCode.COMMAND_OUT_OF_RANGE,
+                             ErrorCode.NOT_NOW, ErrorCode.STORAGE_FAILED}
+        assert fish.acks_dropped == 2 and 'ErrorReport' in seen
+        assert fish.calibration.sources == [CalibrationSource.STORED] * 2
+        # Appended after the damaged slot: SAVE, FACTORY, SAVE, SAVE (generations 3 to 6).
+        unit = storage.read()
+        record, end = winning_record(unit)
+        assert unit[:len(scenario.stored)] == scenario.stored
+        assert record is not None and (record.generation, end) == (6, 8 * RECORD_SIZE)
     if scenario.silent[1]:
         assert any(s & Status.SERVO_CLAMPED and s & Status.GAIT_MODE for s in statuses)
         assert {Status.COASTING, Status.RESTING} <= {s & GAP_FLAGS for s in statuses}
         assert 'TelemetryCompact' in seen
+
+
+def test_the_fit_is_judged_against_the_boards_frame_whatever_the_servo_models_refresh(
+        board: FirmwareHost):
+    # A 500 Hz servo model (a 2000 us refresh) under the build's 2500 us longest pulse: the
+    # firmware's rule is the board's 20 ms frame, so both accept the SET alike.
+    fish = VirtualFish(SimConfig(servo=ServoParameters(update_hz=500.0)))
+    trim = ServoTrim(1, TrimOp.SET, 1, 1550.0, 600.0)
+    board_out = StreamDecoder().feed(board.step(1, FrameEncoder().encode(trim)))
+    assert fish.trim(trim) == 0
+    assert Ack(MsgType.SERVO_TRIM, 0, 0) in [f.message for f in board_out]
+    assert [calibration_of(r) for r in board.calibration()] == [
+        fish.calibration.report(servo) for servo in (1, 2)]

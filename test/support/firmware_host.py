@@ -408,6 +408,11 @@ class FirmwareHost:
         n = self.lib.wf_host_storage_peek(offset, out, length)
         return out.raw[:n]
 
+    def poke_storage(self, offset: int, data: bytes) -> None:
+        """Write ``data`` into the calibration's storage as it is (no flash rule)."""
+        if self.lib.wf_host_storage_poke(offset, data, len(data)) != len(data):
+            raise ValueError(f'{len(data)} bytes at {offset} do not fit the storage')
+
     def set_storage_fault(self, fault: int) -> None:
         """Make the storage fail (wf_host_storage_fault_t; 0: work again)."""
         self.lib.wf_host_storage_set_fault(fault)

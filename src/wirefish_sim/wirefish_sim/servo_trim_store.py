@@ -156,7 +156,8 @@ def winning_record(unit: bytes) -> tuple[Record | None, int]:
             continue
         end = offset + RECORD_SIZE
         record = Record.decode(slot)
-        if record is not None and (best is None or record.generation > best.generation):
+        # A tie (which no writer makes) goes to the later record, as a later write would.
+        if record is not None and (best is None or record.generation >= best.generation):
             best = record
     return best, end
 
@@ -268,7 +269,7 @@ class Calibration:
         if record is not None:
             for i, stored in enumerate(record.servos):
                 cal = self.with_values(stored.neutral_us, stored.us_per_rad, stored.direction)
-                if stored.valid and stored.direction in (1, -1) and self.fits(cal):
+                if stored.valid and self.fits(cal):
                     self.cals[i] = cal
                     self.sources[i] = CalibrationSource.STORED
 
@@ -278,8 +279,13 @@ class Calibration:
                        direction=direction).binary32()
 
     def fits(self, cal: ServoCal) -> bool:
-        """Return True when ``cal`` fits the board (``fits`` with its limit and frame)."""
-        return (math.isfinite(cal.neutral_us) and math.isfinite(cal.us_per_rad)
+        """
+        Return True when the board may run ``cal`` (app.c's ``trim_fits``).
+
+        Direction +-1, us_per_rad > 0 (binary32) and ``fits`` with its limit and frame.
+        """
+        return (cal.direction in (1, -1) and math.isfinite(cal.neutral_us)
+                and math.isfinite(cal.us_per_rad) and cal.us_per_rad > 0.0
                 and fits(cal, self.limit_rad, self.frame_us))
 
     def set_live(self, servo: int, cal: ServoCal) -> None:

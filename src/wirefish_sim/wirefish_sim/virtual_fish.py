@@ -89,6 +89,10 @@ _KEPT_FLAGS = 0xFFFF & ~(_NEUTRAL_FLAGS | _SERVO_CLAMPED | _LOW_BATTERY | _COAST
 # LINK_CONFIG or SERVO_TRIM that finds it full gets none (the host resends). The board's rule
 # (app.c).
 ACK_QUEUE = 4
+# The board's PWM frame (wf_config_defaults' servo_frame_hz, 50 Hz): a calibration's longest
+# pulse must fit in it (wf_servo_cal_fits). The firmware's rule, so the build's frame, not the
+# physical servo model's refresh (ServoParameters.update_hz).
+SERVO_FRAME_US = 1e6 / 50
 # In gait mode the firmware steps its CPG at most this many ms at once: a longer backlog (a
 # stalled poll loop, see ``stall``) is dropped and the oscillator goes on from its state, a
 # pause of the gait instead of a jump of its output (app_state.h's WF_CPG_MAX_LAG_MS).
@@ -222,7 +226,7 @@ class VirtualFish:
         # Each ACK with the servo whose SERVO_TRIM_REPORT follows it (0: none).
         self._acks: deque[tuple[Ack, int]] = deque()
         self.calibration = Calibration(storage if storage is not None else RamStorage(),
-                                       c.servo.limit_rad, 1e6 / c.servo.update_hz)
+                                       c.servo.limit_rad, SERVO_FRAME_US)
         self._boot_reports: deque[int] = deque()  # servos whose boot report is still due
         self._reel_maps = ((0.0, 1.0), (0.0, 1.0))
         self._reel_identity = True
@@ -337,11 +341,14 @@ class VirtualFish:
         """
         Judge and apply a SERVO_TRIM now as the board does; return the ACK's result.
 
-        In the spec's order: a bad field or a calibration that does not fit the board (6),
-        a change in gait mode (7: READ is always allowed), a failed storage write (8); in
-        every refusal nothing changes. Accepted, the next PWM write uses it.
+        In PROTOCOL.md's order: a host of another version (5, READ too), a bad field or a
+        calibration that does not fit the board (6), a change in gait mode (7: READ is always
+        allowed), a failed storage write (8); in every refusal nothing changes. Accepted, the
+        next PWM write uses it.
         """
         self._host_frame()
+        if not self._host_version_ok:
+            return ErrorCode.VERSION_MISMATCH
         if request.problem() is not None:
             return ErrorCode.COMMAND_OUT_OF_RANGE
         op = request.op
@@ -573,7 +580,8 @@ class VirtualFish:
             self._health_sent = True
             self._outbox.append(self.encoder.encode(self.health()))
         if self._boot_reports and not reported:
-            # One report a poll, as of every kind: servo 1 with the boot HEALTH, servo 2 next.
+            # Last in the poll and one a poll, as every kind but ERROR (an ACK's report in this
+            # poll puts it off): servo 1 with the boot HEALTH, servo 2 the next poll.
             self._outbox.append(self.encoder.encode(
                 self.calibration.report(self._boot_reports.popleft())))
 
