@@ -20,8 +20,11 @@ from wirefish_launcher.params_overlay import PARAMETER_TABLES, PARAMETERS_KEY
 import yaml
 
 SRC = Path(__file__).resolve().parents[1] / 'src'
-NODE_MODULES = sorted(f'{path.parent.name}.{path.stem}'
-                      for path in SRC.glob('*/wirefish_*/*_node.py'))
+# Every module that makes a node with parameters: the *_node.py ones, the virtual fish and the
+# fish's relay (their executables are in the registry under other names).
+NODE_MODULES = sorted([f'{path.parent.name}.{path.stem}'
+                       for path in SRC.glob('*/wirefish_*/*_node.py')]
+                      + ['wirefish_sim.fish_sim', 'wirefish_relay.link_relay'])
 # (node module, table module, table name) of every node module's NodeParameters(self, TABLE).
 TABLES = [(node, *table) for node in NODE_MODULES for table in tables_declared_in(node)]
 DEFAULTS_FILE = SRC / 'wirefish_bringup' / 'config' / 'wirefish.yaml'
@@ -102,7 +105,8 @@ def test_the_nodes_with_tables_are_all_found():
     assert {node for node, _, _ in TABLES} >= {
         'wirefish_bridge.bridge_node', 'wirefish_cpg.cpg_node',
         'wirefish_kinematics.kinematics_node', 'wirefish_planner.planner_node',
-        'wirefish_tf.tf_node', 'wirefish_tuner.tuner_node', 'wirefish_view.view_node'}
+        'wirefish_tf.tf_node', 'wirefish_tuner.tuner_node', 'wirefish_view.view_node',
+        'wirefish_sim.fish_sim', 'wirefish_relay.link_relay'}
 
 
 @pytest.mark.parametrize('node, module, table', TABLES)

@@ -9,9 +9,8 @@ from wirefish_bringup.graph import NodeEntry
 from wirefish_common.parameter_table import ParameterSpec
 
 SRC = Path(__file__).resolve().parents[2] / 'src'
-# Entries without a node class: where the table their process declares comes from.
-_TABLES_OF_PROCESSES = {'fish_sim': ('wirefish_kinematics.geometry_parameters',
-                                     'geometry_parameters')}
+# Entries without a node class: the module of the table their process binds.
+_TABLES_OF_PROCESSES = {'fish_sim': 'wirefish_sim.fish_sim_parameters'}
 
 
 def tables_declared_in(module: str) -> list[tuple[str, str]]:
@@ -29,8 +28,7 @@ def tables_declared_in(module: str) -> list[tuple[str, str]]:
 def declared_specs(entry: NodeEntry) -> list[ParameterSpec]:
     """Return the ParameterSpecs the node of ``entry`` declares (empty if none is known)."""
     if entry.name in _TABLES_OF_PROCESSES:
-        module, function = _TABLES_OF_PROCESSES[entry.name]
-        return list(getattr(importlib.import_module(module), function)())
+        return list(importlib.import_module(_TABLES_OF_PROCESSES[entry.name]).TABLE)
     if entry.node_class is None:
         return []
     specs: list[ParameterSpec] = []

@@ -35,7 +35,11 @@ Rule = Callable[[Mapping[str, Any]], str | None]
 
 @dataclass(frozen=True)
 class ParameterSpec:
-    """A parameter: default (float, int, bool or str), description, range [low, high]."""
+    """
+    A parameter: default (float, int, bool or str), description, range [low, high].
+
+    ``read_only``: taken once at start-up (a file, ``-p``); ROS refuses a later set.
+    """
 
     name: str
     default: float | int | bool | str
@@ -43,6 +47,7 @@ class ParameterSpec:
     low: float | None = None
     high: float | None = None
     low_exclusive: bool = False
+    read_only: bool = False
 
 
 def check_value(spec: ParameterSpec, value: object) -> str | None:
@@ -118,7 +123,7 @@ def declare(node: Node, specs: tuple[ParameterSpec, ...],
     from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 
     for spec in specs:
-        descriptor = ParameterDescriptor(description=spec.description)
+        descriptor = ParameterDescriptor(description=spec.description, read_only=spec.read_only)
         if spec.low is not None and spec.high is not None:
             if type(spec.default) is float:
                 descriptor.floating_point_range = [FloatingPointRange(

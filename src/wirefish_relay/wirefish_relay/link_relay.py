@@ -11,14 +11,13 @@ deserialized: the relay costs a copy of bytes, not a Python message per sample.
 
 from __future__ import annotations
 
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from wirefish_common.node_main import run_node
-from wirefish_common.parameter_table import InvalidParameters
+from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, RELIABLE, SENSOR_DATA
 from wirefish_common.topics import message_class
-from wirefish_relay.crossing import (CrossingTopic, default_crossing_file, LatestHold,
-                                     load_crossing)
+from wirefish_relay.crossing import CrossingTopic, LatestHold, load_crossing
+from wirefish_relay.link_relay_parameters import TABLE
 
 QOS = {'sensor': SENSOR_DATA, 'reliable': RELIABLE, 'latched': LATCHED}
 
@@ -29,15 +28,9 @@ class LinkRelay(Node):
     def __init__(self, **kwargs) -> None:
         """Read the crossing table (read-only parameter) and wire one relay per row."""
         super().__init__('link_relay', **kwargs)
-        path = self.declare_parameter(
-            'crossing_file', str(default_crossing_file()),
-            ParameterDescriptor(description='YAML table of the topics that cross to shore '
-                                '(see config/crossing.yaml); read at start-up',
-                                read_only=True)).value
-        try:
-            self.table = load_crossing(path)
-        except ValueError as error:
-            raise InvalidParameters(f'{self.get_name()}: {error}') from error
+        # A file that does not load is refused at start-up (InvalidParameters, with the reason).
+        self._node_parameters = NodeParameters(self, TABLE)
+        self.table = load_crossing(self._node_parameters.str_value('crossing_file'))
         for row in self.table:
             self._relay(row)
         self.get_logger().info('relaying to shore/: ' + ', '.join(

@@ -174,21 +174,20 @@ class GroundTruthPublisher:
         from rclpy.signals import SignalHandlerOptions
         from nav_msgs.msg import Odometry
         from wirefish_common.frames import declare_frame_prefix, prefixed
-        from wirefish_common.parameter_table import declare
+        from wirefish_common.parameter_table import NodeParameters
         from wirefish_common.qos import RELIABLE
-        from wirefish_kinematics.geometry_parameters import geometry_from, geometry_parameters
+        from wirefish_kinematics.geometry_parameters import geometry_from
+        from wirefish_sim.fish_sim_parameters import TABLE
 
         self._rclpy = rclpy
         rclpy.init(args=ros_args, signal_handler_options=SignalHandlerOptions.NO)
         self.node = rclpy.create_node('fish_sim')
-        specs = geometry_parameters()
         try:  # the values the other nodes of the graph judge the same way
-            declare(self.node, specs, geometry_from)
+            self._node_parameters = NodeParameters(self.node, TABLE)
         except InvalidParameters:
             self.close()
             raise
-        self.geometry = geometry_from({spec.name: self.node.get_parameter(spec.name).value
-                                       for spec in specs})
+        self.geometry = geometry_from(self._node_parameters.values)
         prefix = declare_frame_prefix(self.node)  # fish_1: fish_1/odom, fish_1/base_link
         self._frames = [(prefixed(prefixed(prefix, name), 'odom'),
                          prefixed(prefixed(prefix, name), 'base_link')) for name in names]
