@@ -144,6 +144,7 @@ def test_set_is_forgotten_and_save_kept_across_a_power_cycle(board: FirmwareHost
 
 def test_a_failed_write_is_acked_8_and_changes_nothing(board: FirmwareHost):
     board.step(0, board.encode_stream(hello()))
+    board.step(1)  # the boot's second SERVO_TRIM_REPORT (servo 2) out
     before = bytes(board.calibration()[0]), board.storage(0, 64)
     board.set_storage_fault(FAIL_PROGRAM)
     try:
