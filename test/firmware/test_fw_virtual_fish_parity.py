@@ -54,9 +54,9 @@ from wirefish_bridge.protocol import (Ack, ANGLE_LSB_RAD, CalibrationSource, Err
                                       ProtocolMessage, quantize, Role, ServoCommand, ServoTrim,
                                       ServoTrimReport, Status, Telemetry, TelemetryCompact,
                                       TelemetryForm, TrimOp)
+from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.servo_trim_store import (RamStorage, Record, RECORD_SIZE, StoredServo,
                                            winning_record)
-from wirefish_sim.servo_model import ServoParameters
 from wirefish_sim.virtual_fish import CPG_MAX_LAG_MS, ImuNoise, SimConfig, VirtualFish
 
 TOLERANCE_RAD = 1e-4
