@@ -16,7 +16,7 @@ from geometry_msgs.msg import Vector3Stamped
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import qos_profile_sensor_data
+from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
 from ros_utils import spin_until
 from sensor_msgs.msg import BatteryState, Imu, JointState
 from wirefish_bridge.codec import FrameEncoder, StreamDecoder
@@ -59,6 +59,10 @@ def start_bridge(spawn) -> Callable[..., subprocess.Popen]:
     return start
 
 
+# Samples the probe keeps per topic between two spins (100 Hz streams: 10 s of them).
+PROBE_DEPTH = 1000
+
+
 class Probe:
     """A test node recording imu/data, servo_state and /diagnostics, publishing servo_cmd."""
 
@@ -66,13 +70,14 @@ class Probe:
         self.node = rclpy.create_node('bridge_probe', namespace=namespace, context=context)
         self.imu, self.servo, self.diagnostics = [], [], []
         self.attitude, self.battery = [], []
-        self.node.create_subscription(Imu, 'imu/data', self.imu.append, qos_profile_sensor_data)
-        self.node.create_subscription(Vector3Stamped, 'attitude', self.attitude.append,
-                                      qos_profile_sensor_data)
-        self.node.create_subscription(BatteryState, 'battery', self.battery.append,
-                                      qos_profile_sensor_data)
-        self.node.create_subscription(JointState, 'servo_state', self.servo.append,
-                                      qos_profile_sensor_data)
+        # Best effort as the bridge offers them, with room for every sample of a second or more:
+        # a probe starved by a loaded machine must not drop what the bridge published (its
+        # rates are the claims here), as the sensor-data depth of 5 did.
+        heard = QoSProfile(depth=PROBE_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT)
+        self.node.create_subscription(Imu, 'imu/data', self.imu.append, heard)
+        self.node.create_subscription(Vector3Stamped, 'attitude', self.attitude.append, heard)
+        self.node.create_subscription(BatteryState, 'battery', self.battery.append, heard)
+        self.node.create_subscription(JointState, 'servo_state', self.servo.append, heard)
         self.node.create_subscription(DiagnosticArray, '/diagnostics', self.diagnostics.append,
                                       10)
         self.cmd = self.node.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)

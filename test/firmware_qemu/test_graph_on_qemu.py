@@ -2,8 +2,9 @@
 """
 The whole graph on the emulated board: `wirefish up --fish qemu`, as a user starts it.
 
-The bridge's streams at their registry rates, a QEMU restarted under the running graph, and
-Ctrl-C leaving no QEMU behind. The emulated board has no physics: sim/ground_truth is absent.
+The bridge's streams at their registry rates, a QEMU restarted under the running graph,
+`wirefish calibrate` trimming the emulated board live and back, and Ctrl-C leaving no QEMU
+behind. The emulated board has no physics: sim/ground_truth is absent.
 """
 
 from collections.abc import Iterator
@@ -20,9 +21,8 @@ import psutil
 import pytest
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
-from ros_utils import spin_until, stop_process
+from ros_utils import probe_node, spin_until, stop_process
 from sensor_msgs.msg import JointState
 from wirefish_bringup.graph import entry
 from wirefish_launcher.monitor import measure_rates
@@ -42,6 +42,7 @@ class QemuGraph:
     launcher: subprocess.Popen
     domain_id: int
     qemu_pids: set[int]
+    env: dict[str, str]
 
     def qemu_processes(self) -> list[psutil.Process]:
         found = [p for p in descendants(self.launcher.pid) if _is_qemu(p)]
@@ -76,7 +77,7 @@ def qemu_graph(tmp_path_factory) -> Iterator[QemuGraph]:
          '--namespace', NAMESPACE, '--out', str(tmp_path_factory.mktemp('qemu_run'))],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
-    graph = QemuGraph(launcher, domain_id, set())
+    graph = QemuGraph(launcher, domain_id, set(), env)
     try:
         seen = lines_until_running(launcher, 90.0)
         assert seen and seen[-1].startswith('running:'), ''.join(seen)
@@ -96,13 +97,11 @@ def graph_node(qemu_graph: QemuGraph, monkeypatch: pytest.MonkeyPatch):
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     context = Context()
     rclpy.init(context=context, domain_id=qemu_graph.domain_id)
-    node = rclpy.create_node('qemu_graph_probe', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-    yield node, executor
-    executor.shutdown()
-    node.destroy_node()
-    rclpy.try_shutdown(context=context)
+    try:
+        with probe_node('qemu_graph_probe', context) as node_and_executor:
+            yield node_and_executor
+    finally:
+        rclpy.try_shutdown(context=context)
 
 
 def _full(topic: str) -> str:
@@ -183,6 +182,31 @@ def test_qemu_restarted_under_the_running_graph_the_link_comes_back(qemu_graph, 
           'and launcher')
     assert bridge.is_running() and qemu_graph.process('bridge_node').pid == bridge.pid
     assert qemu_graph.launcher.poll() is None
+
+
+def _calibrate(qemu_graph: QemuGraph, *args: str) -> tuple[int, list[list[str]], str]:
+    """Run `wirefish calibrate ARGS` on the graph; return its code, its table's rows, stderr."""
+    done = subprocess.run([sys.executable, '-m', 'wirefish_cli.cli', 'calibrate', '--namespace',
+                           NAMESPACE, *args], env=qemu_graph.env, capture_output=True,
+                          text=True, timeout=60)
+    print(done.stdout, done.stderr)
+    return done.returncode, [line.split() for line in done.stdout.splitlines()[1:]], done.stderr
+
+
+def test_wirefish_calibrate_reads_the_emulated_boards_build_values(qemu_graph):
+    code, rows, stderr = _calibrate(qemu_graph, 'show')
+    assert code == 0, stderr
+    assert [row[:2] for row in rows] == [['1', 'DEFAULTS'], ['2', 'DEFAULTS']]
+
+
+def test_wirefish_calibrate_trims_the_emulated_board_live_then_back(qemu_graph):
+    code, rows, stderr = _calibrate(qemu_graph, 'set', '1', '--neutral-us', '1520',
+                                    '--us-per-rad', '600', '--direction', '-1')
+    assert code == 0, stderr
+    assert rows[0][:5] == ['1', 'LIVE', '1520.0', '600.00', '-1']
+    code, rows, stderr = _calibrate(qemu_graph, 'factory', '1')
+    assert code == 0, stderr
+    assert rows[0][:2] == ['1', 'DEFAULTS']
 
 
 def test_ctrl_c_stops_the_graph_and_leaves_no_qemu(qemu_graph):
