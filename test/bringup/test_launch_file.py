@@ -341,6 +341,12 @@ def test_the_virtual_fish_on_one_host_runs_the_graph_on_its_clock(monkeypatch):
     assert override['/**/bridge_node']['ros__parameters']['max_command_rate_hz'] == 1000.0
 
 
+def test_every_launch_on_the_clock_shares_one_overrides_file(monkeypatch):
+    files = {node['parameters'][1] for _ in range(2)
+             for node in launched_nodes(monkeypatch, **LAUNCHES['sim'])}
+    assert len(files) == 1 and Path(files.pop()).is_file()
+
+
 def test_a_real_fish_and_two_hosts_run_on_the_wall_clock(monkeypatch):
     for launch in ('real fish', 'fish role, prefixed', 'shore role'):
         for node in launched_nodes(monkeypatch, **LAUNCHES[launch]):

@@ -22,6 +22,7 @@ that stopped on a Ctrl-C is reported with its own exit code, not 255, however lo
 """
 
 import os
+from pathlib import Path
 import re
 
 from launch import LaunchDescription, Substitution
@@ -84,17 +85,23 @@ def _simulated_time_overrides():
     """Return a parameter file of what simulated time changes in the parameter file's sections."""
     # launch_ros writes a dict of values under /**, which a /**/bridge_node section of the
     # parameter file overrides: a file of its own, after that one, carries the bridge's value.
+    # One file per content, named by it and written once: every node of every launch reads the
+    # same file, and no launch leaves one more behind.
+    import hashlib
     import tempfile
 
     import yaml
     from wirefish_bringup.graph import SIM_TIME_COMMAND_RATE_HZ
 
-    overrides = {'/**/bridge_node': {'ros__parameters': {
-        'max_command_rate_hz': float(SIM_TIME_COMMAND_RATE_HZ)}}}
-    with tempfile.NamedTemporaryFile('w', prefix='wirefish_sim_time_', suffix='.yaml',
-                                     delete=False) as file:
-        yaml.safe_dump(overrides, file)
-    return file.name
+    text = yaml.safe_dump({'/**/bridge_node': {'ros__parameters': {
+        'max_command_rate_hz': float(SIM_TIME_COMMAND_RATE_HZ)}}})
+    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+    path = Path(tempfile.gettempdir(), f'wirefish_sim_time_{digest}.yaml')
+    if not path.is_file() or path.read_text() != text:
+        partial = path.with_name(f'{path.name}.{os.getpid()}')
+        partial.write_text(text)
+        os.replace(partial, path)  # whole or not at all for a launch reading it meanwhile
+    return str(path)
 
 
 def _parameter_files(params_file: str) -> list[str]:
