@@ -19,7 +19,7 @@ import time
 from machine_share import heavy_weight, machine_share, slot_count
 from module_order import module_rank
 import pytest
-from ros_utils import stop_process
+from ros_utils import domain_context, stop_process
 
 WORKSPACE = Path(__file__).resolve().parents[1]
 # Fast DDS maps a domain to UDP ports; 0..101 is the portable range. A test run owns the window
@@ -67,18 +67,10 @@ def ros_env(ros_domain_id: int) -> dict[str, str]:
 
 
 @pytest.fixture
-def ros_context(ros_domain_id: int, monkeypatch: pytest.MonkeyPatch) -> Iterator[object]:
+def ros_context(ros_domain_id: int) -> Iterator[object]:
     """Yield an initialised rclpy context of its own, on this test's domain."""
-    import rclpy
-    from rclpy.context import Context
-
-    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    context = Context()
-    rclpy.init(context=context, domain_id=ros_domain_id)
-    try:
+    with domain_context(ros_domain_id) as context:
         yield context
-    finally:
-        rclpy.try_shutdown(context=context)
 
 
 @pytest.fixture

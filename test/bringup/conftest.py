@@ -7,6 +7,7 @@ import os
 from cpg_fixtures import probe  # noqa: F401 (a fixture, found by name)
 from e2e_utils import RunningGraph, start_graph, stopped_on_exit
 import pytest
+from ros_utils import domain_context
 
 
 @pytest.fixture(scope='module')
@@ -25,15 +26,7 @@ def running_graph(e2e_domain_id: int, tmp_path_factory, request) -> Iterator[Run
 
 
 @pytest.fixture
-def graph_context(running_graph: RunningGraph, monkeypatch: pytest.MonkeyPatch):
+def graph_context(running_graph: RunningGraph):
     """Yield an rclpy context of this test's own, on the shared graph's domain."""
-    import rclpy
-    from rclpy.context import Context
-
-    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    context = Context()
-    rclpy.init(context=context, domain_id=running_graph.domain_id)
-    try:
+    with domain_context(running_graph.domain_id) as context:
         yield context
-    finally:
-        rclpy.try_shutdown(context=context)

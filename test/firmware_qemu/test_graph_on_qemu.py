@@ -19,10 +19,8 @@ import time
 from e2e_utils import descendants, lines_until_running
 import psutil
 import pytest
-import rclpy
-from rclpy.context import Context
 from rclpy.qos import qos_profile_sensor_data
-from ros_utils import probe_node, spin_until, stop_process
+from ros_utils import domain_context, probe_node, spin_until, stop_process
 from sensor_msgs.msg import JointState
 from wirefish_bringup.graph import entry
 from wirefish_launcher.monitor import measure_rates
@@ -93,15 +91,10 @@ def qemu_graph(tmp_path_factory) -> Iterator[QemuGraph]:
 
 
 @pytest.fixture
-def graph_node(qemu_graph: QemuGraph, monkeypatch: pytest.MonkeyPatch):
-    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    context = Context()
-    rclpy.init(context=context, domain_id=qemu_graph.domain_id)
-    try:
-        with probe_node('qemu_graph_probe', context) as node_and_executor:
-            yield node_and_executor
-    finally:
-        rclpy.try_shutdown(context=context)
+def graph_node(qemu_graph: QemuGraph):
+    with domain_context(qemu_graph.domain_id) as context, \
+            probe_node('qemu_graph_probe', context) as node_and_executor:
+        yield node_and_executor
 
 
 def _full(topic: str) -> str:

@@ -18,7 +18,7 @@ import time
 
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 import pytest
-from ros_utils import stop_process
+from ros_utils import domain_context, stop_process
 from wirefish_common.executors import ExecutorKind, make_executor, spin_until_stopped, wake
 
 NAMESPACE = '/h181_planner'
@@ -289,18 +289,11 @@ def simulated_planner_graph(planner_domain_id: int, tmp_path_factory,
 @pytest.fixture(scope='module')
 def driver(simulated_planner_graph: PlannerGraph) -> Iterator[Driver]:
     """Yield the module's driver node on the graph's domain and clock, in a context of its own."""
-    import rclpy
-    from rclpy.context import Context
-
     planner_graph = simulated_planner_graph
-    with pytest.MonkeyPatch.context() as monkeypatch:
-        monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-        context = Context()
-        rclpy.init(context=context, domain_id=planner_graph.domain_id)
+    with domain_context(planner_graph.domain_id) as context:
         probe = Driver(context, planner_graph.namespace, simulated=planner_graph.simulated)
         try:
             yield probe
         finally:
             probe.command = None
             probe.close()
-            rclpy.try_shutdown(context=context)

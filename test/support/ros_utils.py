@@ -14,6 +14,28 @@ PEERS = str(Path(__file__).with_name('ros_peers.py'))
 
 
 @contextmanager
+def domain_context(domain_id: int) -> Iterator[object]:
+    """
+    Yield an initialised rclpy context of its own on ``domain_id``; shut it down after.
+
+    Discovery stays on this host (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` while it is open),
+    as every graph a test starts.
+    """
+    import pytest
+    import rclpy
+    from rclpy.context import Context
+
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+        context = Context()
+        rclpy.init(context=context, domain_id=domain_id)
+        try:
+            yield context
+        finally:
+            rclpy.try_shutdown(context=context)
+
+
+@contextmanager
 def probe_node(name: str, context) -> Iterator[tuple]:
     """Yield (node, executor): a test's own node on ``context``, spun by hand; closed after."""
     import rclpy

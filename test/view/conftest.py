@@ -12,6 +12,7 @@ from e2e_utils import RunningGraph, start_graph, stopped_on_exit
 from foxglove_client import free_port
 from headless_chromium import headless_chromium
 import pytest
+from ros_utils import domain_context
 from wirefish_bringup.graph import default_params_file
 import yaml
 
@@ -70,18 +71,10 @@ def view_graph(tmp_path_factory, request) -> Iterator[ViewGraph]:
 
 
 @pytest.fixture
-def graph_context(view_graph: ViewGraph, monkeypatch: pytest.MonkeyPatch):
+def graph_context(view_graph: ViewGraph):
     """Yield an rclpy context of this test's own, on the view graph's domain."""
-    import rclpy
-    from rclpy.context import Context
-
-    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    context = Context()
-    rclpy.init(context=context, domain_id=view_graph.graph.domain_id)
-    try:
+    with domain_context(view_graph.graph.domain_id) as context:
         yield context
-    finally:
-        rclpy.try_shutdown(context=context)
 
 
 class DashboardPage:
