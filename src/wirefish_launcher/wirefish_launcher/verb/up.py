@@ -57,6 +57,11 @@ DUPLICATE_CHECK_S = 4.0
 # A timed run on simulated time ends after --duration of the virtual fish's clock; a clock that
 # has not moved for this long (wall s: the virtual fish gone, its restarts given up) ends it.
 CLOCK_STALL_S = 30.0
+# A timed run on simulated time counts from when the recorder takes the virtual fish's clock:
+# counted from the recording line, a recorder that discovered the fish late (a loaded machine:
+# 0.3 simulated s at --speed 0.5) got less than --duration into its bag. At most this long
+# (wall s) is waited for it.
+RECORDER_WAIT_S = 30.0
 
 
 class Fish(enum.StrEnum):
@@ -398,6 +403,20 @@ def _graph_probe(namespace: str) -> Iterator[tuple]:
     yield node, executor
 
 
+def _recorder_takes(node, topic: str, stop) -> bool:
+    """Wait until the recorder subscribes to ``topic`` (it found its publisher); True if so."""
+    from wirefish_bringup.graph import entry
+
+    recorder = entry('wirefish_recorder').name
+    deadline = time.monotonic() + RECORDER_WAIT_S
+    while not stop.requested and time.monotonic() < deadline:
+        if any(info.node_name == recorder
+               for info in node.get_subscriptions_info_by_topic(topic)):
+            return True
+        time.sleep(0.05)
+    return False
+
+
 def run(args: argparse.Namespace) -> int:
     """Run `wirefish up`; return its exit code, or exit with it if the graph was probed."""
     code = _run(args)
@@ -548,6 +567,10 @@ def _run(args: argparse.Namespace) -> int:
                 print(f'gait library: {library}', flush=True)
             status, measured = _wait_ready(node, executor, namespace, specs, supervisor,
                                            not args.no_status, stop, role=args.role)
+            if run_clock is not None and bag_path is not None and clock_topic is not None \
+                    and not _recorder_takes(node, clock_topic, stop):
+                print(f'wirefish up: the recorder did not subscribe to {clock_topic} within '
+                      f'{RECORDER_WAIT_S:g} s; the run counts from now', file=sys.stderr)
         if status and status.startswith('not up'):
             raise RuntimeError(status)
         # On a terminal the status is redrawn in place while the graph runs; else shown once.
