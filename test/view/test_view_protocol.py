@@ -14,10 +14,11 @@ import time
 
 from foxglove_client import FoxgloveClient
 import pytest
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from ros_utils import probe_node, spin_until
 from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import Imu, JointState
-from wirefish_common.qos import RELIABLE, SENSOR_DATA
+from wirefish_common.qos import RELIABLE
 from wirefish_msgs.msg import PlannerState
 
 pytestmark = pytest.mark.ros
@@ -83,10 +84,12 @@ def test_a_fast_stream_arrives_whole_and_decodes_to_what_was_published(
     # Every message of each stamp: on simulated time two messages may share one (the bridge
     # stamps what it reads with the clock, which moves once a step).
     published: dict[int, list] = {}
+    # Room for every sample between two spins (a probe starved on one core must not drop a
+    # message the view then shows: the comparison below needs all of them).
     node.create_subscription(message_type, name,
                              lambda m: published.setdefault(_stamp_ns(m.header.stamp),
                                                             []).append(m),
-                             SENSOR_DATA)
+                             QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT))
     assert client.wait(lambda: client.channel_of(name) is not None, timeout_s=30.0)
     subscription = client.subscribe(client.channel_of(name)['id'])
     assert client.wait(lambda: len(client.messages.get(subscription, [])) > 50, 20.0)
