@@ -16,7 +16,7 @@ import sys
 import time
 
 from bag_utils import assert_bag_readable, counters, flushed_topics, reindex_bag
-from e2e_utils import descendants
+from e2e_utils import descendants, lines_until_running
 import numpy as np
 import psutil
 import pytest
@@ -148,25 +148,12 @@ def test_a_clean_stop_writes_a_finished_bag(tmp_path, spawn, talker_namespace, l
     assert f'Count: {info.message_count}' in result.stdout
 
 
-def _read_until(proc: subprocess.Popen, prefix: str, timeout_s: float) -> list[str]:
-    lines: list[str] = []
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        line = proc.stdout.readline()
-        if not line:
-            break
-        lines.append(line)
-        if line.startswith(prefix):
-            break
-    return lines
-
-
 def _up_recording(spawn, python, namespace: str, out: Path, duration_s: int
                   ) -> tuple[subprocess.Popen, Path, psutil.Process]:
     """Start `wirefish up --duration`; return it, its bag and its recorder, once it flushed."""
     launcher = spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
                       '--namespace', namespace, '--out', str(out), '--duration', str(duration_s)])
-    lines = _read_until(launcher, 'recording to', 120.0)
+    lines = lines_until_running(launcher, 120.0, ('recording to',))
     assert lines and lines[-1].startswith('recording to'), ''.join(lines)
     bag = Path(lines[-1].split()[2].rstrip(';'))
     (recorder,) = [p for p in descendants(launcher.pid)
