@@ -3,7 +3,7 @@
 
 import pytest
 from wirefish_common.executors import (executor_kind, EXECUTOR_VARIABLE, ExecutorKind,
-                                       make_executor, spin_until_stopped, wake)
+                                       make_executor, settle, spin_until_stopped, wake)
 
 EVENTS, CLASSIC = ExecutorKind.EVENTS, ExecutorKind.CLASSIC
 
@@ -87,3 +87,26 @@ def test_wake_hands_the_executor_a_task_that_does_nothing():
     executor = FakeExecutor()
     wake(executor)
     assert len(executor.tasks) == 1 and executor.tasks[0]() is None
+
+
+class QueueExecutor(FakeExecutor):
+    """Runs one queued task per spin, in order, as both rclpy executors do."""
+
+    def spin_once(self, timeout_sec: float) -> None:
+        super().spin_once(timeout_sec)
+        if self.tasks:
+            self.tasks.pop(0)()
+
+
+def test_settle_spins_until_the_work_queued_before_it_has_run():
+    executor = QueueExecutor()
+    ran = []
+    for index in range(3):  # callbacks already waiting: each takes one spin
+        executor.create_task(lambda index=index: ran.append(index))
+    assert settle(executor) is True
+    assert ran == [0, 1, 2] and executor.spins == 4
+
+
+def test_settle_says_false_when_the_time_runs_out_first():
+    executor = FakeExecutor()  # never runs its tasks
+    assert settle(executor, timeout_s=0.05) is False

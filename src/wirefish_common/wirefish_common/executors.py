@@ -25,6 +25,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 import enum
 import os
+import time
 from typing import Any
 
 EXECUTOR_VARIABLE = 'WIREFISH_EXECUTOR'
@@ -39,6 +40,8 @@ class ExecutorKind(enum.StrEnum):
 
 # The longest the loop goes without looking at its stop flag if nobody wakes it.
 SPIN_TIMEOUT_S = 0.1
+# The longest ``settle`` spins: callbacks already queued run first, each a few ms at most.
+SETTLE_S = 2.0
 
 
 def executor_kind(environ: Mapping[str, str] | None = None) -> ExecutorKind:
@@ -75,6 +78,23 @@ def spin_until_stopped(executor: Any, stopped: Callable[[], bool]) -> None:
     """
     while not stopped():
         executor.spin_once(timeout_sec=SPIN_TIMEOUT_S)
+
+
+def settle(executor: Any, timeout_s: float = SETTLE_S) -> bool:
+    """
+    Spin ``executor`` until everything handed to it before this call has run; return whether.
+
+    Both executors run their queued work in order: a task queued now runs after what
+    ``remove_node`` asked for (the events executor lets go of a removed node's entities in a
+    handler it queues, behind whatever callbacks were already waiting, so one ``spin_once``
+    may run one of those instead). False if ``timeout_s`` went by first.
+    """
+    done: list[bool] = []
+    executor.create_task(lambda: done.append(True))
+    deadline = time.monotonic() + timeout_s
+    while not done and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=SPIN_TIMEOUT_S)
+    return bool(done)
 
 
 def _nothing() -> None:

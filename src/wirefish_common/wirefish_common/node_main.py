@@ -27,7 +27,8 @@ import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
-from wirefish_common.executors import executor_kind, make_executor, spin_until_stopped
+from wirefish_common.executors import (executor_kind, make_executor, settle,
+                                       spin_until_stopped)
 from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
 
@@ -83,13 +84,14 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         # The node's own threads (serial reader, publish loop) are joined by destroy_node
         # before the executor goes: a task they hand over meets a live executor.
         executor.remove_node(node)
-        # The events executor lets go of a removed node's entities on its next spin, not in
-        # remove_node: until then destroy_node cannot destroy the node, and without that the
-        # node stays in every other participant's graph (`ros2 node list`) until this
-        # participant's lease runs out, ~20 s after the exit (measured: 20.0 s, 0.0 s with
-        # this spin).
+        # The events executor lets go of a removed node's entities in a handler it queues
+        # behind the callbacks already waiting: until that has run, destroy_node cannot
+        # destroy the node, and without that the node stays in every other participant's
+        # graph (`ros2 node list`) until this participant's lease runs out, ~20 s after the
+        # exit. One spin_once ran a waiting callback instead on a loaded machine: settle
+        # spins until a task queued after the removal has run.
         try:
-            executor.spin_once(timeout_sec=0.0)
+            settle(executor)
         except (ExternalShutdownException, RuntimeError):  # the context is already shut down
             pass
         node.destroy_node()
