@@ -5,7 +5,8 @@ bridge_node in gait mode, against a fish the test plays on a pty.
 cpg_params becomes a GAIT (and never a SERVO_CMD), LINK_CONFIG goes out at link-up until an ACK
 accepts it, then the GAIT (not before: the fish must run the configured link), resent until
 acknowledged, COASTING shows in /diagnostics, compact
-telemetry is published in SI units.
+telemetry is published in SI units. Stream mode on a link the bridge configures sends no
+SERVO_CMD before that ACK either.
 """
 
 import dataclasses
@@ -92,6 +93,23 @@ def test_gait_mode_sends_gaits_and_its_link_config_until_acknowledged(fake_devic
         probe.spin_for(0.1)
     status = probe.statuses()[-1]
     assert status.level == b'\x01' and 'COASTING' in status.message
+
+
+def test_stream_mode_on_a_configured_link_streams_only_once_the_fish_acknowledges_it(
+        fake_device, start_bridge, probe):
+    start_bridge(fake_device.link, 'drive_mode:=stream', 'telemetry_period_s:=0.1',
+                 'telemetry_form:=compact', 'gait_resend_s:=0.3')
+    # Neither servo_cmd's neutral before the first servo_cmd nor anything else but the
+    # LINK_CONFIG (and heartbeats, READs) goes out before its ACK.
+    sent = _until(probe, fake_device,
+                  lambda s: sum(isinstance(m, LinkConfig) for m in s) >= 3, 20.0)
+    print(f'stream mode before the ACK: {sorted({type(m).__name__ for m in sent})}')
+    assert not any(isinstance(m, (ServoCommand, Gait)) for m in sent), sent
+    fake_device.send(Ack(MsgType.LINK_CONFIG, _last_seq(fake_device, LinkConfig)))
+    sent = _until(probe, fake_device,
+                  lambda s: sum(isinstance(m, ServoCommand) for m in s) >= 5, 20.0)
+    assert sum(isinstance(m, ServoCommand) for m in sent) >= 5
+    assert probe.last_diagnostics()['link_configured'] == 'True'
 
 
 def _last_seq(fake_device, kind: type) -> int:

@@ -186,9 +186,13 @@ def drive(out: Path, preset: str, *, drive_mode: str | None = None, drive_s: flo
         source = record.servo if qemu else record.truth
         # The drive starts on a configured link: until LINK_CONFIG reaches it, a board floods
         # a narrow radio with its boot defaults (100 Hz of full telemetry).
+        waited_from = time.monotonic()
         assert probe.spin_until(lambda: bool(source) and _configured(record), 60.0), \
-            'no ground truth (servo_state on QEMU) or no configured link within 60 s'
+            (f'within 60 s: {len(source)} samples of ground truth (servo_state on QEMU); the '
+             f"bridge's last link values: {_last_link_values(record)}")
         record.started = time.monotonic()
+        print(f'{preset} {record.drive_mode}: ground truth and a configured link '
+              f'{record.started - waited_from:.1f} s after `wirefish up` ran')
         next_cmd = record.started
         total = drive_s + cut_s + after_cut_s
         control = _run_dir(out) / 'radio-control'
@@ -214,6 +218,14 @@ def drive(out: Path, preset: str, *, drive_mode: str | None = None, drive_s: flo
     record.radio = json.loads(radio.read_text())
     record.cuts = [tuple(cut) for cut in record.radio['cuts']]
     return record
+
+
+def _last_link_values(record: Drive) -> dict[str, str] | str:
+    """Return the bridge's newest serial-link diagnostics values, or why there are none."""
+    if not record.diagnostics:
+        return 'no /diagnostics of the serial link'
+    _, level, message, values = record.diagnostics[-1]
+    return {'level': str(level), 'message': message, **values}
 
 
 def _configured(record: Drive) -> bool:

@@ -15,7 +15,8 @@ Subscribes
     acknowledges it (``gait_link.GaitLink``).
 LINK_CONFIG (telemetry period and form, HEALTH period, link timeout, coast time: the
 parameters of the same names) goes out when the fish identifies itself, again until an ACK
-accepts it, in gait mode or whenever it differs from the fish's boot defaults.
+accepts it, in gait mode or whenever it differs from the fish's boot defaults; until that ACK
+neither a GAIT nor a SERVO_CMD goes out (the fish rests on its failsafe meanwhile).
 Publishes (sensor-data QoS, stamped on receipt with the node clock)
     ``imu/data`` (sensor_msgs/Imu, frame ``imu_frame_id``), ``attitude``
     (geometry_msgs/Vector3Stamped: roll, pitch, yaw rad), ``servo_state`` (sensor_msgs/JointState,
@@ -500,6 +501,8 @@ class BridgeNode(Node):
             with self._gait_lock:
                 self._watch.add_host(self._now_s(), angles)
             return
+        if not self._streams():
+            return
         sweep = self._sweep_command()
         if sweep is not None:   # the wiring sweep's angles go instead (at servo_cmd's pace)
             angles = sweep
@@ -551,6 +554,18 @@ class BridgeNode(Node):
                 with self._gait_lock:
                     self._gait.sent(seq, now)
 
+    def _streams(self) -> bool:
+        """
+        Return True when SERVO_CMD may go out (stream mode): once the fish runs the link.
+
+        A stream of 100 Hz fills a narrow radio (rf433: 174 % of its UART towards the fish),
+        and whole frames that find the queue full are refused: the LINK_CONFIG and the
+        heartbeats among them were refused for a minute on end. Until the fish acknowledges
+        the link it rests on its own failsafe, as a fish in gait mode before its first GAIT.
+        """
+        with self._gait_lock:
+            return self._link_configured()
+
     def _link_configured(self) -> bool:
         """Return True when the fish runs the link the bridge wants (the gait lock held)."""
         return self._config.acknowledged or not self._configures_fish()
@@ -588,7 +603,7 @@ class BridgeNode(Node):
     def _on_command_tick(self) -> None:
         self._send_gait_mode_frames()
         self._send_calibration_reads()
-        if self._gait_mode:
+        if self._gait_mode or not self._streams():
             return   # no SERVO_CMD: one would put the board back in stream mode
         sweep = self._sweep_command()
         if sweep is not None:
