@@ -10,6 +10,7 @@ stream the killed node does not feed paused longer than MAX_PAUSE_S. Rates and p
 the graph's simulated time (fish_sim's clock: every node runs on it, so fish_sim feeds all).
 Checks that belong to one victim (the bridge holding the fish neutral while the CPG is gone,
 the tuner answering again, the recorder writing on into the same bag) are in VICTIM_CHECKS.
+Each kill waits for the graph in lockstep (fish_sim says when its host holds the clock).
 After the kills the graph is stopped and its one bag is read: it opens with rosbags, and no
 publisher sequence number of any topic is missing except while the recorder itself was down
 (from at most KILL_MARGIN_S before its kill). The refusal test gives
@@ -282,6 +283,18 @@ def watched(e2e_domain_id: int, tmp_path_factory) -> Iterator[WatchedGraph]:
         graph.launcher.stdout.close()
 
 
+def _in_lockstep(watched: WatchedGraph) -> bool:
+    """
+    Return whether fish_sim's newest word on its host is that simulated time waits for it.
+
+    After a CPG's restart the clock follows the wall clock until the new CPG's stream has
+    been found and runs at the step rate (``wirefish_sim.lockstep``): a kill before that would
+    measure a clock that does not wait for the graph.
+    """
+    lines = _engagement_lines(watched.graph.out_dir)
+    return bool(lines) and 'simulated time waits' in lines[-1]
+
+
 def _all_streaming(watched: WatchedGraph) -> bool:
     """Return whether every stream came at its rate over the last RATE_WINDOW_S of sim time."""
     return all(watched.rate(_full(t), RATE_WINDOW_S) >= RESUMED_FRACTION * hz
@@ -357,6 +370,8 @@ VICTIM_CHECKS: dict[str, Callable[[WatchedGraph, Kill], None]] = {
 @pytest.mark.parametrize('victim', VICTIMS)
 def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watched, victim):
     assert _wait(lambda: _all_streaming(watched), BACK_WITHIN_S), 'not streaming before'
+    assert _wait(lambda: _in_lockstep(watched), BACK_WITHIN_S), \
+        f'fish_sim not in lockstep before the kill: {_engagement_lines(watched.graph.out_dir)}'
     before = watched.pids()
     assert set(before) == set(VICTIMS), before
     killed_at, killed_wall = time.monotonic(), time.time()
@@ -438,6 +453,7 @@ def test_the_bag_of_the_whole_run_is_readable_and_lost_nothing_while_the_recorde
             if topic in stamped:
                 pause = longest_gap(stamped[topic], since, until)
                 paused[(victim, topic)] = pause
+    print('fish_sim on its hosts: ' + ' | '.join(_engagement_lines(watched.graph.out_dir)))
     print('longest pauses in the bag (simulated s): ' + ', '.join(
         f'{victim} {topic.rsplit("/", 1)[-1]} {pause:.2f}'
         for (victim, topic), pause in paused.items()))
@@ -465,6 +481,13 @@ def _bag_types(bag: Path) -> dict[str, str]:
 
     with AnyReader([Path(bag)], default_typestore=wirefish_typestore()) as reader:
         return {c.topic: c.msgtype for c in reader.connections}
+
+
+def _engagement_lines(out_dir: Path) -> list[str]:
+    """Return fish_sim's lines of when its host started and stopped holding the clock."""
+    return [line.strip() for log in sorted(out_dir.glob('run_*/logs/fish_sim.log'))
+            for line in log.read_text(errors='replace').splitlines()
+            if 'simulated time waits' in line or 'simulated time follows' in line]
 
 
 def longest_gap(stamps: list[float], since: float, until: float) -> float:

@@ -387,9 +387,11 @@ def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence
         for index in _exchange(fleet, links, closing, stalled):
             clock.on_command(index)
         now = time.monotonic()
+        engaged = list(clock.engaged)  # ready() releases a fish whose host went silent
         if clock.ready(now):
             _step(fleet, links, disturbance, step_s, stalled)
             clock.advance(now)
+            _say_engagement(engaged, clock)
             if ground_truth is not None:
                 ground_truth.publish_clock(clock.time_ns)
                 said_wall = now
@@ -410,6 +412,17 @@ def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence
           f'(real-time factor {simulated_s / max(wall_s, 1e-9):.2f}); {counters.steps} steps, '
           f'{counters.lockstep_steps} in lockstep; the host went silent {counters.releases} '
           'times', file=sys.stderr, flush=True)
+
+
+def _say_engagement(before: list[bool], clock: LockstepClock) -> None:
+    """Log each fish whose host started or stopped holding the clock with this step."""
+    for fish, (was, now) in enumerate(zip(before, clock.engaged)):
+        if was != now:
+            what = ('its host streams: simulated time waits for each command' if now else
+                    f'its host was silent {clock.grace_s:g} s: simulated time follows the '
+                    'wall clock')
+            print(f'fish_sim: fish {fish} at simulated {clock.time_s:.2f} s: {what}',
+                  file=sys.stderr, flush=True)
 
 
 def _run_wall_clock(args: argparse.Namespace, fleet: VirtualFleet,
