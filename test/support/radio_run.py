@@ -185,14 +185,16 @@ def drive(out: Path, preset: str, *, drive_mode: str | None = None, drive_s: flo
     try:
         source = record.servo if qemu else record.truth
         # The drive starts on a configured link: until LINK_CONFIG reaches it, a board floods
-        # a narrow radio with its boot defaults (100 Hz of full telemetry).
+        # a narrow radio with its boot defaults (100 Hz of full telemetry); in gait mode, on a
+        # board that runs its gait.
         waited_from = time.monotonic()
-        assert probe.spin_until(lambda: bool(source) and _configured(record), 60.0), \
+        assert probe.spin_until(lambda: bool(source) and _ready_to_drive(record), 60.0), \
             (f'within 60 s: {len(source)} samples of ground truth (servo_state on QEMU); the '
              f"bridge's last link values: {_last_link_values(record)}")
         record.started = time.monotonic()
-        print(f'{preset} {record.drive_mode}: ground truth and a configured link '
-              f'{record.started - waited_from:.1f} s after `wirefish up` ran')
+        print(f'{preset} {record.drive_mode}: ready to drive (ground truth, the link '
+              f'configured, a gait on the board in gait mode) {record.started - waited_from:.1f} '
+              's after `wirefish up` ran')
         next_cmd = record.started
         total = drive_s + cut_s + after_cut_s
         control = _run_dir(out) / 'radio-control'
@@ -228,10 +230,19 @@ def _last_link_values(record: Drive) -> dict[str, str] | str:
     return {'level': str(level), 'message': message, **values}
 
 
-def _configured(record: Drive) -> bool:
-    """Return whether the bridge's newest diagnostics say the fish runs the wanted link."""
-    configured = record.bridge_values('link_configured')
-    return bool(configured) and configured[-1][1] == 'True'
+def _ready_to_drive(record: Drive) -> bool:
+    """
+    Return whether the bridge's newest diagnostics say the fish runs the wanted link.
+
+    In gait mode also that the board's telemetry says it runs a gait (a non-zero gait id):
+    between the link's ACK and the first GAIT's arrival the board is still in stream mode.
+    """
+    if not record.diagnostics:
+        return False
+    values = record.diagnostics[-1][3]
+    if values.get('link_configured') != 'True':
+        return False
+    return values.get('drive_mode') != 'gait' or values.get('board_gait_id', '0') != '0'
 
 
 def describe_link(record: Drive) -> str:
