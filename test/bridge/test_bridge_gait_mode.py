@@ -109,6 +109,9 @@ def test_stream_mode_on_a_configured_link_streams_only_once_the_fish_acknowledge
     sent = _until(probe, fake_device,
                   lambda s: sum(isinstance(m, ServoCommand) for m in s) >= 5, 20.0)
     assert sum(isinstance(m, ServoCommand) for m in sent) >= 5
+    # /diagnostics comes at its own rate: wait for one that says so.
+    _until(probe, fake_device, lambda _: bool(probe.statuses())
+           and probe.last_diagnostics()['link_configured'] == 'True', 10.0)
     assert probe.last_diagnostics()['link_configured'] == 'True'
 
 
