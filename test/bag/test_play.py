@@ -69,12 +69,14 @@ def test_play_publishes_every_message_in_order_with_its_qos(ros_context, ros_env
     spinner = threading.Thread(target=executor.spin, daemon=True)
     spinner.start()
     try:
+        # Discovery on a loaded machine took over 3 s: the first messages went to no one.
         result = subprocess.run([*CLI, 'play', str(bag), '--remap', '/recorded:=/played',
-                                 '--delay', '3'], env=ros_env, capture_output=True, text=True,
-                                timeout=120)
+                                 '--wait-for-subscribers', '60', '--delay', '0.5'],
+                                env=ros_env, capture_output=True, text=True, timeout=120)
         assert result.returncode == 0, result.stderr
         assert f'played {COUNT + 1} messages of 2 topics' in result.stdout
         assert 'deprecated' not in result.stderr, result.stderr  # rcl read no --remap of ours
+        assert 'no subscriber' not in result.stderr, result.stderr
         deadline = time.monotonic() + 10.0
         while len(heard) < COUNT and time.monotonic() < deadline:
             time.sleep(0.1)
@@ -98,3 +100,28 @@ def test_play_publishes_every_message_in_order_with_its_qos(ros_context, ros_env
         executor.shutdown()
         spinner.join(timeout=5.0)
         node.destroy_node()
+
+
+@pytest.mark.ros
+def test_a_topic_without_a_subscriber_is_said_and_played_anyway(ros_env, tmp_path):
+    bag = tmp_path / 'bag'
+    write_bag(bag)
+    result = subprocess.run([*CLI, 'play', str(bag), '--remap', '/recorded:=/nobody',
+                             '--wait-for-subscribers', '0.5', '--delay', '0'],
+                            env=ros_env, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    # The latched topic needs no subscriber before it plays: only the volatile one is named.
+    assert 'no subscriber of /nobody/chatter within 0.5 s: playing anyway' in result.stderr
+    assert '/nobody/state' not in result.stderr
+    assert f'played {COUNT + 1} messages of 2 topics' in result.stdout
+
+
+@pytest.mark.parametrize('option, value', [('--delay', 'nan'), ('--delay', '-1'),
+                                           ('--wait-for-subscribers', 'inf')])
+def test_a_wait_that_is_no_number_of_seconds_is_refused(tmp_path, option, value):
+    bag = tmp_path / 'bag'
+    write_bag(bag)
+    result = subprocess.run([*CLI, 'play', str(bag), option, value],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert f'{option} must be a number of seconds from 0 to 3600' in result.stderr

@@ -10,6 +10,8 @@ power cycle, a SAVE survives it, and a failed write changes nothing. The frames 
 and decoded by the C codec (flat records of wf_host.h).
 """
 
+import os
+import select
 import struct
 import subprocess
 import time
@@ -19,7 +21,6 @@ from firmware_host import BUILD, FirmwareHost, MSG_DTYPE
 import numpy as np
 import pytest
 from ros_utils import stop_process
-import serial
 
 PROGRAM = BUILD / 'host' / 'wirefish-fw-host'
 SERVO_TRIM, SERVO_TRIM_REPORT, ACK, HEARTBEAT, HEALTH = 0x12, 0x22, 0x03, 0x01, 0x30
@@ -58,7 +59,14 @@ def reports(frames: np.ndarray) -> list[tuple[int, int, int, float, float]]:
 
 
 class Board:
-    """wirefish-fw-host on a pty with a calibration file; the C codec for its frames."""
+    """
+    wirefish-fw-host on a pty with a calibration file; the C codec for its frames.
+
+    The pty is opened as a plain file, not with pyserial: pyserial's open flushes the input
+    queue (TCIFLUSH), and the boot reports the board writes at once after saying its pty were
+    flushed with it whenever this process opened the pty later than that (seen in a loaded
+    full run). The program keeps the pty raw and its other end open, so nothing is lost here.
+    """
 
     def __init__(self, lib: FirmwareHost, path) -> None:
         """Start the program on ``path``; wait for its pty."""
@@ -68,18 +76,19 @@ class Board:
         assert self.proc.stdout is not None
         line = self.proc.stdout.readline()
         assert line.startswith('pty: '), line
-        self.port = serial.Serial(line.split(' ', 1)[1].strip(), 115200, timeout=0.05)
+        self.fd = os.open(line.split(' ', 1)[1].strip(), os.O_RDWR | os.O_NOCTTY)
         self.received = b''
 
     def send(self, *messages: np.ndarray) -> None:
         """Write the messages, encoded in C."""
-        self.port.write(self.lib.encode_stream(np.concatenate(messages)))
+        os.write(self.fd, self.lib.encode_stream(np.concatenate(messages)))
 
     def until(self, done, timeout_s: float = 5.0) -> np.ndarray:
         """Read until ``done(frames)`` holds for every frame received so far; return them."""
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
-            self.received += self.port.read(self.port.in_waiting or 1)
+            if select.select([self.fd], [], [], 0.05)[0]:
+                self.received += os.read(self.fd, 4096)
             frames, _ = self.lib.decode_stream(self.received)
             if done(frames):
                 return frames
@@ -87,7 +96,7 @@ class Board:
 
     def stop(self) -> None:
         """Close the pty and SIGINT the program; it exits 0."""
-        self.port.close()
+        os.close(self.fd)
         assert stop_process(self.proc) == 0
 
 

@@ -7,7 +7,10 @@ with the reliability and durability its publishers offered (metadata.yaml; latch
 latched), each message's bytes as recorded, in the order and with the spacing of their log
 times (``--rate`` scales it). ``--remap FROM:=TO`` replaces a name prefix, so a bag of
 /wirefish plays into a graph under another namespace without meeting the graph's own
-publishers. The publishers are created first and given ``--delay`` seconds to be discovered.
+publishers. The publishers are created first and given ``--delay`` seconds to be discovered;
+``--wait-for-subscribers SECONDS`` waits first, at most that long, until every played topic that
+is not latched has a subscriber (a late subscriber of a latched one still gets it): the first
+messages then reach the graph's readers however slowly discovery goes.
 """
 
 from __future__ import annotations
@@ -22,6 +25,8 @@ from typing import Any
 from wirefish_cli.ros_session import ros_session
 
 ACK_WAIT_S = 5.0  # how long the played messages may take to be acknowledged at the end
+MAX_WAIT_S = 3600.0  # the longest --delay or --wait-for-subscribers
+SUBSCRIBER_POLL_S = 0.05
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -36,6 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--delay', type=float, default=1.0,
                         help='seconds between creating the publishers and the first message '
                         '(for subscribers to match; default %(default)g)')
+    parser.add_argument('--wait-for-subscribers', type=float, default=0.0, metavar='SECONDS',
+                        help='before the delay, wait at most SECONDS until every played topic '
+                        'that is not latched has a subscriber (default: no wait)')
 
 
 def remapped(topic: str, remaps: list[tuple[str, str]]) -> str:
@@ -82,6 +90,11 @@ def run(args: argparse.Namespace) -> int:
     problem = bag_directory_problem(args.bag)
     if problem is None and not (math.isfinite(args.rate) and args.rate > 0.0):
         problem = f'--rate must be a finite number > 0, got {args.rate}'
+    for name in ('delay', 'wait_for_subscribers'):
+        value = getattr(args, name)
+        if problem is None and not (math.isfinite(value) and 0.0 <= value <= MAX_WAIT_S):
+            problem = (f'--{name.replace("_", "-")} must be a number of seconds from 0 to '
+                       f'{MAX_WAIT_S:g}, got {value}')
     try:
         remaps = [parse_remap(text) for text in args.remap]
     except ValueError as error:
@@ -108,6 +121,17 @@ def _wait_for_acks(publishers: dict[str, Any]) -> list[str]:
         if not publishers[topic].wait_for_all_acked(Duration(nanoseconds=int(left * 1e9))):
             unacked.append(topic)
     return unacked
+
+
+def _without_subscribers(publishers: dict[str, Any], waited: list[str],
+                         seconds: float) -> list[str]:
+    """Wait at most ``seconds`` until each of ``waited`` has a subscriber; return those without."""
+    deadline = time.monotonic() + seconds
+    while True:
+        missing = [t for t in waited if publishers[t].get_subscription_count() == 0]
+        if not missing or time.monotonic() >= deadline:
+            return missing
+        time.sleep(SUBSCRIBER_POLL_S)
 
 
 def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
@@ -156,7 +180,14 @@ def _play(args: argparse.Namespace, remaps: list[tuple[str, str]]) -> int:
             except (ImportError, AttributeError, ValueError) as error:
                 print(f'wirefish play: skipping {topic}: unknown type {type_name} ({error})',
                       file=sys.stderr)
-        time.sleep(max(0.0, args.delay))
+        if args.wait_for_subscribers > 0.0:
+            volatile = [t for t in publishers if not qos_of.get(t, (True, False))[1]]
+            missing = _without_subscribers(publishers, volatile, args.wait_for_subscribers)
+            if missing:
+                names = ', '.join(publishers[t].topic_name for t in missing)
+                print(f'wirefish play: no subscriber of {names} within '
+                      f'{args.wait_for_subscribers:g} s: playing anyway', file=sys.stderr)
+        time.sleep(args.delay)
         span_s = max(0.0, (last - first) * 1e-9) / args.rate
         progress = Progress(f'play {args.bag.name}', max(1, math.ceil(span_s)))
         started, played = time.monotonic(), 0
