@@ -113,7 +113,13 @@ def test_a_fast_stream_arrives_whole_and_decodes_to_what_was_published(
             return tuple(m.name), tuple(m.position)
         return m.orientation.x, m.orientation.y, m.orientation.z, m.orientation.w
 
-    for stamp in set(view_stamps) & set(graph_stamps):
+    # A stamp where the probe holds fewer messages than the view is one where the probe,
+    # starved, dropped one (best effort: seen pinned to one core): nothing to compare there.
+    common = set(view_stamps) & set(graph_stamps)
+    judged = [s for s in common if len(published[s]) >= len(viewed[s])]
+    print(f'{topic}: {len(judged)} of {len(common)} shared stamps held whole by the probe')
+    assert len(judged) >= 0.9 * len(common) > 0
+    for stamp in judged:
         assert {values(m) for m in viewed[stamp]} <= {values(m) for m in published[stamp]}
 
 
