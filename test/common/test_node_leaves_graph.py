@@ -8,11 +8,9 @@ until the lease of its participant (~20 s) runs out. Here the node's executor ha
 waiting when the node is removed, as a busy node's has when a signal stops it.
 """
 
-import time
-
 import pytest
 import rclpy
-from ros_utils import domain_context, probe_node
+from ros_utils import domain_context, probe_node, spin_until
 from wirefish_common.executors import make_executor, settle
 
 pytestmark = pytest.mark.ros
@@ -25,31 +23,25 @@ def _listed(probe, name: str) -> bool:
     return name in [n for n, _ in probe.get_node_names_and_namespaces()]
 
 
-def _wait(condition, timeout_s: float) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while not condition() and time.monotonic() < deadline:
-        time.sleep(0.02)
-    return condition()
-
-
 @pytest.mark.parametrize('kind', ['events', 'classic'])
 def test_a_busy_node_removed_and_settled_leaves_the_graph_when_destroyed(
         ros_context, ros_domain_id, kind):
     name = f'busy_{kind}'
-    with probe_node('leave_probe', ros_context) as (probe, _), \
+    with probe_node('leave_probe', ros_context) as (probe, probe_executor), \
             domain_context(ros_domain_id) as context:
         node = rclpy.create_node(name, context=context)
         node.create_timer(0.001, lambda: None)
         executor = make_executor(kind, context)
         executor.add_node(node)
         try:
-            assert _wait(lambda: (executor.spin_once(timeout_sec=0.01), _listed(probe, name))[1],
-                         LISTED_S)
+            assert spin_until(executor, lambda: _listed(probe, name), LISTED_S)
+            for _ in range(50):  # the node at work: its entities taken, its timer firing
+                executor.spin_once(timeout_sec=0.01)
             for _ in range(3):  # callbacks waiting when the stop comes
                 executor.create_task(lambda: None)
             executor.remove_node(node)
             assert settle(executor)
             node.destroy_node()
-            assert _wait(lambda: not _listed(probe, name), GONE_S)
+            assert spin_until(probe_executor, lambda: not _listed(probe, name), GONE_S)
         finally:
             executor.shutdown()

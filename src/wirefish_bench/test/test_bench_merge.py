@@ -8,6 +8,10 @@ from wirefish_bench import bench
 from wirefish_bench.bench_report import (merge_markdown, MergeError, parse_markdown,
                                          render_markdown, Section)
 
+# BENCHMARKS.md names each run by when it started (bench_report's format): four runs' stamps.
+RUN_1, RUN_2 = '2026-12-03 15:12 UTC', '2026-12-04 16:40:05 UTC'
+RUN_3, RUN_4 = '2026-12-04 16:50:00 UTC', '2026-12-04 16:55:00 UTC'
+RUN_LINE = f'- {RUN_1[:5]}'  # the header's line of a run starts with the run's stamp
 HISTORY = '## History\n\n### 2026-12-01: a dated entry\n\n| what | then |\n|---|---|\n| a | b |\n'
 OLD_ROWS = {
     'cpg': '| CPG node at 100 Hz: achieved rate | p99 ≤ 0.2 ms | **classic**: 100.0 Hz<br>'
@@ -23,7 +27,7 @@ OLD_ROWS = {
 LEGACY = '\n'.join([
     '# Benchmarks', '',
     'Written by `make bench` (`python -m wirefish_bench.bench`); figures from one run.',
-    'Machine: Xeon, 2 cores, Python 3.11.7, numpy 2.4.6, kernel k1; 2026-12-03 15:12 UTC, load '
+    f'Machine: Xeon, 2 cores, Python 3.11.7, numpy 2.4.6, kernel k1; {RUN_1}, load '
     'average 0.5 at the start. Shared and noisy: medians and p99 from one run.', '',
     '| figure | goal | measured | verdict | how |', '|---|---|---|---|---|', *OLD_ROWS.values(),
     '', 'Raw numbers: `out/bench/results.json` of the same run.', '', HISTORY])
@@ -40,7 +44,7 @@ def _results(date: str, load: float, **sections: dict) -> dict:
     return results
 
 
-FIRMWARE_RUN = _results('2026-12-04 16:40:05 UTC', 1.3,
+FIRMWARE_RUN = _results(RUN_2, 1.3,
                         firmware={'error': 'CalledProcessError: make cycles'})
 
 
@@ -58,7 +62,7 @@ def test_other_sections_rows_are_kept_byte_for_byte_and_the_named_ones_replaced(
     for key in ('cpg', 'radio', 'fleet'):
         assert OLD_ROWS[key] in lines
     assert OLD_ROWS['firmware'] not in merged and 'TSC ticks 550' not in merged
-    at = lines.index('## `firmware`, run of 2026-12-04 16:40:05 UTC')
+    at = lines.index(f'## `firmware`, run of {RUN_2}')
     assert lines[at + 4].startswith('| Firmware: ')
     assert '| CalledProcessError: make cycles | not measured |' in lines[at + 4]
     assert merged.endswith('\n' + HISTORY)
@@ -66,53 +70,53 @@ def test_other_sections_rows_are_kept_byte_for_byte_and_the_named_ones_replaced(
 
 def test_the_header_lists_each_run_with_its_machine_its_load_and_its_rows():
     merged = merge_markdown(parse_markdown(LEGACY), FIRMWARE_RUN)
-    runs = [line for line in _lines(merged) if line.startswith('- 2026-')]
+    runs = [line for line in _lines(merged) if line.startswith(RUN_LINE)]
     assert runs == [
-        '- 2026-12-03 15:12 UTC, whole run: Xeon, 2 cores, Python 3.11.7, numpy 2.4.6, kernel '
+        f'- {RUN_1}, whole run: Xeon, 2 cores, Python 3.11.7, numpy 2.4.6, kernel '
         'k1; load average 0.5 at the start. Its rows: cpg-rate, radio-link, fleet.',
-        '- 2026-12-04 16:40:05 UTC, `--only firmware`: Xeon, 2 cores, Python 3.11.7, numpy '
+        f'- {RUN_2}, `--only firmware`: Xeon, 2 cores, Python 3.11.7, numpy '
         '2.4.6, kernel k2; load average 1.3 at the start. Its rows: firmware.']
     assert _headings(merged) == [
-        '## `cpg-rate`, run of 2026-12-03 15:12 UTC',
-        '## `radio-link`, run of 2026-12-03 15:12 UTC',
-        '## `firmware`, run of 2026-12-04 16:40:05 UTC',
-        '## `fleet`, run of 2026-12-03 15:12 UTC']
+        f'## `cpg-rate`, run of {RUN_1}',
+        f'## `radio-link`, run of {RUN_1}',
+        f'## `firmware`, run of {RUN_2}',
+        f'## `fleet`, run of {RUN_1}']
 
 
 def test_a_second_run_keeps_the_first_runs_rows_and_a_run_with_none_left_leaves_the_header():
     first = merge_markdown(parse_markdown(LEGACY), FIRMWARE_RUN)
     firmware_row = next(line for line in _lines(first) if line.startswith('| Firmware: '))
     second = merge_markdown(parse_markdown(first), _results(
-        '2026-12-04 16:50:00 UTC', 0.9, radio_link={'error': 'only root'}))
+        RUN_3, 0.9, radio_link={'error': 'only root'}))
     assert firmware_row in _lines(second) and OLD_ROWS['cpg'] in _lines(second)
     assert OLD_ROWS['radio'] not in second
     assert '| only root | not measured |' in second
-    assert [line.split(',')[0] for line in _lines(second) if line.startswith('- 2026-')] == [
-        '- 2026-12-03 15:12 UTC', '- 2026-12-04 16:40:05 UTC', '- 2026-12-04 16:50:00 UTC']
+    assert [line.split(',')[0] for line in _lines(second) if line.startswith(RUN_LINE)] == [
+        f'- {RUN_1}', f'- {RUN_2}', f'- {RUN_3}']
     # a third run of radio-link again: the second run has no row left, so no line either
     third = merge_markdown(parse_markdown(second), _results(
-        '2026-12-04 16:55:00 UTC', 0.9, radio_link={'error': 'only root'}))
+        RUN_4, 0.9, radio_link={'error': 'only root'}))
     assert ([b for b in parse_markdown(third).blocks if b.section != 'radio-link']
             == [b for b in parse_markdown(second).blocks if b.section != 'radio-link'])
-    assert '2026-12-04 16:50:00 UTC' not in third
+    assert RUN_3 not in third
 
 
 def test_a_section_new_to_the_file_is_added_in_run_order():
     merged = merge_markdown(parse_markdown(LEGACY), _results(
-        '2026-12-04 16:40:05 UTC', 1.3, sim_clock={'error': 'RuntimeError: no clock'}))
+        RUN_2, 1.3, sim_clock={'error': 'RuntimeError: no clock'}))
     assert _headings(merged) == [
-        '## `cpg-rate`, run of 2026-12-03 15:12 UTC',
-        '## `radio-link`, run of 2026-12-03 15:12 UTC',
-        '## `firmware`, run of 2026-12-03 15:12 UTC',
-        '## `sim-clock`, run of 2026-12-04 16:40:05 UTC',
-        '## `fleet`, run of 2026-12-03 15:12 UTC']
+        f'## `cpg-rate`, run of {RUN_1}',
+        f'## `radio-link`, run of {RUN_1}',
+        f'## `firmware`, run of {RUN_1}',
+        f'## `sim-clock`, run of {RUN_2}',
+        f'## `fleet`, run of {RUN_1}']
     assert all(row in _lines(merged) for row in OLD_ROWS.values())
 
 
 def test_a_whole_run_rewrites_every_section_under_one_run_and_keeps_the_history():
     text = render_markdown({**FIRMWARE_RUN, 'sections': list(Section)}, HISTORY)
-    assert [line for line in _lines(text) if line.startswith('- 2026-')] == [
-        '- 2026-12-04 16:40:05 UTC, whole run: Xeon, 2 cores, Python 3.11.7, numpy 2.4.6, '
+    assert [line for line in _lines(text) if line.startswith(RUN_LINE)] == [
+        f'- {RUN_2}, whole run: Xeon, 2 cores, Python 3.11.7, numpy 2.4.6, '
         'kernel k2; load average 1.3 at the start. Its rows: '
         + ', '.join(Section) + '.']
     assert len(_headings(text)) == len(Section) and text.endswith('\n' + HISTORY)
@@ -126,7 +130,7 @@ def test_a_row_that_belongs_to_no_section_stops_the_merge():
 
 def test_a_run_already_in_the_file_is_refused():
     first = merge_markdown(parse_markdown(LEGACY), FIRMWARE_RUN)
-    with pytest.raises(MergeError, match='already has a run of 2026-12-04 16:40:05 UTC'):
+    with pytest.raises(MergeError, match=f'already has a run of {RUN_2}'):
         merge_markdown(parse_markdown(first), FIRMWARE_RUN)
 
 
@@ -165,7 +169,7 @@ def test_a_plain_run_is_a_whole_run(monkeypatch, tmp_path: Path):
     assert bench.main(['--markdown', str(markdown), '--out', str(tmp_path)]) == 0
     assert called == [s.value for s in bench.SECTIONS]
     text = markdown.read_text()
-    assert '2026-12-03' not in text.replace(HISTORY, '') and ', whole run: ' in text
+    assert RUN_1[:10] not in text.replace(HISTORY, '') and ', whole run: ' in text
 
 
 def test_an_unknown_section_is_a_usage_error_and_nothing_runs(monkeypatch, tmp_path, capsys):
