@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from rclpy.action import ActionClient
 from ros_utils import spin_until
+from rosgraph_msgs.msg import Clock
 from wirefish_common.qos import latched, reliable
 from wirefish_cpg.gait_library import Gait, GaitLibrary, load_library, save_library
 from wirefish_msgs.action import RetuneGait as RetuneGaitAction
@@ -269,3 +270,42 @@ def test_killing_the_tuner_while_it_writes_leaves_a_readable_library(
         if os.stat(library_path).st_mtime_ns == before:
             assert len(library.gaits) == stored
         stored = len(library.gaits)
+
+
+SIMULATED_S = 1234  # a tick far from the wall clock's seconds
+
+
+def _ticking(probe):
+    """Publish /clock at SIMULATED_S every 10 ms of the probe's spin (as fish_sim does)."""
+    clock = probe.node.create_publisher(Clock, '/clock', 10)
+    tick = Clock()
+    tick.clock.sec = SIMULATED_S
+    probe.node.create_timer(0.01, lambda: clock.publish(tick))
+
+
+def test_on_simulated_time_a_goal_is_stamped_with_the_clocks_tick(tuner, probe, action):
+    _ticking(probe)
+    tuner('-p', 'use_sim_time:=true')
+    run = GoalRun(probe, action, goal(seed=1, max_iterations=1, swarm_size=4,
+                                      use_library=False))
+    assert run.handle.accepted
+    assert run.handle.stamp.sec == SIMULATED_S, run.handle.stamp
+
+
+def test_on_simulated_time_the_tuners_ticks_arrive_on_its_clock_node_not_its_own(tuner, probe):
+    _ticking(probe)
+    tuner('-p', 'use_sim_time:=true')
+    namespace = probe.node.get_namespace()
+
+    def topics(by_node, name: str) -> list[str]:
+        try:
+            return [topic for topic, _types in by_node(name, namespace)]
+        except Exception:  # noqa: B902 (rclpy's NodeNameNonExistentError: not discovered yet)
+            return []
+    subscribed = probe.node.get_subscriber_names_and_types_by_node
+    published = probe.node.get_publisher_names_and_types_by_node
+    assert spin_until(probe.executor, lambda: '/clock' in topics(subscribed, 'tuner_node_clock'),
+                      WAIT_S), topics(subscribed, 'tuner_node_clock')
+    assert spin_until(probe.executor, lambda: any(
+        topic.endswith('target_wave') for topic in topics(published, 'tuner_node')), WAIT_S)
+    assert '/clock' not in topics(subscribed, 'tuner_node')

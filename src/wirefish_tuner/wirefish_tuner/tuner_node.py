@@ -29,6 +29,8 @@ Gait library (``library_path``, ``wirefish_cpg.gait_library``): every successful
 file changes.
 Publishes ``target_wave`` (wirefish_msgs/BodyWaveSpec, reliable, transient local, depth 1):
 the wave the CPG runs, only once a fit was applied.
+On simulated time the node's /clock is taken on ``tuner_node_clock``, a companion node on a
+thread of its own (``wirefish_common.clock_feed``): every tick woke the multi-threaded executor.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallb
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from wirefish_common.clock_feed import ClockFeed
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import LATCHED, latched, reliable
@@ -114,9 +117,13 @@ class TunerNode(Node):
             self, RetuneGaitAction, 'retune_gait', execute_callback=self._execute_goal,
             goal_callback=self._on_goal, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
             callback_group=serving, feedback_pub_qos_profile=FEEDBACK_QOS)
+        # The multi-threaded executor woken by every /clock tick took most of a core.
+        self._clock_feed = ClockFeed.start(self)
 
     def destroy_node(self) -> None:
-        """Destroy the action server, then the node."""
+        """Stop the clock feed, destroy the action server, then the node."""
+        if self._clock_feed is not None:
+            self._clock_feed.close()
         self._action.destroy()
         super().destroy_node()
 
