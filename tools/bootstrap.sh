@@ -178,4 +178,12 @@ if [ "$(cat install/.wirefish-stamp 2>/dev/null)" != "$src_key" ]; then
 else
   log "install/ is up to date"
 fi
+
+# --- bytecode -------------------------------------------------------------------------------
+# Every node is a Python process of its own. Where PYTHONDONTWRITEBYTECODE is set (machines of
+# this kind set it) no process writes its .pyc, so each compiled the workspace's modules again
+# at every start; compiled here, once (compileall skips what is current; a module edited since
+# is compiled in memory as before, until the next setup).
+"$VENV/bin/python" -m compileall -q -j 0 src/*/wirefish_* test/support >/dev/null \
+  || die "compileall failed: a module of src/ or test/support does not compile"
 log "ready: 'source tools/activate.sh' for a shell, or 'tools/wfenv CMD'"
