@@ -2,9 +2,9 @@
 """
 The same scenarios with the ARM build in QEMU behind the rf433 radio model, in gait mode.
 
-One drive of `wirefish up --fish qemu --radio rf433` (60 s by cmd_vel, then a 10 s radio cut
+One drive of `wirefish up --fish qemu --radio rf433` (40 s by cmd_vel, then a 10 s radio cut
 and 8 s after it): the C firmware integrates eq 1, answers GAIT and LINK_CONFIG, coasts and
-rests. QEMU has no physics, so there is no ground-truth speed to compare. What it costs: 78 s
+rests. QEMU has no physics, so there is no ground-truth speed to compare. What it costs: 58 s
 of driving, a start-up, and the emulator (two machine slots).
 """
 

@@ -35,8 +35,10 @@ from wirefish_common.qos import LATCHED, RELIABLE
 from wirefish_msgs.msg import CpgParams
 
 # The commands of every drive: (start s, forward m/s, yaw rate rad/s), held to the next start.
-SCHEDULE = ((0.0, 0.15, 0.0), (15.0, 0.25, 0.0), (30.0, 0.2, 0.2), (45.0, 0.2, 0.0))
-DRIVE_S = 60.0
+# 10 s a command: the surge settles in ~6 s (time constant ~1.5 s), and each speed is judged
+# from 5 s after its command.
+SCHEDULE = ((0.0, 0.15, 0.0), (10.0, 0.25, 0.0), (20.0, 0.2, 0.2), (30.0, 0.2, 0.0))
+DRIVE_S = 40.0
 CMD_RATE_HZ = 10.0
 
 
