@@ -108,7 +108,9 @@ def test_a_cut_asked_for_loses_everything_for_its_length(relay_factory, tmp_path
     control = tmp_path / 'radio-control'
     relay = relay_factory('wired', '--control', str(control))
     control.write_text('cut 0.5\n')
-    time.sleep(0.1)
+    deadline = time.monotonic() + 5.0   # the relay looks at every turn of its loop
+    while control.exists() and time.monotonic() < deadline:
+        time.sleep(0.01)
     assert not control.exists()   # read and removed
     os.write(relay.bridge, b'lost')
     got, _ = _read_for(relay.fish.fileno(), 0.2)

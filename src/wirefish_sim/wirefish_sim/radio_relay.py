@@ -11,12 +11,13 @@ the bytes of each side to the other through the link model, on the wall clock
 late with jitter, or never. A device that goes away (a virtual fish reopening its pty, a
 restarted QEMU) is reopened every ``REOPEN_S`` while the relay runs on.
 
-Cuts: ``--cut AT:FOR`` (s after start, repeatable), or a file written at ``--control`` PATH
-holding ``cut SECONDS`` (the relay reads it, removes it and cuts from now), lose everything on
-the air for that long. Each cut is printed on stderr with its
-monotonic start and end (``radio_relay: cut 1234.500 .. 1244.500``), the clock every process
-of the machine shares. ``--stats PATH`` writes the counters as JSON every ``--stats-every`` s
-and at the stop (``RadioStats``: link use per direction, losses, turn-arounds).
+Cuts: ``--cut AT:FOR`` (s after start, repeatable), or a file written at ``--control``
+PATH holding lines ``cut SECONDS`` (the relay reads it once its last line is complete,
+removes it and cuts from now), lose everything on the air for that long. Each cut is printed
+on stderr with its monotonic start and end (``radio_relay: cut 1234.500 .. 1244.500``), the
+clock every process of the machine shares. ``--stats PATH`` writes the counters as JSON every
+``--stats-every`` s and at the stop (``RadioStats``: link use per direction, losses,
+turn-arounds).
 
 Runs until SIGINT/SIGTERM (exit 0). The loop wakes when a side has bytes or the model has an
 event due, and at least every ``MAX_WAIT_S``.
@@ -83,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help='lose everything on the air from AT s after start for FOR s '
                    '(repeatable)')
     p.add_argument('--control', type=Path, default=None,
-                   help='a file the relay watches: "cut SECONDS" written there starts a cut now')
+                   help='a file the relay watches: a line "cut SECONDS" written there '
+                        'starts a cut now')
     p.add_argument('--stats', type=Path, default=None,
                    help='write the link counters here as JSON (every --stats-every s)')
     p.add_argument('--stats-every', type=float, default=1.0, help='(s)')
@@ -221,7 +223,7 @@ def run(args: argparse.Namespace) -> int:
         while not signals.requested:
             now = time.monotonic()
             if args.control is not None:
-                for length in _control_cuts(args.control):
+                for length in read_control_cuts(args.control):
                     add_cut(now, length)
             device.ensure_open(now)
             from_host = host.read()
@@ -274,11 +276,19 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _control_cuts(path: Path) -> list[float]:
-    """Return the cut lengths written at ``path`` and remove it ([] when there is none)."""
+def read_control_cuts(path: Path) -> list[float]:
+    """
+    Return the cut lengths written at ``path`` and remove it ([] when there is none).
+
+    A file whose last line is not complete is left for the next look: a writer creates the
+    file before it writes (``echo cut 10 > PATH``, Python's ``write_text``), and a file read
+    and removed in between took the cut with it (seen: a drive's cut never made).
+    """
     try:
         text = path.read_text()
     except (FileNotFoundError, IsADirectoryError):
+        return []
+    if not text.endswith('\n'):
         return []
     path.unlink(missing_ok=True)
     lengths = []
