@@ -281,11 +281,16 @@ def _ticking(probe):
     tick = Clock()
     tick.clock.sec = SIMULATED_S
     probe.node.create_timer(0.01, lambda: clock.publish(tick))
+    return clock
 
 
 def test_on_simulated_time_a_goal_is_stamped_with_the_clocks_tick(tuner, probe, action):
-    _ticking(probe)
+    clock = _ticking(probe)
     tuner('-p', 'use_sim_time:=true')
+    # A goal that arrives before the tuner heard a tick is stamped 0 (no simulated time yet):
+    # the tuner's reader matched, then a second of ticks (100) before the goal.
+    assert spin_until(probe.executor, lambda: clock.get_subscription_count() > 0, WAIT_S)
+    spin_until(probe.executor, lambda: False, 1.0)
     run = GoalRun(probe, action, goal(seed=1, max_iterations=1, swarm_size=4,
                                       use_library=False))
     assert run.handle.accepted
