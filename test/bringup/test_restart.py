@@ -443,35 +443,60 @@ def test_the_bag_of_the_whole_run_is_readable_and_lost_nothing_while_the_recorde
         assert any(g.first_missing_s >= down_from and g.before_s <= back_by for g in gaps)
     # No stream a victim does not feed paused longer than MAX_PAUSE_S of simulated time while it
     # was away, by the stamps the bag holds (not while the recorder itself was away).
+    # A stretch before the recorder heard a restarted publisher (an earlier victim's: its first
+    # messages go out before the two have matched) is not in the bag at all, so the bag says
+    # nothing of it: such a gap, which ends at that publisher's first recorded message, is not
+    # judged here (the probe's own pauses in the kill test cover it).
     stamped = bag_stamps(watched.bag)
-    paused = {}
+    paused, unheard = {}, {}
     for victim, kill in watched.kills.items():
         if victim == RECORDER:
             continue
         since, until = kill.simulated_span
         for topic in kill.untouched:
             if topic in stamped:
-                pause = longest_gap(stamped[topic], since, until)
+                pause, before_match = longest_gap(stamped[topic], since, until)
                 paused[(victim, topic)] = pause
+                if before_match > 0.0:
+                    unheard[(victim, topic)] = before_match
     print('fish_sim on its hosts: ' + ' | '.join(_engagement_lines(watched.graph.out_dir)))
+    print('not yet heard by the recorder (a restarted publisher, simulated s): ' + (', '.join(
+        f'{victim} {topic.rsplit("/", 1)[-1]} {span:.2f}'
+        for (victim, topic), span in unheard.items()) or 'none'))
     print('longest pauses in the bag (simulated s): ' + ', '.join(
         f'{victim} {topic.rsplit("/", 1)[-1]} {pause:.2f}'
         for (victim, topic), pause in paused.items()))
     assert {key: pause for key, pause in paused.items() if pause >= MAX_PAUSE_S} == {}
 
 
-def bag_stamps(bag: Path) -> dict[str, list[float]]:
-    """Return the header stamps (s) of every message of the bag whose first field is a Header."""
+@dataclass(frozen=True)
+class BagStamps:
+    """A topic's header stamps in a bag (s, sorted), and those that opened a writer's run."""
+
+    stamps: list[float]
+    run_starts: frozenset[float]
+
+
+def bag_stamps(bag: Path) -> dict[str, BagStamps]:
+    """Return the header stamps of every topic of the bag whose first field is a Header."""
     stamped_types = {name for name, type_name in _bag_types(bag).items()
                      if hasattr(message_class(type_name)(), 'header')}
     stamps: dict[str, list[float]] = {}
+    starts: dict[str, set[float]] = {}
+    last_sequence: dict[str, int] = {}
     from wirefish_bag.bag_storage import storage_files
 
     for path in storage_files(Path(bag)):
         for topic, message in bag_messages(path):
             if topic in stamped_types:
-                stamps.setdefault(topic, []).append(header_stamp(message.data))
-    return {topic: sorted(values) for topic, values in stamps.items()}
+                stamp = header_stamp(message.data)
+                stamps.setdefault(topic, []).append(stamp)
+                # A sequence number at or below the last one: a new writer (sequence_gaps).
+                if message.sequence <= last_sequence.get(topic, -1):
+                    starts.setdefault(topic, set()).add(stamp)
+                last_sequence[topic] = message.sequence
+    return {topic: BagStamps(sorted(values), frozenset(starts.get(topic, ())))
+            for topic, values in stamps.items()}
 
 
 def _bag_types(bag: Path) -> dict[str, str]:
@@ -490,12 +515,22 @@ def _engagement_lines(out_dir: Path) -> list[str]:
             if 'simulated time waits' in line or 'simulated time follows' in line]
 
 
-def longest_gap(stamps: list[float], since: float, until: float) -> float:
-    """Return the longest span in [since, until] without a stamp of ``stamps`` (sorted)."""
+def longest_gap(bagged: BagStamps, since: float, until: float) -> tuple[float, float]:
+    """
+    Return the longest span in [since, until] without a stamp, and the span left unjudged.
+
+    A span that ends at a restarted writer's first recorded stamp is the recorder not yet
+    hearing that writer: it is left out of the first figure and is the second one's (the
+    longest such).
+    """
+    stamps = bagged.stamps
     first = bisect.bisect_left(stamps, since)
     last = bisect.bisect_right(stamps, until)
     edges = [since, *stamps[first:last], until]
-    return max(b - a for a, b in zip(edges, edges[1:]))
+    judged, unheard = [0.0], [0.0]
+    for a, b in zip(edges, edges[1:]):
+        (unheard if b in bagged.run_starts else judged).append(b - a)
+    return max(judged), max(unheard)
 
 
 # --- crash loops ----------------------------------------------------------------------------
