@@ -25,8 +25,9 @@ WORKSPACE = Path(__file__).resolve().parents[1]
 # Fast DDS maps a domain to UDP ports; 0..101 is the portable range. A test run owns the window
 # [base, base + 20): each test takes the next of the first 19 ids (so a test never shares a
 # domain with the one before it); base + 19 is kept for module-scoped graphs (test/bringup).
-# Under pytest-xdist (`make test` runs test/ on two workers) worker k owns the next window,
-# [base + 20 k, base + 20 k + 20): set here, before any conftest or test module reads it.
+# Under pytest-xdist (`make test` runs test/ on a worker more than the cores, at most four)
+# worker k owns the next window, [base + 20 k, base + 20 k + 20): set here, before any conftest
+# or test module reads it.
 _WORKER = os.environ.get('PYTEST_XDIST_WORKER', '')
 if _WORKER.startswith('gw'):
     os.environ['WIREFISH_TEST_DOMAIN_BASE'] = str(
