@@ -16,6 +16,7 @@ from pathlib import Path
 import subprocess
 
 from bag_utils import assert_bag_readable, publish_lags, sequence_gaps
+from e2e_utils import OWN_NAMESPACE
 import pytest
 
 pytestmark = [pytest.mark.ros, pytest.mark.loads_machine]
@@ -30,7 +31,7 @@ HOG = 'import os\nos.nice(19)\nwhile True:\n    pass\n'
 
 def _graph(spawn, python, namespace: str, out: Path):
     return spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
-                  '--namespace', namespace, '--out', str(out)])
+                  *OWN_NAMESPACE, '--namespace', namespace, '--out', str(out)])
 
 
 def _assert_started(proc, namespace: str) -> None:

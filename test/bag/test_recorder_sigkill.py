@@ -16,7 +16,7 @@ import sys
 import time
 
 from bag_utils import assert_bag_readable, counters, flushed_topics, reindex_bag
-from e2e_utils import descendants, lines_until_running
+from e2e_utils import descendants, lines_until_running, OWN_NAMESPACE
 import numpy as np
 import psutil
 import pytest
@@ -152,7 +152,8 @@ def _up_recording(spawn, python, namespace: str, out: Path, duration_s: int
                   ) -> tuple[subprocess.Popen, Path, psutil.Process]:
     """Start `wirefish up --duration`; return it, its bag and its recorder, once it flushed."""
     launcher = spawn([python, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
-                      '--namespace', namespace, '--out', str(out), '--duration', str(duration_s)])
+                      *OWN_NAMESPACE, '--namespace', namespace, '--out', str(out),
+                      '--duration', str(duration_s)])
     lines = lines_until_running(launcher, 120.0, ('recording to',))
     assert lines and lines[-1].startswith('recording to'), ''.join(lines)
     bag = Path(lines[-1].split()[2].rstrip(';'))

@@ -35,7 +35,10 @@ from wirefish_bridge.protocol import (Health, HealthFlags, Heartbeat, PROTOCOL_V
                                       ResetCause, Role, ServoCommand, Telemetry)
 from wirefish_launcher.qemu_board import QemuBoard
 
-pytestmark = [pytest.mark.loads_machine]
+# Not a module that loads the machine (machine_share.py): QEMU takes ~20 % of a core, and the
+# watchdog's stand-in counts SysTick interrupts, which a descheduled QEMU drops with the main
+# loop's polls (failsafe.c), so a busy host fires no fault. It passed twice sharing one core
+# with a busy loop (`taskset -c 1` both).
 
 NEUTRAL_TICKS = 1500
 COMMANDED = (0.5, -0.5)

@@ -49,7 +49,9 @@ from wirefish_cpg.oscillator import CpgIntegrator, CpgParameters
 from wirefish_cpg.servo_limit import clamp_to_limit
 from wirefish_launcher.qemu_board import QemuBoard
 
-pytestmark = [pytest.mark.loads_machine]
+# Not a module that loads the machine (machine_share.py): QEMU takes ~20 % of a core, and the
+# claims hold on a board the host deschedules (the backlog rule above, a link timeout of 10 s).
+# It passed twice sharing one core with a busy loop (`taskset -c 1` both).
 
 LIMIT = float(np.float32(1.57079625))   # the board's servo limit (binary32 below pi/2)
 CPG_MAX_LAG_MS = 5                      # WF_CPG_MAX_LAG_MS: a poll's steps at most

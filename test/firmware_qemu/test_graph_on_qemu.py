@@ -16,7 +16,7 @@ import subprocess
 import sys
 import time
 
-from e2e_utils import descendants, lines_until_running
+from e2e_utils import descendants, lines_until_running, OWN_NAMESPACE
 import psutil
 import pytest
 from rclpy.qos import qos_profile_sensor_data
@@ -72,7 +72,8 @@ def qemu_graph(tmp_path_factory) -> Iterator[QemuGraph]:
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
         [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fish', 'qemu', '--no-status',
-         '--namespace', NAMESPACE, '--out', str(tmp_path_factory.mktemp('qemu_run'))],
+         *OWN_NAMESPACE, '--namespace', NAMESPACE,
+         '--out', str(tmp_path_factory.mktemp('qemu_run'))],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     graph = QemuGraph(launcher, domain_id, set(), env)

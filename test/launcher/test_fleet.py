@@ -16,6 +16,7 @@ import sys
 import time
 
 from bag_utils import assert_bag_readable
+from e2e_utils import OWN_NAMESPACE
 import pytest
 from wirefish_bag.bagfile import read_bag
 
@@ -61,7 +62,7 @@ def _wait_for_action_server(context, name: str, timeout_s: float) -> None:
 
 def test_a_fleet_of_three_streams_apart_and_one_bag_holds_them_all(spawn, ros_env, ros_context,
                                                                    tmp_path):
-    up = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fleet', '3',
+    up = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'up', '--fleet', '3', *OWN_NAMESPACE,
                 '--start-swimming', '--namespace', BASE, '--duration', str(DURATION_S),
                 '--no-status', '--out', str(tmp_path)])
     deadline = time.monotonic() + UP_TIMEOUT_S

@@ -16,6 +16,11 @@ import psutil
 from ros_utils import stop_process
 
 NAMESPACE = '/e2e'
+# `wirefish up` first listens DUPLICATE_CHECK_S (4 s) for the registry's nodes already running
+# in its namespace. A test's graph runs on a ROS domain and in a namespace of its own
+# (conftest.py), where no other graph can be found: its start skips the listen. The refusal is
+# test/bringup/test_duplicate_namespace.py's.
+OWN_NAMESPACE = ('--allow-duplicate',)
 
 
 @dataclass
@@ -45,7 +50,7 @@ def start_graph(domain_id: int, out_dir: Path, *options: str,
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
         [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
-         '--namespace', namespace, '--out', str(out_dir), *options],
+         *OWN_NAMESPACE, '--namespace', namespace, '--out', str(out_dir), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     try:

@@ -21,7 +21,7 @@ import sys
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from e2e_utils import descendants, RunningGraph
+from e2e_utils import descendants, OWN_NAMESPACE, RunningGraph
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -139,7 +139,7 @@ def start_up(domain: int, out: Path, target: list[str], *options: str,
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
         [sys.executable, '-m', 'wirefish_cli.cli', 'up', *target, '--no-status',
-         '--namespace', namespace, '--out', str(out), *options],
+         *OWN_NAMESPACE, '--namespace', namespace, '--out', str(out), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     assert launcher.stdout is not None
