@@ -327,7 +327,10 @@ class CutFigures:
     start: float
     end: float
     coasting_after_s: float      # from the cut's start to the first COASTING frame
-    coast_s: float               # from the first COASTING to the first RESTING frame
+    # From the first COASTING to the first RESTING frame on the board's own clock (board_ms): the
+    # coast is the board's timer; the relay's read times add how late the host read each frame
+    # (by them, a run pinned to one core measured a 3 s coast as 3.37 s).
+    coast_s: float
     rest_amplitude: float        # largest |servo| of the last RESTING frames before the end
     link_back_s: float           # from the cut's end to the first servo_state at the bridge
     gait_back_s: float           # from the cut's end to the board running the current gait
@@ -347,7 +350,7 @@ def cut_figures(record: Drive, board: list[BoardFrame]) -> CutFigures:
 
     assert len(record.cuts) == 1, record.cuts
     start, end = record.cuts[0]
-    coasting = [f.t for f in board if f.t >= start and f.status & Status.COASTING]
+    coasting = [f for f in board if f.t >= start and f.status & Status.COASTING]
     resting = [f for f in board if f.t >= start and f.status & Status.RESTING]
     assert coasting and resting, 'the board never coasted or rested during the cut'
     rested = [f for f in resting if f.t <= end]
@@ -358,6 +361,7 @@ def cut_figures(record: Drive, board: list[BoardFrame]) -> CutFigures:
     current = max(int(v) for t, v in record.bridge_values('gait_id') if t <= end)
     again = [f.t for f in board if f.t > end and f.gait_id >= current
              and not f.status & (Status.COASTING | Status.RESTING)]
-    return CutFigures(start, end, coasting[0] - start, resting[0].t - coasting[0], amplitude,
+    coast_s = (resting[0].board_ms - coasting[0].board_ms) * 1e-3
+    return CutFigures(start, end, coasting[0].t - start, coast_s, amplitude,
                       after[0] - end if after else math.inf,
                       again[0] - end if again else math.inf)
