@@ -154,17 +154,19 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     A message with a header (or a sequence of them first: /tf, a MarkerArray) counts by its
     (first item's) stamp, the graph's simulated time when it was published, so a probe that
     falls behind on a loaded machine still counts every message of the window: it listens
-    until /clock is ``LATE_S`` past the window's end, and each subscription keeps 1,000
-    messages (10 s of the fastest stream: a queue of 100 overflowed beside two CPU hogs). A
-    message without one counts at the simulated time current when the probe took it. Raises
-    AssertionError naming what it waited for if /clock does not cover the window within
-    ``wall_timeout_s`` of wall time.
+    until /clock is ``LATE_S`` past the window's end and every stamped stream it heard has
+    brought a stamp past the end (its queue drained up to there; within ``wall_timeout_s``),
+    and each subscription keeps 1,000 messages (10 s of the fastest stream: a queue of 100
+    overflowed beside two CPU hogs). A message without one counts at the simulated time current
+    when the probe took it. Raises AssertionError naming what it waited for if /clock does not
+    cover the window within ``wall_timeout_s`` of wall time.
     """
     from wirefish_common.cdr_views import CdrError, CdrReader
     from wirefish_common.topics import graph_topics, matching_qos, message_class
 
     topics = graph_topics(node, namespace)
     counts = dict.fromkeys(topics, 0)
+    newest: dict[str, float] = {}  # the newest stamp heard of each stamped stream
     window: list[float] = []
     subscriptions = []
 
@@ -180,6 +182,7 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
             except CdrError:
                 return
             at: float | None = sec + 1e-9 * nanosec
+            newest[topic] = max(newest.get(topic, -math.inf), at)
         else:
             at = clock.now()
         if at is not None and window[0] <= at < window[1]:
@@ -206,6 +209,14 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
         assert time.monotonic() < deadline, (
             f'/clock covered {max(0.0, clock.now() - start):.2f} of {window_s + LATE_S} s of '
             f'simulated time in {wall_timeout_s} s of wall time')
+        executor.spin_once(timeout_sec=0.05)
+    # The probe takes a message of each ready stream per turn, and /clock's newest: pinned to
+    # one core beside a busy loop and a graph it had counted 417 of attitude's 500 messages of
+    # the window when /clock passed its end, and 500 once drained. So it also drains each
+    # stream heard in the window up to the window's end (a latched one, stamped before, is not
+    # waited for; one that stops is waited for up to the deadline: its rate says so).
+    while (any(window[0] <= at < window[1] for at in newest.values())
+           and time.monotonic() < deadline):
         executor.spin_once(timeout_sec=0.05)
     for subscription in subscriptions:
         node.destroy_subscription(subscription)
