@@ -13,6 +13,7 @@ prints the rate every second, as ``ros2 topic hz`` does. A relative name is take
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 import difflib
 import enum
 import math
@@ -128,14 +129,36 @@ class _Probe:
         while time.monotonic() < end:
             self.executor.spin_once(timeout_sec=min(0.1, max(0.0, end - time.monotonic())))
 
-    def type_of(self, topic: str, wait_s: float) -> str | None:
-        end = time.monotonic() + wait_s
+    def find(self, topic: str, waiting: Callable[[], None]) -> tuple[str | None, str | None]:
+        """
+        Listen for ``topic`` up to WAIT_S; return (its type, None) once it has a publisher.
+
+        Return (None, why) once the graph around it has been known for DISCOVERY_S without it
+        (``missing_topic_text``: a typo, or a node that is not running), and (None, None) at
+        WAIT_S. A graph discovered late (a loaded machine, a graph still starting) is judged
+        DISCOVERY_S after it appeared, not when the first DISCOVERY_S ended. ``waiting`` is
+        called once, after DISCOVERY_S, if no graph was heard by then.
+        """
+        start = time.monotonic()
+        known_since: float | None = None
+        said_waiting = False
         while True:
             types = dict(self.node.get_topic_names_and_types())
             if topic in types and self.node.count_publishers(topic):
-                return types[topic][0]
-            if time.monotonic() >= end:
-                return None
+                return types[topic][0], None
+            now = time.monotonic()
+            missing = missing_topic_text(topic, list(types))
+            if missing is None:
+                known_since = None
+            elif known_since is None:
+                known_since = now
+            if known_since is not None and now >= max(start, known_since) + DISCOVERY_S:
+                return None, missing
+            if now >= start + WAIT_S:
+                return None, None
+            if known_since is None and not said_waiting and now >= start + DISCOVERY_S:
+                waiting()
+                said_waiting = True
             self.spin_for(0.1)
 
 
@@ -149,16 +172,15 @@ def _run(probe: _Probe, args: argparse.Namespace) -> int:
     if args.verb == TopicVerb.LIST:
         return _list(probe, args)
     topic = full_name(args.topic, args.namespace)
-    type_name = probe.type_of(topic, DISCOVERY_S)
-    if type_name is None:
-        names = [name for name, _ in probe.node.get_topic_names_and_types()]
-        missing = missing_topic_text(topic, names)
-        if missing is not None:  # the graph is there, the topic is not: say it at once
-            print(f'wirefish topic {args.verb}: {missing}', file=sys.stderr)
-            return 1
+
+    def waiting() -> None:
         print(f'wirefish topic {args.verb}: waiting up to {WAIT_S:g} s for a publisher of '
               f'{topic} (Ctrl-C stops)', file=sys.stderr, flush=True)
-        type_name = probe.type_of(topic, WAIT_S - DISCOVERY_S)
+
+    type_name, missing = probe.find(topic, waiting)
+    if missing is not None:  # the graph is there, the topic is not: say so
+        print(f'wirefish topic {args.verb}: {missing}', file=sys.stderr)
+        return 1
     if type_name is None:
         print(f'wirefish topic {args.verb}: no publisher of {topic} within {WAIT_S:g} s '
               '(wirefish topic list shows what there is)', file=sys.stderr)
