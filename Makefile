@@ -38,10 +38,13 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # QEMU, the dashboard) would starve the real-time streams of the modules beside it, so it holds
 # all the machine's slots but one and such modules run one at a time
 # (test/support/machine_share.py).
+# A crashed worker (a test hung in C code is ended so: pytest.ini) ends the run of test/: under
+# --dist loadfile xdist 3.8 gives a replacement worker the crashed test again, and a run once
+# waited on that for good (test/test_hung_test_ends_the_run.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
-	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder test \
-		$(PYTEST_ARGS)
+	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder \
+		--max-worker-restart 0 test $(PYTEST_ARGS)
 
 # The quick loop: every package's pure tests and every linter (flake8, pep257, mypy, the
 # package.xml check); no ROS process is started and the paper's experiments (wirefish_analysis:
