@@ -4,7 +4,8 @@
 
 One graph for the module. The claims: every topic of the registry is a channel with its type as
 schema; servo_cmd and imu/data arrive through the view at 95 % of what the graph publishes and
-decode (rosbags) to the same values; a client's cmd_vel drives the planner; a client message on
+decode (rosbags) to the same values; a latched topic whose publisher comes after the client
+subscribed still delivers its message; a client's cmd_vel drives the planner; a client message on
 any other topic is refused; a malformed frame leaves the server serving.
 """
 
@@ -14,10 +15,12 @@ import time
 
 from foxglove_client import FoxgloveClient
 import pytest
-from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_utils import probe_node, spin_until
+import rclpy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ros_utils import domain_context, probe_node, spin_until
 from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import String
 from wirefish_common.qos import RELIABLE
 from wirefish_msgs.msg import PlannerState
 
@@ -121,6 +124,35 @@ def test_a_fast_stream_arrives_whole_and_decodes_to_what_was_published(
     assert len(judged) >= 0.9 * len(common) > 0
     for stamp in judged:
         assert {values(m) for m in viewed[stamp]} <= {values(m) for m in published[stamp]}
+
+
+def test_a_latched_message_published_before_the_view_found_its_publisher_reaches_the_client(
+        view_graph, client, probe):
+    # The topic is known before its publisher (a subscriber of the probe's), so the view
+    # subscribes, for the client, before any publisher is found. The publisher then comes in a
+    # participant of its own and publishes at once, as cpg_node does when a graph starts: the
+    # view has not discovered that participant yet, so only a subscription made again with the
+    # publisher's latched QoS receives the message.
+    node, executor = probe
+    topic = f'{view_graph.graph.namespace}/late_latched'
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    node.create_subscription(String, topic, lambda _: None, latched)
+    assert client.wait(lambda: client.channel_of(topic) is not None, timeout_s=30.0)
+    subscription = client.subscribe(client.channel_of(topic)['id'])
+    assert spin_until(executor, lambda: any(
+        info.node_name == 'view_node' for info in node.get_subscriptions_info_by_topic(topic)),
+        timeout_s=30.0), 'the view never subscribed'
+    with domain_context(view_graph.graph.domain_id) as context:
+        publisher = rclpy.create_node('late_latched_publisher', context=context)
+        try:
+            publisher.create_publisher(String, topic, latched).publish(
+                String(data='published before'))
+            assert client.wait(lambda: client.messages.get(subscription), timeout_s=30.0)
+        finally:
+            publisher.destroy_node()
+    payload = client.messages[subscription][0][1]
+    assert TYPESTORE.deserialize_cdr(payload, 'std_msgs/msg/String').data == 'published before'
 
 
 def test_a_client_cmd_vel_moves_the_planners_target_speed(view_graph, client, probe):

@@ -7,10 +7,11 @@ Channels (protocol ``foxglove.sdk.v1``, also offered as ``foxglove.websocket.v1`
     ``/diagnostics``: one CDR channel each with its ``ros2msg`` schema, found by a discovery
     tick (``discovery_period_s``). A topic is subscribed (raw bytes: nothing is decoded) only
     while a client subscribes to its channel; its QoS follows its publishers' (best effort,
-    transient local). ``view/scene`` (foxglove.SceneUpdate): the fish (``scene``), at
-    ``scene_rate_hz`` while a client watches it (body_wave and /tf decoded only then; the
-    trail is this fish's odom -> base_link from then on). ``view/retune`` (JSON): the retune
-    goal's progress and result.
+    transient local), found again each discovery tick (a latched topic whose publisher is
+    found after the client subscribed still delivers its message). ``view/scene``
+    (foxglove.SceneUpdate): the fish (``scene``), at ``scene_rate_hz`` while a client watches
+    it (body_wave and /tf decoded only then; the trail is this fish's odom -> base_link from
+    then on). ``view/retune`` (JSON): the retune goal's progress and result.
 Client publish
     Accepted on ``cmd_vel`` (geometry_msgs/msg/Twist, CDR or JSON) within ``max_speed`` and
     ``max_turn`` (`wirefish drive`'s limits); any other channel, or a message outside the
@@ -114,6 +115,24 @@ def _qos_of(publishers: list) -> QoSProfile:
                                   else DurabilityPolicy.VOLATILE))
 
 
+def resubscribe_qos(held: QoSProfile, publishers: list) -> QoSProfile | None:
+    """
+    Return the QoS a topic's subscription should be made again with, or None to keep ``held``.
+
+    A subscription made before its topic's publishers were discovered is best effort and
+    volatile (``_qos_of``): it matches any publisher, but a latched one's message, published
+    before the match, never reaches it. Once publishers are known and want another QoS, the
+    subscription is made again with theirs (a latched topic then delivers its message). With no
+    publisher known (one restarting) the held QoS stays.
+    """
+    if not publishers:
+        return None
+    wanted = _qos_of(publishers)
+    if (wanted.reliability, wanted.durability) == (held.reliability, held.durability):
+        return None
+    return wanted
+
+
 class ViewNode(Node):
     """The graph as Foxglove channels; cmd_vel, start/stop and retune from the clients."""
 
@@ -131,7 +150,7 @@ class ViewNode(Node):
         self._cmd_vel_topic = f'{namespace}/cmd_vel'
         self._channels: dict[str, foxglove.Channel] = {}
         self._subscribers: dict[str, int] = {}  # topic -> clients subscribed
-        self._raw_subscriptions: dict[str, Any] = {}
+        self._raw_subscriptions: dict[str, tuple[Any, QoSProfile]] = {}  # with its QoS
         self._requests: queue.Queue[tuple[str, str]] = queue.Queue()
         self._trail: list[tuple[float, float]] = []
         self._segments: list[tuple[list[float], list[float]]] = []
@@ -220,6 +239,14 @@ class ViewNode(Node):
             f'{self._namespace}/view/')
 
     def _discover(self) -> None:
+        for topic, (_, held) in list(self._raw_subscriptions.items()):
+            qos = resubscribe_qos(held, self.get_publishers_info_by_topic(topic))
+            if qos is not None:
+                self.destroy_subscription(self._raw_subscriptions.pop(topic)[0])
+                self._subscribe_raw(topic, qos)
+                self.get_logger().info(
+                    f'{topic}: subscribed again as its publishers offer '
+                    f'({qos.reliability.name.lower()}, {qos.durability.name.lower()})')
         for topic, types in self.get_topic_names_and_types():
             if topic in self._channels or not self._wanted(topic) or len(types) != 1:
                 continue
@@ -244,13 +271,14 @@ class ViewNode(Node):
             if topic == self._scene.topic():
                 self._watch_scene(count > 0)
             elif count > 0 and topic not in self._raw_subscriptions and topic in self._channels:
-                publishers = self.get_publishers_info_by_topic(topic)
-                self._raw_subscriptions[topic] = self.create_subscription(
-                    _type_of(self._channels[topic]), topic,
-                    partial(self._forward, self._channels[topic]), _qos_of(publishers),
-                    raw=True)
+                self._subscribe_raw(topic, _qos_of(self.get_publishers_info_by_topic(topic)))
             elif count <= 0 and topic in self._raw_subscriptions:
-                self.destroy_subscription(self._raw_subscriptions.pop(topic))
+                self.destroy_subscription(self._raw_subscriptions.pop(topic)[0])
+
+    def _subscribe_raw(self, topic: str, qos: QoSProfile) -> None:
+        channel = self._channels[topic]
+        self._raw_subscriptions[topic] = (self.create_subscription(
+            _type_of(channel), topic, partial(self._forward, channel), qos, raw=True), qos)
 
     def _forward(self, channel: foxglove.Channel, data: bytes) -> None:
         channel.log(data, log_time=time.time_ns())
