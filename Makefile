@@ -40,7 +40,7 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # (test/support/machine_share.py).
 # A crashed worker (a test hung in C code is ended so: pytest.ini) ends the run of test/: under
 # --dist loadfile xdist 3.8 gives a replacement worker the crashed test again, and a run once
-# waited on that for good (test/test_hung_test_ends_the_run.py).
+# waited on that for good (test/test_scheduling.py).
 test: setup  ## the whole suite, lint included
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
 	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder \

@@ -1,9 +1,22 @@
 # SPDX-License-Identifier: Apache-2.0
-"""`make test` deals the longest modules first and shares the machine by slots."""
+"""
+`make test` deals the longest modules first, shares the machine by slots, ends a hung run.
 
+A test that hangs where no signal reaches it: pytest-timeout (``timeout`` in pytest.ini)
+interrupts a test by SIGALRM, whose handler is Python code, and a thread waiting in C code for
+good (seen once: a probe's DDS participant destroyed while a peer was being discovered, Fast
+DDS's teardown waiting on its own listener) never runs it. pytest's own faulthandler timeout,
+later, dumps every thread's stack and ends that worker from C; xdist then reports the test as
+crashed, and with ``--max-worker-restart 0`` ends the run (xdist 3.8's loadfile scheduling gives
+a replacement worker the crashed test again, and a run once waited on that for good).
+"""
+
+import configparser
 import fcntl
+import os
 from pathlib import Path
 import subprocess
+import sys
 import threading
 import time
 
@@ -26,14 +39,25 @@ def test_the_longest_modules_rank_first_in_their_order():
     assert ordered == [WORKSPACE / name for name in LONGEST_MODULES] + others
 
 
+def _graph_run_words() -> list[str]:
+    """
+    Return the command line `make test` runs test/ with, as words.
+
+    `make -n` prints the commands without running them; a `make test` around this one (the
+    suite's own run) passes its command-line variables down in MAKEFLAGS: left out here.
+    """
+    env = {k: v for k, v in os.environ.items() if k not in ('MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
+    commands = subprocess.run(['make', '-n', 'test', 'PYTEST_ARGS='], cwd=WORKSPACE, env=env,
+                              capture_output=True, text=True, check=True).stdout
+    return next(line for line in commands.replace('\\\n', ' ').splitlines()
+                if '--dist loadfile' in line).split()
+
+
 def test_make_test_deals_files_in_collection_order():
     # Without --no-loadscope-reorder xdist deals the files with most tests first, and the
-    # one-test long modules come last whatever the collection order. `make -n` prints the
-    # commands `make test` runs, without running them.
-    commands = subprocess.run(['make', '-n', 'test'], cwd=WORKSPACE, capture_output=True,
-                              text=True, check=True).stdout.replace('\\\n', ' ')
-    run = next(line for line in commands.splitlines() if '--dist loadfile' in line)
-    assert '--no-loadscope-reorder' in run.split() and 'test' in run.split()
+    # one-test long modules come last whatever the collection order.
+    run = _graph_run_words()
+    assert '--no-loadscope-reorder' in run and 'test' in run
 
 
 def _hold(directory: Path, slots: int, weight: int, events: list, name: str,
@@ -116,3 +140,46 @@ def test_a_weight_outside_one_to_the_slots_is_refused(tmp_path, weight):
 @pytest.mark.parametrize('slots', [2, 3, 4])
 def test_a_module_that_loads_the_machine_leaves_one_slot_to_the_rest(slots):
     assert heavy_weight(slots) == slots - 1
+
+
+HANG = """
+import ctypes
+
+
+def test_hangs_in_c_code():
+    # A default mutex locked twice by its owner: the thread waits in the kernel for good.
+    libc = ctypes.CDLL(None)
+    mutex = ctypes.create_string_buffer(64)  # more than a pthread_mutex_t
+    libc.pthread_mutex_init(mutex, None)
+    libc.pthread_mutex_lock(mutex)
+    libc.pthread_mutex_lock(mutex)
+"""
+TIMEOUT_S, FAULTHANDLER_S = 1, 4  # the suite's two timeouts, shortened
+
+
+def _suite_ini() -> configparser.SectionProxy:
+    ini = configparser.ConfigParser()
+    ini.read(WORKSPACE / 'pytest.ini')
+    return ini['pytest']
+
+
+def test_the_faulthandler_timeout_comes_after_pytest_timeouts_and_ends_the_worker():
+    ini = _suite_ini()
+    assert float(ini['faulthandler_timeout']) > float(ini['timeout'])
+    assert ini.getboolean('faulthandler_exit_on_timeout')
+
+
+def test_a_test_hung_in_c_code_fails_and_the_run_ends(tmp_path):
+    (tmp_path / 'test_hang.py').write_text(HANG)
+    (tmp_path / 'pytest.ini').write_text(
+        f'[pytest]\ntimeout = {TIMEOUT_S}\nfaulthandler_timeout = {FAULTHANDLER_S}\n'
+        f"faulthandler_exit_on_timeout = {_suite_ini()['faulthandler_exit_on_timeout']}\n")
+    words = _graph_run_words()
+    options = [w for w in words[words.index('pytest') + 1:] if w != 'test']
+    run = subprocess.run([sys.executable, '-m', 'pytest', '-p', 'no:cacheprovider', *options,
+                          str(tmp_path)], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=120)
+    print(run.stdout[-3000:])
+    assert run.returncode == 1
+    assert "crashed while running 'test_hang.py::test_hangs_in_c_code'" in run.stdout
+    assert f'Timeout (0:00:0{FAULTHANDLER_S})!' in run.stdout + run.stderr  # the stacks
