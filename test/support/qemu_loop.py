@@ -158,7 +158,8 @@ class Tap:
         self._board = _open_raw(board_pty)
         self.record = TapRecord()
         self.host_decoder = StreamDecoder()    # every byte the bridge wrote, as written
-        self.board_decoder = StreamDecoder()   # every byte the board wrote
+        self.board_decoder = StreamDecoder()   # every byte the board wrote, from a frame start
+        self._board_joined = False
         self.zeros_forwarded = 0   # 0x00 bytes forwarded that end a frame (follow a non-zero)
         self._last_forwarded = 0
         self.drop_servo_cmd = False
@@ -226,7 +227,13 @@ class Tap:
         except OSError:
             return
         now = time.monotonic()
-        for frame in self.board_decoder.feed(chunk):
+        decoded = chunk
+        if not self._board_joined:
+            # The board may be mid-frame when the tap opens its pty (QEMU boots on its own
+            # time): decode from the first 0x00, which every frame has before and after it.
+            start = chunk.find(b'\x00')
+            decoded, self._board_joined = (chunk[start:], True) if start >= 0 else (b'', False)
+        for frame in self.board_decoder.feed(decoded):
             self.record.to_host.append(Crossing(now, frame))
         try:
             os.write(self.master, chunk)
