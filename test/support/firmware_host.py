@@ -22,6 +22,7 @@ import numpy as np
 from wirefish_bridge.protocol import (Ack, ErrorReport, Gait, Health, Heartbeat, LinkConfig,
                                       MsgType, ProtocolMessage, Role, ServoCommand, ServoTrim,
                                       ServoTrimReport, Telemetry, TelemetryCompact)
+from wirefish_launcher.qemu_board import BUILD_LOCK
 
 WORKSPACE = Path(__file__).resolve().parents[2]
 FIRMWARE = WORKSPACE / 'firmware'
@@ -172,7 +173,7 @@ def _flat(values: tuple) -> list:
 def build_firmware(*targets: str) -> None:
     """Run ``make -C firmware`` for ``targets``; raise with make's output when it fails."""
     BUILD.mkdir(parents=True, exist_ok=True)
-    with open(BUILD / '.make.lock', 'w') as lock:
+    with open(BUILD / BUILD_LOCK, 'w') as lock:  # qemu_board.build_image's turns too
         fcntl.flock(lock, fcntl.LOCK_EX)
         result = subprocess.run(['make', '-s', '-C', str(FIRMWARE), *targets],
                                 capture_output=True, text=True, timeout=300)

@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections import deque
 import ctypes
 from dataclasses import dataclass
+import fcntl
 import os
 from pathlib import Path
 import re
@@ -39,6 +40,7 @@ START_TIMEOUT_S = 10.0
 TERM_GRACE_S = 3.0
 _PTY_LINE = re.compile(r'char device redirected to (/dev/pts/\d+) \(label serial(\d+)\)')
 _PR_SET_PDEATHSIG = 1
+BUILD_LOCK = '.make.lock'  # in the firmware's build/: whoever runs make there takes it
 INSTALL_HINT = ('install it with `make setup` as root (apt: gcc-arm-none-eabi '
                 'libnewlib-arm-none-eabi qemu-system-arm)')
 
@@ -60,7 +62,9 @@ def build_image(directory: Path | None = None) -> Path:
     """
     Build the emulator image (``make -C firmware qemu``) if it is out of date; return its path.
 
-    Raises QemuBoardError with one line: the missing tool, or the build's first error.
+    Raises QemuBoardError with one line: the missing tool, or the build's first error. Builds
+    of one tree take turns (a lock file in its build/): two at once, two boards started side by
+    side on a fresh tree, wrote the same objects and one linked the other's half-written ones.
     """
     directory = firmware_dir() if directory is None else directory
     if not (directory / 'Makefile').is_file():
@@ -68,8 +72,11 @@ def build_image(directory: Path | None = None) -> Path:
                              "WIREFISH_FIRMWARE_DIR to the repository's firmware/)")
     if shutil.which('make') is None:
         raise QemuBoardError('make not found: install it (apt-get install make)')
-    result = subprocess.run(['make', '--no-print-directory', '-C', str(directory), 'qemu'],
-                            capture_output=True, text=True)
+    (directory / 'build').mkdir(exist_ok=True)
+    with open(directory / 'build' / BUILD_LOCK, 'w') as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        result = subprocess.run(['make', '--no-print-directory', '-C', str(directory), 'qemu'],
+                                capture_output=True, text=True)
     if result.returncode != 0:
         raise QemuBoardError('the emulator image did not build: '
                              + _first_error(result.stderr or result.stdout))
