@@ -53,3 +53,31 @@ def test_a_stop_in_time_writes_nothing(signum):
     code, stderr = _stop('at once', signum)
     assert code == 0
     assert stderr == ''
+
+
+# Three threads besides the main one, then the teardown's start; prints each thread's CPUs.
+_TEARDOWN = textwrap.dedent("""
+    import os
+    import threading
+    from wirefish_common.shutdown import begin_teardown
+
+    stop = threading.Event()
+    workers = [threading.Thread(target=stop.wait) for _ in range(3)]
+    for worker in workers:
+        worker.start()
+    begin_teardown(seconds=30.0)
+    for task in sorted(os.listdir('/proc/self/task')):
+        print(' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(int(task)))))
+    stop.set()
+    for worker in workers:
+        worker.join()
+""")
+
+
+def test_the_teardown_puts_every_thread_on_one_cpu():
+    done = subprocess.run([sys.executable, '-c', _TEARDOWN], capture_output=True, text=True,
+                          timeout=30.0)
+    assert done.returncode == 0, done.stderr
+    affinities = done.stdout.splitlines()
+    assert len(affinities) >= 4  # the main thread and the three workers
+    assert len(set(affinities)) == 1 and len(affinities[0].split()) == 1, affinities

@@ -30,7 +30,7 @@ from rclpy.signals import SignalHandlerOptions
 from wirefish_common.executors import (executor_kind, make_executor, settle,
                                        spin_until_stopped)
 from wirefish_common.parameter_table import InvalidParameters
-from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
+from wirefish_common.shutdown import begin_teardown, exit_now, SignalShutdown
 
 NodeT = TypeVar('NodeT', bound=Node)
 
@@ -80,7 +80,7 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
         pass
     finally:
         signals.attach_executor(None)
-        bound_teardown()
+        begin_teardown()
         # The node's own threads (serial reader, publish loop) are joined by destroy_node
         # before the executor goes: a task they hand over meets a live executor.
         executor.remove_node(node)

@@ -57,17 +57,41 @@ STOP_STACKS_AFTER_S = 4.0
 TEARDOWN_S = 6.0
 
 
-def bound_teardown(seconds: float = TEARDOWN_S) -> None:
+def begin_teardown(seconds: float = TEARDOWN_S) -> None:
     """
-    End the process with its threads' stacks and exit code 1 if it is still here ``seconds`` on.
+    Start the teardown after a process's loop has stopped: its threads on one CPU, a time bound.
 
-    For the teardown after a process's loop has stopped. A DDS teardown that never returns
-    (seen once in 41 stops of a loaded graph: tf_node's main thread in rclpy's
-    ``EventHandler.__exit__`` under ``destroy_node``, held until the launcher's SIGKILL) may
-    hold the GIL, so no Python thread could end it: faulthandler's own C thread can. A process
-    that finishes in time leaves through ``exit_now``, which ends the timer with the process.
+    One CPU: Fast DDS 2.14 deletes a participant (rclpy's ``destroy_node`` of a process's last
+    node) through ``DomainParticipant::set_listener(nullptr)``, which waits for a discovery
+    callback in flight with an infinite timeout that libstdc++ turns into a busy loop holding
+    the participant's listener mutex (eProsima/Fast-DDS#6513). The callback's thread needs that
+    mutex to finish, and woken on the other core it met the mutex taken again almost every
+    time: when a graph stops, every process's departure is such a callback in the others, and
+    2 of 20 stops of a fleet of three beside two busy loops had a node spinning there until the
+    launcher's SIGKILL (gdb: the main thread in ``set_listener`` under ``rcl_node_fini``, a DDS
+    receive thread in the listener's ``onWriterDiscovery`` waiting for the mutex). On the
+    spinning thread's CPU, the woken thread runs when the spinning one gives the mutex up: 0 of
+    30 such stops, 540 teardowns, the longest 0.35 s.
+
+    The bound: a process still here ``seconds`` on ends with its threads' stacks and exit code 1.
+    A DDS teardown that never returns may hold the GIL, so no Python thread could end it:
+    faulthandler's own C thread can. A process that finishes in time leaves through
+    ``exit_now``, which ends the timer with the process.
     """
+    threads_on_one_cpu()
     faulthandler.dump_traceback_later(seconds, exit=True)
+
+
+def threads_on_one_cpu() -> None:
+    """Let every thread of this process run on one CPU only (the first it may use); Linux."""
+    if not hasattr(os, 'sched_setaffinity'):
+        return
+    cpu = min(os.sched_getaffinity(0))
+    for task in os.listdir('/proc/self/task'):
+        try:
+            os.sched_setaffinity(int(task), {cpu})
+        except OSError:  # the thread has just ended
+            pass
 
 
 def ignore_stop_signals() -> None:

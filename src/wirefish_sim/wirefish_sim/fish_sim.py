@@ -55,7 +55,7 @@ import numpy as np
 from wirefish_common.frames import frame_prefix_problem
 from wirefish_common.input_checks import parse_speed, speed_text
 from wirefish_common.parameter_table import InvalidParameters
-from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
+from wirefish_common.shutdown import begin_teardown, exit_now, SignalShutdown
 from wirefish_sim.faults import disturb, Disturbance, FaultInjector
 from wirefish_sim.lockstep import clock_origin_ns, DEFAULT_GRACE_S, LockstepClock
 from wirefish_sim.pty_device import PtyDevice
@@ -322,7 +322,7 @@ def run(args: argparse.Namespace, ros_args: list[str]) -> int:
             _run_wall_clock(args, fleet, links, disturbance, stalls, reopens, ground_truth,
                             signals)
     finally:
-        bound_teardown()  # closing the devices and the ROS side must not hang the stop
+        begin_teardown()  # closing the devices and the ROS side must not hang the stop
         for link in links:
             link.device.close()
             link.device.remove_link()

@@ -42,7 +42,7 @@ import tty
 from typing import NoReturn
 
 from wirefish_bridge.link_owner import open_refusal
-from wirefish_common.shutdown import bound_teardown, exit_now, SignalShutdown
+from wirefish_common.shutdown import begin_teardown, exit_now, SignalShutdown
 from wirefish_sim.pty_device import PtyDevice
 from wirefish_sim.radio_model import Direction, preset, PRESETS, RadioLink, RadioStats
 
@@ -255,7 +255,7 @@ def run(args: argparse.Namespace) -> int:
             if wait > 0.0:
                 select.select(readers, [], [], wait)
     finally:
-        bound_teardown()
+        begin_teardown()
         if args.stats is not None:
             now = time.monotonic()
             _write_stats(args.stats, stats_document(link.stats, params.name, now, cuts))
