@@ -36,6 +36,34 @@ _DOMAIN_BASE = int(os.environ.get('WIREFISH_TEST_DOMAIN_BASE', '21'))
 _domains = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 19))
 
 
+@pytest.fixture(autouse=True, scope='session')
+def nodes_destroyed_on_one_cpu() -> Iterator[None]:
+    """
+    Destroy every rclpy node of this test process with the process's threads on one CPU.
+
+    The last node of a context deletes its DDS participant, and Fast DDS 2.14 can spin there,
+    holding a mutex a discovery thread on the other core needs, for as long as that thread
+    misses it (``wirefish_common.shutdown.begin_teardown``, where the nodes' own processes do
+    the same): a worker once hung 20 minutes in a probe's ``destroy_node`` beside two busy
+    loops. Each thread gets its CPUs back once the node is gone.
+    """
+    from rclpy.node import Node
+    from wirefish_common.shutdown import restore_cpus, threads_on_one_cpu
+
+    destroy_node = Node.destroy_node
+
+    def destroy_node_on_one_cpu(node: Node) -> None:
+        before = threads_on_one_cpu()
+        try:
+            destroy_node(node)
+        finally:
+            restore_cpus(before)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(Node, 'destroy_node', destroy_node_on_one_cpu)
+        yield
+
+
 @pytest.fixture(autouse=True)
 def isolated_ros_home(tmp_path_factory: pytest.TempPathFactory,
                       monkeypatch: pytest.MonkeyPatch) -> Path:

@@ -81,3 +81,33 @@ def test_the_teardown_puts_every_thread_on_one_cpu():
     affinities = done.stdout.splitlines()
     assert len(affinities) >= 4  # the main thread and the three workers
     assert len(set(affinities)) == 1 and len(affinities[0].split()) == 1, affinities
+
+
+# Pins, starts a thread while pinned, gives the CPUs back; prints each thread's CPUs after.
+_PIN_AND_RESTORE = textwrap.dedent("""
+    import os
+    import threading
+    from wirefish_common.shutdown import restore_cpus, threads_on_one_cpu
+
+    stop = threading.Event()
+    workers = [threading.Thread(target=stop.wait) for _ in range(2)]
+    workers[0].start()
+    print(' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(0))))
+    before = threads_on_one_cpu()
+    workers[1].start()  # made while the process is on one CPU
+    restore_cpus(before)
+    for task in sorted(os.listdir('/proc/self/task')):
+        print(' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(int(task)))))
+    stop.set()
+    for worker in workers:
+        worker.join()
+""")
+
+
+def test_every_thread_gets_its_cpus_back():
+    done = subprocess.run([sys.executable, '-c', _PIN_AND_RESTORE], capture_output=True,
+                          text=True, timeout=30.0)
+    assert done.returncode == 0, done.stderr
+    started_with, *after = done.stdout.splitlines()
+    assert len(after) >= 3  # the main thread and both workers
+    assert set(after) == {started_with}, done.stdout

@@ -82,14 +82,33 @@ def begin_teardown(seconds: float = TEARDOWN_S) -> None:
     faulthandler.dump_traceback_later(seconds, exit=True)
 
 
-def threads_on_one_cpu() -> None:
-    """Let every thread of this process run on one CPU only (the first it may use); Linux."""
+def threads_on_one_cpu() -> dict[int, set[int]]:
+    """
+    Let every thread of this process run on one CPU only (the first it may use); Linux.
+
+    Returns the CPUs each thread could use before, for ``restore_cpus``.
+    """
     if not hasattr(os, 'sched_setaffinity'):
-        return
+        return {}
     cpu = min(os.sched_getaffinity(0))
+    before: dict[int, set[int]] = {}
     for task in os.listdir('/proc/self/task'):
         try:
+            before[int(task)] = os.sched_getaffinity(int(task))
             os.sched_setaffinity(int(task), {cpu})
+        except OSError:  # the thread has just ended
+            pass
+    return before
+
+
+def restore_cpus(before: dict[int, set[int]]) -> None:
+    """Give each thread the CPUs ``threads_on_one_cpu`` took; a newer one, the calling one's."""
+    if not before:
+        return
+    default = before.get(threading.get_native_id(), set().union(*before.values()))
+    for task in os.listdir('/proc/self/task'):
+        try:
+            os.sched_setaffinity(int(task), before.get(int(task), default))
         except OSError:  # the thread has just ended
             pass
 
