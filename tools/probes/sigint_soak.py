@@ -3,11 +3,12 @@
 SIGINT a whole `wirefish up` graph many times in a row; say how fast every process stopped.
 
     tools/wfenv python tools/probes/sigint_soak.py --runs 50 [--graphs 8] [--domain 90]
-        [--discovery-range LOCALHOST]
+        [--discovery-range LOCALHOST] [--fleet 3 --swim-s 20]
 
 Each round starts ``--graphs`` virtual-fish graphs at once (each its own namespace on one ROS
-domain, the way eight users of one machine would), waits until each says "running:", sends one
-SIGINT to each launcher (Ctrl-C), and watches every process of each graph until it is gone.
+domain, the way eight users of one machine would; with ``--fleet N`` each a fleet of N fish),
+waits until each says "running:" (and, with ``--swim-s``, lets the fish swim that long), sends
+one SIGINT to each launcher (Ctrl-C), and watches every process of each graph until it is gone.
 Per round: the slowest process's stop time after the SIGINT, the launchers' exit codes and the
 codes they report for their processes. A process killed by the launcher's escalation (SIGTERM,
 SIGKILL after its deadline) shows as a code other than 0. Prints one line per round and a
@@ -33,11 +34,14 @@ START_TIMEOUT_S = 180.0
 WATCH_S = 30.0
 
 
-def _start(index: int, domain: int, out: Path, discovery: str) -> subprocess.Popen:
+def _start(index: int, domain: int, out: Path, discovery: str, fleet: int,
+           swim: bool) -> subprocess.Popen:
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE=discovery,
                PYTHONUNBUFFERED='1')
+    graph = ['--fleet', str(fleet)] if fleet else ['--sim']
     return subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', *graph, '--no-status',
+         *(['--start-swimming'] if swim else []),
          '--namespace', f'/soak_{index}', '--out', str(out)],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
@@ -76,12 +80,15 @@ def _name(proc: psutil.Process) -> str:
     return Path(command[1] if len(command) > 1 and 'python' in command[0] else command[0]).name
 
 
-def one_round(graphs: int, domain: int, out: Path, discovery: str) -> dict:
+def one_round(graphs: int, domain: int, out: Path, discovery: str, fleet: int = 0,
+              swim_s: float = 0.0) -> dict:
     """Start ``graphs`` graphs, SIGINT them, watch them stop; return the round's figures."""
-    launchers = [_start(k, domain, out / f'g{k}', discovery) for k in range(graphs)]
+    launchers = [_start(k, domain, out / f'g{k}', discovery, fleet, swim_s > 0.0)
+                 for k in range(graphs)]
     try:
         for launcher in launchers:
             _wait_running(launcher)
+        time.sleep(swim_s)
         children = {launcher.pid: psutil.Process(launcher.pid).children(recursive=True)
                     for launcher in launchers}
         sent = time.monotonic()
@@ -134,14 +141,21 @@ def main() -> int:
     # SUBNET (rmw's default, what `wirefish up` gets unless the user sets a range) keeps UDPv4.
     parser.add_argument('--discovery-range', choices=('LOCALHOST', 'SUBNET'), default='SUBNET',
                         help='ROS_AUTOMATIC_DISCOVERY_RANGE of the graphs (default %(default)s)')
+    parser.add_argument('--fleet', type=int, default=0,
+                        help='fish per graph: `wirefish up --fleet N` (default: one, --sim)')
+    parser.add_argument('--swim-s', type=float, default=0.0,
+                        help='seconds the fish swim (--start-swimming) before the SIGINT '
+                             '(default: stopped at once)')
     parser.add_argument('--bound', type=float, default=3.0,
                         help='seconds every process must stop within (default %(default)s)')
     args = parser.parse_args()
+    if args.fleet < 0 or not 0.0 <= args.swim_s <= 3600.0:
+        parser.error('--fleet is 0 (one fish, --sim) or more, --swim-s 0 to 3600')
     slowest, bad = [], 0
     with tempfile.TemporaryDirectory(prefix='wirefish_soak_') as tmp:
         for run in range(args.runs):
             figures = one_round(args.graphs, args.domain, Path(tmp) / f'r{run}',
-                                args.discovery_range)
+                                args.discovery_range, args.fleet, args.swim_s)
             clean = (set(figures['launcher_codes']) == {0} and set(figures['reported']) == {'0'}
                      and len(figures['reported']) == figures['processes'] and not figures['left']
                      and figures['slowest_s'] <= args.bound)
