@@ -55,59 +55,53 @@ def test_a_stop_in_time_writes_nothing(signum):
     assert stderr == ''
 
 
-# Three threads besides the main one, then the teardown's start; prints each thread's CPUs.
-_TEARDOWN = textwrap.dedent("""
+# Three threads besides the main one, the last started after the main thread's CPUs are printed
+# and before the teardown starts ('teardown'), or while the process is pinned to one CPU, before
+# the CPUs are given back ('restore'); then every thread's CPUs, a line each.
+_THREADS = textwrap.dedent("""
     import os
+    import sys
     import threading
-    from wirefish_common.shutdown import begin_teardown
+    from wirefish_common.shutdown import begin_teardown, restore_cpus, threads_on_one_cpu
+
+    def cpus(task):
+        return ' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(task)))
 
     stop = threading.Event()
     workers = [threading.Thread(target=stop.wait) for _ in range(3)]
-    for worker in workers:
-        worker.start()
-    begin_teardown(seconds=30.0)
-    for task in sorted(os.listdir('/proc/self/task')):
-        print(' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(int(task)))))
-    stop.set()
-    for worker in workers:
-        worker.join()
-""")
-
-
-def test_the_teardown_puts_every_thread_on_one_cpu():
-    done = subprocess.run([sys.executable, '-c', _TEARDOWN], capture_output=True, text=True,
-                          timeout=30.0)
-    assert done.returncode == 0, done.stderr
-    affinities = done.stdout.splitlines()
-    assert len(affinities) >= 4  # the main thread and the three workers
-    assert len(set(affinities)) == 1 and len(affinities[0].split()) == 1, affinities
-
-
-# Pins, starts a thread while pinned, gives the CPUs back; prints each thread's CPUs after.
-_PIN_AND_RESTORE = textwrap.dedent("""
-    import os
-    import threading
-    from wirefish_common.shutdown import restore_cpus, threads_on_one_cpu
-
-    stop = threading.Event()
-    workers = [threading.Thread(target=stop.wait) for _ in range(2)]
     workers[0].start()
-    print(' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(0))))
-    before = threads_on_one_cpu()
-    workers[1].start()  # made while the process is on one CPU
-    restore_cpus(before)
+    workers[1].start()
+    print(cpus(0))
+    if sys.argv[1] == 'teardown':
+        workers[2].start()
+        begin_teardown(seconds=30.0)
+    else:
+        before = threads_on_one_cpu()
+        workers[2].start()
+        restore_cpus(before)
     for task in sorted(os.listdir('/proc/self/task')):
-        print(' '.join(str(cpu) for cpu in sorted(os.sched_getaffinity(int(task)))))
+        print(cpus(int(task)))
     stop.set()
     for worker in workers:
         worker.join()
 """)
 
 
-def test_every_thread_gets_its_cpus_back():
-    done = subprocess.run([sys.executable, '-c', _PIN_AND_RESTORE], capture_output=True,
+def _thread_cpus(mode: str) -> tuple[str, list[str]]:
+    """Return the CPUs the process started with and those of each of its threads after."""
+    done = subprocess.run([sys.executable, '-c', _THREADS, mode], capture_output=True,
                           text=True, timeout=30.0)
     assert done.returncode == 0, done.stderr
     started_with, *after = done.stdout.splitlines()
-    assert len(after) >= 3  # the main thread and both workers
-    assert set(after) == {started_with}, done.stdout
+    assert len(after) >= 4, done.stdout  # the main thread and the three workers
+    return started_with, after
+
+
+def test_the_teardown_puts_every_thread_on_one_cpu():
+    _, after = _thread_cpus('teardown')
+    assert len(set(after)) == 1 and len(after[0].split()) == 1, after
+
+
+def test_every_thread_gets_its_cpus_back():
+    started_with, after = _thread_cpus('restore')
+    assert set(after) == {started_with}, after
