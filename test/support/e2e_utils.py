@@ -46,16 +46,29 @@ def start_graph(domain_id: int, out_dir: Path, *options: str,
     """
     if swimming:
         options = ('--start-swimming', *options)
+    return start_launcher(domain_id, out_dir, ['--sim'], *options, namespace=namespace,
+                          markers=('running:', 'recording to '))
+
+
+def start_launcher(domain_id: int, out_dir: Path, target: list[str], *options: str,
+                   namespace: str, timeout_s: float = 60.0,
+                   markers: tuple[str, ...] = ('running:',)) -> RunningGraph:
+    """
+    Start `wirefish up TARGET --no-status [options]` on its own domain; return once it runs.
+
+    It runs once a line starts with one of ``markers`` (`up --duration` says "recording to");
+    a launcher that does not get there within ``timeout_s`` is stopped and its output raised.
+    """
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id),
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
     launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_cli.cli', 'up', '--sim', '--no-status',
+        [sys.executable, '-m', 'wirefish_cli.cli', 'up', *target, '--no-status',
          *OWN_NAMESPACE, '--namespace', namespace, '--out', str(out_dir), *options],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     try:
-        seen = lines_until_running(launcher, 60.0, ('running:', 'recording to '))
-        if seen and seen[-1].startswith(('running:', 'recording to ')):  # up, up --duration
+        seen = lines_until_running(launcher, timeout_s, markers)
+        if seen and seen[-1].startswith(markers):
             return RunningGraph(launcher, env, domain_id, namespace, out_dir)
     except BaseException:  # Ctrl-C or a timeout while waiting: leave no graph behind
         stop_process(launcher)

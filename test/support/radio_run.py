@@ -16,12 +16,10 @@ import json
 import math
 import os
 from pathlib import Path
-import subprocess
-import sys
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from e2e_utils import descendants, OWN_NAMESPACE, RunningGraph
+from e2e_utils import descendants, start_launcher
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -132,34 +130,6 @@ class _Probe:
         self.node.destroy_node()
 
 
-def start_up(domain: int, out: Path, target: list[str], *options: str,
-             namespace: str) -> RunningGraph:
-    """Start `wirefish up TARGET --no-status [options]`; return once it says it runs."""
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain),
-               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
-    launcher = subprocess.Popen(
-        [sys.executable, '-m', 'wirefish_cli.cli', 'up', *target, '--no-status',
-         *OWN_NAMESPACE, '--namespace', namespace, '--out', str(out), *options],
-        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-        start_new_session=True)
-    assert launcher.stdout is not None
-    seen = []
-    deadline = time.monotonic() + 90.0
-    try:
-        while time.monotonic() < deadline:
-            line = launcher.stdout.readline()
-            if not line:
-                break
-            seen.append(line)
-            if line.startswith('running:'):
-                return RunningGraph(launcher, env, domain, namespace, out)
-    except BaseException:
-        stop_process(launcher)
-        raise
-    stop_process(launcher)
-    raise RuntimeError('wirefish up did not start:\n' + ''.join(seen) + launcher.stdout.read())
-
-
 def _run_dir(out: Path) -> Path:
     runs = sorted(out.glob('run_*'))
     assert runs, f'no run directory in {out}'
@@ -178,8 +148,8 @@ def drive(out: Path, preset: str, *, drive_mode: str | None = None, drive_s: flo
     options = ['--radio', preset] + (['--drive-mode', drive_mode] if drive_mode else [])
     namespace = f'/radio_{preset}_{drive_mode or "road"}{"_qemu" if qemu else ""}'
     record = Drive(preset, drive_mode or 'road')
-    graph = start_up(domain_id(), out, ['--fish', 'qemu'] if qemu else ['--sim'], *options,
-                     namespace=namespace)
+    graph = start_launcher(domain_id(), out, ['--fish', 'qemu'] if qemu else ['--sim'],
+                           *options, namespace=namespace, timeout_s=90.0)
     children = descendants(graph.launcher.pid)
     context = Context()
     rclpy.init(context=context, domain_id=graph.domain_id)
