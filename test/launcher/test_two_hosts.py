@@ -244,9 +244,11 @@ def test_every_relayed_topic_crosses_a_100_kbit_radio_at_its_rate(run, row):
     figures = run.figures
     # An on-change topic (cpg_params, planner_state) crosses at most once per relay tick
     # that finds a change on the fish (changes come in bursts: 16 in one window were
-    # seen to cross as 5); one message of slack for the window's ends.
+    # seen to cross as 5). Every topic has one message of slack for the window's ends: at
+    # 0.5 Hz a span of 9.5 s holds 4 or 5 messages by phase alone, so without it battery had
+    # no sample to lose (best effort through the bucket) where the fraction leaves a fifth.
     wanted = min(row.rate_hz, figures[True][4].get(row.topic, row.rate_hz))
-    slack = 1.0 / RATE_WINDOW_S if row.topic in FISH_SOURCES else 0.0
+    slack = 1.0 / RATE_WINDOW_S
     assert figures[True][2][row.topic] >= RATE_FRACTION * wanted - slack, row.topic
 
 
