@@ -16,7 +16,7 @@ Each servo is a cascade, advanced in fixed steps:
 
 The slew limit is calibrated on the paper's 3 Hz cap (``wirefish_analysis.servo_calibration``):
 the fastest gait of its grid, 9 cm at 3 Hz, commands a peak servo rate of 9.03 rad/s. The
-issue's first estimate, 12 rad/s, makes the 5 cm speed curve peak at 8.5 Hz (paper: 6.5 Hz);
+uncalibrated first guess, 12 rad/s, makes the 5 cm speed curve peak at 8.5 Hz (paper: 6.5 Hz);
 ``--servo-rate-limit 12`` still selects it.
 
 The cascade is what makes the tail amplitude collapse at high frequency: beyond the rate limit
