@@ -5,7 +5,10 @@ Record the graph's topics into a rosbag2 bag (MCAP storage), like `ros2 bag reco
 Subscriptions are raw (serialised CDR bytes go into the bag untouched, no decode/encode cost),
 with a QoS matched to each topic's publishers and a reader history QUEUE_DEPTH deep, and topics
 that appear later are picked up by a periodic rescan, so the recorder can start before or after
-the nodes.
+the nodes. The rescan runs in a thread of its own while the loop below takes: on a loaded
+machine a subscription costs 0.05-0.5 s (its type, its QoS from the graph, the reader), and a
+graph that comes up brings some twenty topics at once, which kept the streams already recorded
+waiting a second and more when the loop subscribed them itself.
 
 No executor takes the messages: every POLL_PERIOD_S one loop takes everything each reader holds
 (``take_message`` until it is empty) and writes it. An executor pays its wake-up, wait-set and
@@ -71,7 +74,7 @@ class BagRecorder(Node):
 
     def __init__(self, bag_path: Path, namespace: str, resume: bool = False,
                  announce: bool = True) -> None:
-        """Open the bag and subscribe; ``announce``: log each topic it starts recording."""
+        """Open the bag (``record`` subscribes); ``announce``: log each topic it records."""
         # Nothing spins this node: parameter services would only hang their callers.
         super().__init__('wirefish_recorder', start_parameter_services=False)
         self._announce = announce
@@ -80,28 +83,22 @@ class BagRecorder(Node):
         self._typestore = wirefish_typestore()
         self._writer, self._known_qos = open_bag_file(bag_path, resume)
         self._streams: list[_Stream] = []
+        # The writer, the streams and the accounts: the scan thread adds, the loop writes.
+        self._lock = threading.Lock()
         self._seen: set[str] = set()
         self.accounts: dict[str, TopicAccount] = {}
         self._closed = False
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
+        self._scan_error: Exception | None = None
         self.first_message_ns: int | None = None
-        self.scan()
 
     def scan(self) -> None:
-        """
-        Subscribe to the topics that appeared since the last scan.
-
-        Before each new topic it takes what the readers hold: a subscription costs 0.05-0.15 s
-        on a loaded core (its type, its QoS from the graph, the reader), and a graph that comes
-        up brings some twenty topics at once, which kept the streams already recorded waiting
-        over a second in one scan.
-        """
+        """Subscribe to the topics that appeared since the last scan."""
         for topic, type_name in graph_topics(self, self._namespace).items():
             if topic in self._seen:
                 continue
             self._seen.add(topic)
-            self.take_all()
             try:
                 msg_class = message_class(type_name)
                 self._typestore.generate_msgdef(type_name, ros_version=2)
@@ -110,16 +107,28 @@ class BagRecorder(Node):
                                           f'({type(error).__name__}: {error})')
                 continue
             qos = self._known_qos.get(topic) or offered_qos_yaml(self, topic)
-            channel = add_topic(self._writer, self._typestore, topic, type_name, qos)
             qos_profile = matching_qos(self, topic, QUEUE_DEPTH)
             # A latched sample may be older than the recorder: its wait is no lag.
             latched = qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
-            account = self.accounts[topic] = TopicAccount(latched=latched)
+            account = TopicAccount(latched=latched)
+            # What arrives before the stream is added waits in the reader's history.
             subscription = self.create_subscription(
                 msg_class, topic, _unused_callback, qos_profile, raw=True)
-            self._streams.append(_Stream(topic, subscription, channel, account))
+            with self._lock:
+                channel = add_topic(self._writer, self._typestore, topic, type_name, qos)
+                self.accounts[topic] = account
+                self._streams.append(_Stream(topic, subscription, channel, account))
             if self._announce:
                 self.get_logger().info(f'recording {topic} [{type_name}]')
+
+    def _scan_until(self, stop: threading.Event) -> None:
+        """Scan now and every RESCAN_PERIOD_S until ``stop``; keep what fails for ``record``."""
+        try:
+            self.scan()
+            while not stop.wait(RESCAN_PERIOD_S):
+                self.scan()
+        except Exception as error:  # raised again by the loop, which stops on it
+            self._scan_error = error
 
     def take_all(self, published_before_ns: int | None = None) -> int:
         """
@@ -127,6 +136,13 @@ class BagRecorder(Node):
 
         With ``published_before_ns``: count only those published before that time.
         """
+        with self._lock:
+            taken = self._take_all(published_before_ns)
+        if taken and self.first_message_ns is None:
+            self.first_message_ns = time.time_ns()
+        return taken
+
+    def _take_all(self, published_before_ns: int | None) -> int:
         taken = 0
         write = self._writer.write
         clock = time.time_ns
@@ -153,30 +169,35 @@ class BagRecorder(Node):
                     account.lag_max_ns = now - source_ns
                 if published_before_ns is None or source_ns < published_before_ns:
                     taken += 1
-        if taken and self.first_message_ns is None:
-            self.first_message_ns = time.time_ns()
         return taken
 
     def flush(self) -> None:
         """Write what was taken since the last flush to the file (it survives a SIGKILL)."""
-        if not self._closed:
-            self._writer.flush()
+        with self._lock:
+            if not self._closed:
+                self._writer.flush()
 
     def record(self, stopped: Callable[[], bool]) -> None:
-        """Take, flush and rescan until ``stopped()``, then drain the readers."""
-        now = time.monotonic()
-        next_flush, next_scan = now + FLUSH_PERIOD_S, now + RESCAN_PERIOD_S
-        while not stopped():
-            self.take_all()
-            now = time.monotonic()
-            if now >= next_flush:
-                self.flush()
-                next_flush = max(next_flush + FLUSH_PERIOD_S, now)
-            if now >= next_scan:
-                self.scan()
-                next_scan = now + RESCAN_PERIOD_S
-            time.sleep(max(0.0, POLL_PERIOD_S - (time.monotonic() - now)))
+        """Take and flush until ``stopped()`` (a thread rescans meanwhile), then drain."""
+        stop_scan = threading.Event()
+        scanner = threading.Thread(target=self._scan_until, args=(stop_scan,),
+                                   name='recorder-scan', daemon=True)
+        scanner.start()
+        try:
+            next_flush = time.monotonic() + FLUSH_PERIOD_S
+            while not stopped() and self._scan_error is None:
+                self.take_all()
+                now = time.monotonic()
+                if now >= next_flush:
+                    self.flush()
+                    next_flush = max(next_flush + FLUSH_PERIOD_S, now)
+                time.sleep(max(0.0, POLL_PERIOD_S - (time.monotonic() - now)))
+        finally:
+            stop_scan.set()
+            scanner.join()
         self.drain()
+        if self._scan_error is not None:
+            raise self._scan_error
 
     def drain(self) -> None:
         """
@@ -204,16 +225,23 @@ class BagRecorder(Node):
         account = self.accounts.get(topic)
         return 0 if account is None else account.count
 
+    def total_count(self) -> int:
+        """Return how many messages were taken so far, all topics."""
+        with self._lock:
+            return sum(account.count for account in self.accounts.values())
+
     def close(self) -> None:
         """Stop and drain the thread if any, then finish the bag; idempotent."""
         if self._thread is not None:
             self._stop.set()
             self._thread.join()
             self._thread = None
-        if not self._closed:
+        with self._lock:
+            if self._closed:
+                return
             self._closed = True
             self._writer.close(recording_account(self.accounts))
-            write_metadata(self.bag_path)
+        write_metadata(self.bag_path)
 
 
 def _unused_callback(_data: bytes) -> None:

@@ -100,7 +100,7 @@ def _record(recorder, namespace: str, args: argparse.Namespace, bag_path: Path, 
             now - started_ns >= (args.duration + NOTHING_TIMEOUT_S) * 1e9
 
     def recorder_count() -> int:
-        return sum(account.count for account in recorder.accounts.values())
+        return recorder.total_count()
 
     try:
         recorder.record(stopped)
