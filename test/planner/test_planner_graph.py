@@ -32,9 +32,10 @@ HOLD_WINDOW_S = 15.0
 OFF_WINDOW_S = 10.0  # open loop drifts ~0.5 rad in it against the 0.05 rad/s current
 STOP_WITHIN_S = 5.0
 MAX_CPG_ACCELERATION = 300.0  # rad/s^2 (see the servo check)
-# fish_sim --speed 1: the planner is not in the lockstep (its 20 Hz loop is a timer of the
-# graph's clock), so a graph at --speed max beside two CPU hogs outran it: its loop skipped
-# periods and the fish swam 0.247 m/s for 0.3 (-17.6 %). At 1 the clock waits for real time.
+# fish_sim --speed 1. The planner holds the clock at each control tick, but not its input: at
+# --speed max beside two CPU hogs imu/data lagged the clock by over 0.5 s of simulated time
+# (the planner went open loop for 9 ticks of the heading hold and a +0.2 rad/s step turned at
+# +0.274). At 1 the clock waits for real time, which the bridge keeps up with.
 GRAPH_SPEED = '1'
 
 

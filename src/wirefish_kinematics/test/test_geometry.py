@@ -7,7 +7,7 @@ import pytest
 from wirefish_kinematics.geometry import FishGeometry, GEOMETRY_FIELDS
 
 
-def test_defaults_are_the_issue_estimates():
+def test_defaults_are_the_geometry_estimates_in_si_units():
     g = FishGeometry()
     assert (g.l1, g.l2, g.l3, g.r1, g.r2, g.rd1, g.rd2) == (
         0.080, 0.100, 0.060, 0.020, 0.012, 0.018, 0.018)

@@ -14,6 +14,10 @@ Subscribes
 Publishes
     ``planner_state`` (wirefish_msgs/PlannerState, reliable, depth 10) at ``control_rate_hz``;
     ``/diagnostics`` (diagnostic_msgs/DiagnosticArray) at 1 Hz.
+    On simulated time (``use_sim_time``), after every control tick, ``lockstep/next_tick``
+    (rosgraph_msgs/Clock, reliable): when the next tick is due. The virtual fish's clock waits
+    there for the tick's answer, so a fast clock never makes the loops skip a period
+    (``wirefish_sim.lockstep``).
 Drives
     cpg_node (``cpg_node_name``) by its control topic: ``cpg_command`` (wirefish_msgs/CpgCommand,
     reliable, keep last 1) in the CPG node's namespace, the whole target set at every control
@@ -44,10 +48,12 @@ from __future__ import annotations
 
 import math
 
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
 from rclpy.node import Node
 from rclpy.task import Future
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Trigger
 from wirefish_common.batch_intake import BatchIntake, intake_qos
@@ -55,6 +61,7 @@ from wirefish_common.cdr_views import CdrError, read_imu
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import COMMAND, LATCHED, RELIABLE
+from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
 from wirefish_cpg.cpg_control import TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values
 from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
@@ -103,6 +110,8 @@ class PlannerNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                 self._on_control)
+        self._hold_pub = (self.create_publisher(Clock, LOCKSTEP_HOLD_TOPIC, RELIABLE)
+                          if self.get_parameter('use_sim_time').value else None)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._on_diagnostics)
 
     def _now_s(self) -> float:
@@ -116,6 +125,7 @@ class PlannerNode(Node):
             self._control_timer.cancel()
             self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                     self._on_control)
+            self._say_next_tick()  # the clock may be held at the cancelled timer's tick
             self._subscribe_imu()  # its queue holds the samples of two ticks
         if 'cpg_node_name' in names:
             self.destroy_publisher(self._command_pub)
@@ -249,6 +259,16 @@ class PlannerNode(Node):
         else:
             self._send(cpg_values(out))
         self._state_pub.publish(self._state_message(out, now))
+        self._say_next_tick()
+
+    def _say_next_tick(self) -> None:
+        """On simulated time, publish when the control timer's next tick is due."""
+        until_ns = self._control_timer.time_until_next_call()
+        if self._hold_pub is None or until_ns is None:
+            return
+        due = self.get_clock().now().nanoseconds + max(0, until_ns)
+        sec, nanosec = divmod(due, 1_000_000_000)
+        self._hold_pub.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
 
     def _manual(self) -> bool:
         status = self._cpg_status

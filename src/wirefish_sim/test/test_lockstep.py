@@ -101,3 +101,41 @@ def test_simulated_time_starts_on_a_whole_step_of_the_wall_clock():
     assert clock_origin_ns(1_234_567_891_234, STEP_NS) == 1_234_560_000_000
     with pytest.raises(ValueError):
         LockstepClock(0, 0, 1.0, 1, 0.0)
+
+
+def test_a_holding_node_keeps_the_clock_at_its_next_tick_until_it_answers():
+    clock = _engaged_clock()
+    tick = clock.time_ns + 2 * STEP_NS
+    clock.on_hold(0, tick)
+    for wall in (1.0, 1.01):  # up to the tick: the commands alone decide
+        clock.on_command(0)
+        assert clock.ready(wall)
+        clock.advance(wall)
+    assert clock.time_ns == tick
+    clock.on_command(0)
+    assert clock.held_by() == [0] and not clock.ready(1.02)  # the tick's answer is owed
+    clock.on_hold(0, tick + 5 * STEP_NS)
+    assert clock.held_by() == [] and clock.ready(1.02)
+
+
+def test_a_holding_node_silent_for_the_grace_is_released_until_it_answers_again():
+    clock = _engaged_clock()
+    clock.on_hold(0, clock.time_ns)
+    clock.on_command(0)
+    assert not clock.ready(10.0)
+    assert clock.wait_s(10.0) == pytest.approx(2.0)
+    assert clock.ready(12.0)
+    assert clock.counters.hold_releases == 1 and clock.held_by() == []
+    assert clock.counters.releases == 0  # the host streamed: it still holds the clock
+    clock.advance(12.0)
+    clock.on_hold(0, clock.time_ns)  # back: it holds again
+    clock.on_command(0)
+    assert clock.held_by() == [0] and not clock.ready(12.01)
+
+
+def test_each_fish_of_a_fleet_is_held_by_its_own_node():
+    clock = _engaged_clock(fish=2)
+    clock.on_hold(1, clock.time_ns)
+    clock.on_command(0)
+    clock.on_command(1)
+    assert clock.held_by() == [1] and not clock.ready(1.0)

@@ -195,6 +195,14 @@ class GroundTruthPublisher:
         self.publishers = [self.node.create_publisher(
             Odometry, prefixed(name, 'sim/ground_truth'), RELIABLE) for name in names]
         self._clock_publisher: Any = None  # an rclpy Publisher once the clock is published
+        # Each fish's holding node (its planner) says when its next tick is due; no executor
+        # spins this node: the lockstep loop takes the answers itself (``take_holds``).
+        from rosgraph_msgs.msg import Clock
+        from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
+        self._holds = [
+            self.node.create_subscription(Clock, prefixed(name, LOCKSTEP_HOLD_TOPIC),
+                                          _taken_not_called, RELIABLE)
+            for name in names]
 
     def publish_clock(self, time_ns: int) -> None:
         """Publish ``time_ns`` on the node's ``clock`` (made at the first call)."""
@@ -208,6 +216,17 @@ class GroundTruthPublisher:
             self._clock_publisher = self.node.create_publisher(Clock, 'clock', CLOCK)
         sec, nanosec = divmod(time_ns, 1_000_000_000)
         self._clock_publisher.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
+
+    def take_holds(self) -> list[tuple[int, int]]:
+        """Return (fish, next tick in ns) of each fish whose holding node answered since."""
+        answers = []
+        for fish, subscription in enumerate(self._holds):
+            latest = None
+            while (taken := subscription.handle.take_message(subscription.msg_type, False)):
+                latest = taken[0].clock
+            if latest is not None:
+                answers.append((fish, latest.sec * 1_000_000_000 + latest.nanosec))
+        return answers
 
     def publish(self, school: Sequence[VirtualFish], time_ns: int | None = None) -> None:
         """Publish the ground truth of every fish at ``time_ns`` (None: the node clock's now)."""
@@ -233,6 +252,10 @@ class GroundTruthPublisher:
         """Destroy the node and shut rclpy down."""
         self.node.destroy_node()
         self._rclpy.try_shutdown()
+
+
+def _taken_not_called(_msg: Any) -> None:
+    """Never called: the lockstep loop takes the holds (``GroundTruthPublisher.take_holds``)."""
 
 
 class Schedule:
@@ -362,6 +385,9 @@ def _step(fleet: VirtualFleet, links: Sequence[_FishLink], disturbance: Disturba
 # While the clock waits for a command, /clock is said again this often (wall s): the nodes
 # take /clock best effort, and a node that missed the last one must not hold the clock.
 CLOCK_REPEAT_S = 0.02
+# While a holding node owes its answer the loop looks for it this often (wall s): it comes over
+# DDS, which does not end the wait on the devices.
+HOLD_POLL_S = 0.001
 
 
 def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence[_FishLink],
@@ -386,6 +412,8 @@ def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence
         stalled = stalls.index(elapsed) is not None
         for index in _exchange(fleet, links, closing, stalled):
             clock.on_command(index)
+        for index, next_tick_ns in ground_truth.take_holds() if ground_truth else ():
+            clock.on_hold(index, next_tick_ns)
         now = time.monotonic()
         engaged = list(clock.engaged)  # ready() releases a fish whose host went silent
         if clock.ready(now):
@@ -403,7 +431,7 @@ def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence
             ground_truth.publish_clock(clock.time_ns)
             said_wall = now
         devices = [link.device for link in links if link.device.is_open]
-        timeout = min(clock.wait_s(now), CLOCK_REPEAT_S)
+        timeout = min(clock.wait_s(now), HOLD_POLL_S if clock.held_by() else CLOCK_REPEAT_S)
         if timeout > 0.0:
             select.select(devices, [], [], timeout)  # a command ends the wait at once
     counters, wall_s = clock.counters, time.monotonic() - started_wall
@@ -411,7 +439,7 @@ def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence
     print(f'fish_sim: {simulated_s:.2f} s of simulated time in {wall_s:.2f} s '
           f'(real-time factor {simulated_s / max(wall_s, 1e-9):.2f}); {counters.steps} steps, '
           f'{counters.lockstep_steps} in lockstep; the host went silent {counters.releases} '
-          'times', file=sys.stderr, flush=True)
+          f'times, a holding node {counters.hold_releases}', file=sys.stderr, flush=True)
 
 
 def _say_engagement(before: list[bool], clock: LockstepClock) -> None:

@@ -23,6 +23,13 @@ clock at ``speed`` (``max``: at real time, so a graph without a host cannot run 
 simulated time), which is also what paces the clock before the host starts and in gait mode.
 So the clock never waits for ever: at worst a step takes ``grace_s``, after which time runs
 at the wall-clock pace. Nothing is ever dropped: every step is ``step_ns`` of simulated time.
+
+A node whose output feeds the fish back on a timer slower than the step (the planner's control
+loop: its cmd_vel tracking and yaw loops act through the CPG's targets) holds the clock too:
+after each tick it says when its next one is due (``on_hold``), and no step goes past that time
+until its next answer. Without it a graph at ``--speed max`` could outrun the node: its timer
+would skip periods and the experiment would change with the machine. A node that stops
+answering is released after ``grace_s`` as a silent host is, and holds again at its next answer.
 """
 
 from __future__ import annotations
@@ -46,6 +53,7 @@ class LockstepCounters:
     steps: int = 0
     lockstep_steps: int = 0
     releases: int = 0
+    hold_releases: int = 0
 
 
 class LockstepClock:
@@ -67,6 +75,8 @@ class LockstepClock:
         self._streak = [0] * fish_count
         self._next_wall_s = wall_now_s
         self._waiting_since_s: float | None = None
+        # Per fish: the simulated time (ns) its holding node's next tick is due, if it holds.
+        self._holds: list[int | None] = [None] * fish_count
 
     @property
     def time_s(self) -> float:
@@ -83,16 +93,25 @@ class LockstepClock:
         """Note that fish ``fish`` received a SERVO_CMD during the current step."""
         self._commanded[fish] = True
 
+    def on_hold(self, fish: int, next_tick_ns: int) -> None:
+        """Note that fish ``fish``'s holding node answered; its next tick is due then."""
+        self._holds[fish] = next_tick_ns
+
     def waiting_for(self) -> list[int]:
         """Return the engaged fish whose command of this step has not arrived."""
         return [f for f, engaged in enumerate(self.engaged) if engaged and not self._commanded[f]]
 
+    def held_by(self) -> list[int]:
+        """Return the fish whose holding node owes the answer of a tick the step would pass."""
+        next_ns = self.time_ns + self.step_ns
+        return [f for f, hold in enumerate(self._holds) if hold is not None and next_ns > hold]
+
     def ready(self, wall_now_s: float) -> bool:
-        """Return whether the next step may be taken now (releasing a fish silent too long)."""
+        """Return whether the next step may be taken now (releasing what is silent too long)."""
         if wall_now_s < self._next_wall_s:
             return False
-        waiting = self.waiting_for()
-        if not waiting:
+        waiting, held = self.waiting_for(), self.held_by()
+        if not waiting and not held:
             return True
         if self._waiting_since_s is None:
             self._waiting_since_s = wall_now_s
@@ -103,19 +122,22 @@ class LockstepClock:
             self.engaged[fish] = False
             self._streak[fish] = 0
             self.counters.releases += 1
+        for fish in held:  # its holding node went silent: it holds again when it answers
+            self._holds[fish] = None
+            self.counters.hold_releases += 1
         return True
 
     def wait_s(self, wall_now_s: float) -> float:
-        """Return how long (wall s) nothing can change ``ready`` unless a command arrives."""
+        """Return how long (wall s) nothing can change ``ready`` unless an answer arrives."""
         until = self._next_wall_s - wall_now_s
-        if self.waiting_for() and self._waiting_since_s is not None:
+        if (self.waiting_for() or self.held_by()) and self._waiting_since_s is not None:
             until = max(until, self._waiting_since_s + self.grace_s - wall_now_s)
         return max(0.0, until)
 
     def advance(self, wall_now_s: float) -> None:
         """Take the step: simulated time moves on by ``step_ns``; engagement is updated."""
         self.counters.steps += 1
-        if any(self.engaged) and not self.waiting_for():
+        if any(self.engaged) and not self.waiting_for() and not self.held_by():
             self.counters.lockstep_steps += 1
         for fish, commanded in enumerate(self._commanded):
             self._streak[fish] = self._streak[fish] + 1 if commanded else 0
