@@ -3,10 +3,9 @@
 The square mission through `wirefish mission` on the virtual fish: recorded, reported, plotted.
 
 A graph of its own (test_planner_graph.py's drive is another experiment), on the lockstep
-clock at ``--speed 1``: the mission keeps the fish's time (its ground truth's stamps), but the
-planner's loop and the CPG's start service are not in the lockstep, so at ``--speed max`` their
-wall-clock latency becomes simulated time: an idle fresh-clone run swam nothing in the first
-leg (0.000 m/s at its end, the CPG not yet started) and an 8.42 m path for ~10.6.
+clock at ``--speed max``: the mission keeps the fish's time (its ground truth's stamps) and the
+planner holds the clock at its ticks (before it did, an idle run at max swam nothing in the
+first leg, the CPG not yet started, and an 8.42 m path for ~10.6).
 """
 
 import re
@@ -15,7 +14,7 @@ import sys
 
 import pytest
 
-GRAPH_SPEED = '1'
+GRAPH_SPEED = 'max'
 
 
 @pytest.mark.ros

@@ -29,11 +29,9 @@ LONGEST_MODULES = (
     'test/view/test_foxglove_clients.py',
     'test/bag/test_loaded_recording.py',
     'test/test_repeated_signals.py',
-    'test/planner/test_planner_graph.py',
     'test/tuner/test_retune_action.py',
     'test/firmware_qemu/test_graph_on_qemu.py',
     'test/operator/test_topic_param_commands.py',
-    'test/planner/test_planner_mission.py',
     'test/view/test_view_protocol.py',
     'test/view/test_dashboard_browser.py',
 )

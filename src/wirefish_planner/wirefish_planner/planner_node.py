@@ -17,7 +17,11 @@ Publishes
     On simulated time (``use_sim_time``), after every control tick, ``lockstep/next_tick``
     (rosgraph_msgs/Clock, reliable): when the next tick is due. The virtual fish's clock waits
     there for the tick's answer, so a fast clock never makes the loops skip a period
-    (``wirefish_sim.lockstep``).
+    (``wirefish_sim.lockstep``). A tick whose imu/data lags the clock (its newest sample more
+    than ``INPUT_FRESH_S`` older than the tick) waits for the sample first, polling on the wall
+    clock for at most ``INPUT_WAIT_S``: the clock is held meanwhile, so at ``--speed max`` a
+    starved bridge slows the graph down instead of leaving the loops without their input. After
+    a wait that ran out it waits again only once a sample has come.
 Drives
     cpg_node (``cpg_node_name``) by its control topic: ``cpg_command`` (wirefish_msgs/CpgCommand,
     reliable, keep last 1) in the CPG node's namespace, the whole target set at every control
@@ -47,12 +51,15 @@ Parameters: ``planner_node_parameters`` (each with a range; an invalid set chang
 from __future__ import annotations
 
 import math
+import time
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
+from rclpy.clock import Clock as RclClock, ClockType
 from rclpy.node import Node
 from rclpy.task import Future
+from rclpy.timer import Timer
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Trigger
@@ -79,6 +86,14 @@ MAX_IMU_RATE_HZ = 200.0
 # A start call that got no answer in this long (s, node clock) is made again: a request to a
 # server that has just appeared, or its reply, can be lost (start is idempotent).
 START_RETRY_S = 1.0
+# On simulated time, how old (s of the graph's clock) the newest imu/data sample may be at a
+# control tick: the bridge stamps a sample with the last step of the clock it heard, and one
+# sample of the 100 Hz stream may be lost (best effort).
+INPUT_FRESH_S = 0.025
+# How long (wall s) a tick waits for a lagging sample, polling every INPUT_POLL_S: far below
+# the clock's grace for a silent holder (wirefish_sim.lockstep.DEFAULT_GRACE_S).
+INPUT_WAIT_S = 1.0
+INPUT_POLL_S = 0.002
 
 
 class PlannerNode(Node):
@@ -112,6 +127,10 @@ class PlannerNode(Node):
                                                 self._on_control)
         self._hold_pub = (self.create_publisher(Clock, LOCKSTEP_HOLD_TOPIC, RELIABLE)
                           if self.get_parameter('use_sim_time').value else None)
+        self._newest_imu_s: float | None = None  # the newest imu/data stamp taken
+        self._input_came = True  # a sample came since the last wait that ran out
+        self._waiting: tuple[float, float] | None = None  # (tick, wall start) of a waiting tick
+        self._wait_timer: Timer | None = None
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._on_diagnostics)
 
     def _now_s(self) -> float:
@@ -235,6 +254,9 @@ class PlannerNode(Node):
                                        throttle_duration_sec=WARN_THROTTLE_S)
                 continue
             stamp = view.sec + view.nanosec * 1e-9
+            if self._newest_imu_s is None or stamp > self._newest_imu_s:
+                self._newest_imu_s = stamp
+                self._input_came = True
             # REP-145: a covariance of -1 says there is no orientation (yaw NaN: not used)
             yaw = yaw_from_quaternion(*view.orientation) \
                 if view.orientation_covariance_0 != -1.0 else math.nan
@@ -249,8 +271,49 @@ class PlannerNode(Node):
 
     # --- outputs --------------------------------------------------------------------------
     def _on_control(self) -> None:
+        if self._waiting is not None:  # the clock went on without the tick (released)
+            self._end_wait()
         now = self._now_s()
         self._take_imu(now)
+        if self._input_lags(now):
+            self._waiting = (now, time.monotonic())
+            self._wait_timer = self.create_timer(INPUT_POLL_S, self._poll_input,
+                                                 clock=RclClock(clock_type=ClockType.STEADY_TIME))
+            return
+        self._control(now)
+
+    def _input_lags(self, tick: float) -> bool:
+        """Return whether a tick on simulated time should wait for imu/data (see module)."""
+        return (self._hold_pub is not None and self._input_came
+                and self._newest_imu_s is not None
+                and tick - self._newest_imu_s > INPUT_FRESH_S)
+
+    def _poll_input(self) -> None:
+        assert self._waiting is not None
+        tick, since = self._waiting
+        self._take_imu(tick)
+        if not self._input_lags(tick):
+            self._end_wait()
+        elif time.monotonic() - since > INPUT_WAIT_S:
+            self._input_came = False
+            self.get_logger().warn(
+                f'imu/data lags the clock: no sample newer than {self._newest_imu_s:.3f} s at '
+                f'the tick of {tick:.3f} s after {INPUT_WAIT_S:g} s of waiting; the ticks go on '
+                'without it until one comes', throttle_duration_sec=WARN_THROTTLE_S)
+            self._end_wait()
+
+    def _end_wait(self) -> None:
+        """Run the waiting tick with what came."""
+        assert self._waiting is not None
+        tick = self._waiting[0]
+        self._waiting = None
+        if self._wait_timer is not None:
+            self.destroy_timer(self._wait_timer)
+            self._wait_timer = None
+        self._control(tick)
+
+    def _control(self, now: float) -> None:
+        """Run the control tick of simulated or wall time ``now`` (s)."""
         out = self._planner.step(now)
         self._output = out
         self._start_cpg()
