@@ -4,8 +4,8 @@ The square mission through `wirefish mission` on the virtual fish: recorded, rep
 
 A graph of its own (test_planner_graph.py's drive is another experiment), on the lockstep
 clock at ``--speed max``: the mission keeps the fish's time (its ground truth's stamps) and the
-planner holds the clock at its ticks (before it did, an idle run at max swam nothing in the
-first leg, the CPG not yet started, and an 8.42 m path for ~10.6).
+planner holds the clock at its ticks, so its loop, and the CPG's start it calls at the first
+leg, keep simulated time however fast the graph runs.
 """
 
 import re
