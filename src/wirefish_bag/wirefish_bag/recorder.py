@@ -122,13 +122,19 @@ class BagRecorder(Node):
                 self.get_logger().info(f'recording {topic} [{type_name}]')
 
     def _scan_until(self, stop: threading.Event) -> None:
-        """Scan now and every RESCAN_PERIOD_S until ``stop``; keep what fails for ``record``."""
+        """
+        Scan now and every RESCAN_PERIOD_S until ``stop``; keep what fails for ``record``.
+
+        A scan that fails because the process shut rclpy down (a `wirefish mission` that gave
+        up waiting for its graph) ends the scans quietly: the stop is on its way.
+        """
         try:
             self.scan()
             while not stop.wait(RESCAN_PERIOD_S):
                 self.scan()
         except Exception as error:  # raised again by the loop, which stops on it
-            self._scan_error = error
+            if self.context.ok():
+                self._scan_error = error
 
     def take_all(self, published_before_ns: int | None = None) -> int:
         """
