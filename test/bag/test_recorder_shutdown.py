@@ -9,8 +9,9 @@ pytestmark = pytest.mark.ros
 
 # As `wirefish mission` does when its graph never comes: rclpy shut down, then the recorder
 # closed; in between its scan thread looks for topics on a context that is gone.
-_SHUT_DOWN_FIRST = '''
-import sys, time
+_SHUT_DOWN_FIRST = """
+import sys
+import time
 from pathlib import Path
 import rclpy
 from wirefish_bag.recorder import BagRecorder, RESCAN_PERIOD_S
@@ -22,7 +23,7 @@ rclpy.try_shutdown()
 time.sleep(3 * RESCAN_PERIOD_S)  # scans come due on the shut-down context
 recorder.close()
 print('closed')
-'''
+"""
 
 
 def test_a_recorder_closed_after_rclpy_shut_down_says_no_error(tmp_path, python, ros_env):
