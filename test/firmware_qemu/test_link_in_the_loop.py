@@ -36,6 +36,8 @@ COMMAND_TIMEOUT_MS = 500
 HEARTBEAT_TIMEOUT_MS = 1500
 TELEMETRY_PERIOD_MS = 10
 CLOCK_RESOLUTION_MS = 1
+# The kinds of the debug console's "T" lines: the polls that took a frame of that kind.
+TAKEN_HEARTBEAT, TAKEN_SERVO_CMD = 0, 1
 # The graph's stream into the board: 3,000 commands, every one of them must be applied.
 STREAM_S = 30.0
 # The stream failsafe's way to neutral (PROTOCOL.md's failsafe_slew_rad_s default).
@@ -131,20 +133,21 @@ def _wait_board_time(tap: Tap, board_ms: int, timeout_s: float = 90.0) -> None:
     raise AssertionError(f'the board clock did not pass {board_ms} ms within {timeout_s:g} s')
 
 
-def _first_after_deadline(telemetry: list[Telemetry], arrival: int, timeout_ms: int,
-                          flag: Status) -> tuple[Telemetry, int]:
+def _first_after_deadline(telemetry: list[Telemetry], arrival: int, taken: int,
+                          timeout_ms: int, flag: Status) -> tuple[Telemetry, int]:
     """
     Check a timeout rule on the board's clock; return the first flagged frame and its lateness.
 
-    The frame's delimiter arrived at board time ``arrival``; the core took it at the latest in
-    the poll of the first telemetry frame stamped after that. No frame before ``arrival +
-    timeout + 1 ms`` carries ``flag``; every frame from ``taken + timeout + 1 ms`` on does, with
-    both servos neutral. The lateness (ms) is how long after that bound the first flagged frame
-    came, minus the gap to the frame before it beyond one telemetry period (a host that
-    stopped the emulator for a while: the board's clock follows the wall's).
+    The frame's delimiter arrived at board time ``arrival``; the core took it in the poll at
+    ``taken`` (its "T" line: behind a backlog of received bytes that can be polls later). No
+    frame before ``arrival + timeout + 1 ms`` carries ``flag``; every frame from ``taken +
+    timeout + 1 ms`` on does, with both servos neutral. The lateness (ms) is how long after
+    that bound the first flagged frame came, minus the gap to the frame before it beyond one
+    telemetry period (a host that stopped the emulator for a while: the board's clock follows
+    the wall's).
     """
+    assert taken >= arrival
     after = [t for t in telemetry if t.board_time_ms > arrival]
-    taken = after[0].board_time_ms
     early = [t for t in after if t.board_time_ms < arrival + timeout_ms + CLOCK_RESOLUTION_MS]
     assert early and all(not t.status & flag for t in early)
     due = [t for t in after if t.board_time_ms >= taken + timeout_ms + CLOCK_RESOLUTION_MS]
@@ -154,6 +157,15 @@ def _first_after_deadline(telemetry: list[Telemetry], arrival: int, timeout_ms: 
     previous = after[after.index(first) - 1]
     stall = max(0, first.board_time_ms - previous.board_time_ms - TELEMETRY_PERIOD_MS)
     return first, first.board_time_ms - (taken + timeout_ms + CLOCK_RESOLUTION_MS) - stall
+
+
+def _last_taken(console: Console, kind: int, arrival: int, timeout_s: float = 30.0) -> int:
+    """Return the board time of the poll that took the last frame of ``kind`` ("T" line)."""
+    deadline = time.monotonic() + timeout_s
+    while not (console.taken[kind] and console.taken[kind][-1] >= arrival):
+        assert time.monotonic() < deadline, (kind, arrival, console.taken[kind][-3:])
+        time.sleep(0.05)
+    return console.taken[kind][-1]
 
 
 def _slews_to_neutral(telemetry: list[Telemetry]) -> None:
@@ -281,16 +293,16 @@ def test_commands_stopped_on_the_wire_failsafe_command_and_neutral(
             <= last_arrival + COMMAND_TIMEOUT_MS]
     assert held and all((t.servo_1, t.servo_2) == (pytest.approx(0.4), pytest.approx(-0.4))
                         for t in held)
-    failsafe, late = _first_after_deadline(telemetry, last_arrival, COMMAND_TIMEOUT_MS,
+    taken = _last_taken(console, TAKEN_SERVO_CMD, last_arrival)
+    failsafe, late = _first_after_deadline(telemetry, last_arrival, taken, COMMAND_TIMEOUT_MS,
                                            Status.FAILSAFE_COMMAND)
     # The neutral compare itself (the slew's last steps come within a tick of it).
     neutral = [t for t, ch, ticks in console.compares if t > last_arrival
                and console.angle(ch, ticks) == pytest.approx(0.0, abs=console.tick_rad(ch) / 2)]
     latency = failsafe.board_time_ms - last_arrival
     print(f'\nlast command arrived at board time {last_arrival} ms; FAILSAFE_COMMAND in '
-          f'telemetry after {latency} ms (bound: the core took the frame within '
-          f'{latency - late - COMMAND_TIMEOUT_MS - CLOCK_RESOLUTION_MS} ms, + timeout + 1 ms '
-          f'+ one {TELEMETRY_PERIOD_MS} ms period), '
+          f'telemetry after {latency} ms (bound: the core took the frame after '
+          f'{taken - last_arrival} ms, + timeout + 1 ms + one {TELEMETRY_PERIOD_MS} ms period), '
           f'compare registers neutral after {[t - last_arrival for t in neutral]} ms')
     assert not failsafe.status & Status.FAILSAFE_HEARTBEAT
     assert len(neutral) == 2
@@ -308,14 +320,14 @@ def test_bridge_killed_failsafe_heartbeat_and_neutral(board, console, tap, start
     heartbeats = [c for c in tap.record.to_board if isinstance(c.frame.message, Heartbeat)]
     last_arrival = board_time_of(console, heartbeats[-1])
     _wait_board_time(tap, last_arrival + HEARTBEAT_TIMEOUT_MS + 100)
-    failsafe, late = _first_after_deadline(_telemetry(tap), last_arrival,
+    taken = _last_taken(console, TAKEN_HEARTBEAT, last_arrival)
+    failsafe, late = _first_after_deadline(_telemetry(tap), last_arrival, taken,
                                            HEARTBEAT_TIMEOUT_MS, Status.FAILSAFE_HEARTBEAT)
     latency = failsafe.board_time_ms - last_arrival
     print(f'\nbridge killed; its last heartbeat arrived at board time {last_arrival} ms; '
           f'FAILSAFE_HEARTBEAT in telemetry after {latency} ms (bound: the core took the frame '
-          f'within {latency - late - HEARTBEAT_TIMEOUT_MS - CLOCK_RESOLUTION_MS} ms, + timeout + '
-          f'1 ms + one {TELEMETRY_PERIOD_MS} ms period), servos '
-          f'{failsafe.servo_1, failsafe.servo_2}')
+          f'after {taken - last_arrival} ms, + timeout + 1 ms + one {TELEMETRY_PERIOD_MS} ms '
+          f'period), servos {failsafe.servo_1, failsafe.servo_2}')
     assert late <= TELEMETRY_PERIOD_MS   # within the timeout and one telemetry period
 
 

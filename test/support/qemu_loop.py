@@ -3,14 +3,15 @@
 Helpers of the in-the-loop tests: the board's debug console, a tap on the link, a ROS probe.
 
 The emulator build of the firmware writes a debug console on USART2 (firmware/port/stm32f4/
-debug_console.h): the board time of every 0x00 byte USART1 received ("Z"), every change of
-a servo compare register with the value read back from the timer ("P"), the timer set-up and
-the servo calibration ("C", "K"), each accepted GAIT's poll time ("G") and, in gait mode, polls
-more than 1 ms apart ("J"). The ``Tap`` sits between bridge_node and the board's USART1
-pty as a pseudo-terminal pair: it forwards every byte both ways unchanged, frame by frame, and
-records what crossed. Since the board's "Z" lines count the very 0x00 bytes the tap forwarded,
-the k-th delimiter the tap forwarded arrived on the board at ``console.zeros[k]``: each frame
-the bridge sent has a board arrival time, on the board's own clock.
+debug_console.h): the board time of every 0x00 byte USART1 received ("Z"), every change of a
+servo compare register with the value read back from the timer ("P"), the timer set-up and the
+servo calibration ("C", "K"), each accepted GAIT's poll time ("G"), in gait mode polls more
+than 1 ms apart ("J"), and the polls that took a HEARTBEAT or a SERVO_CMD ("T"). The ``Tap``
+sits between bridge_node and the board's USART1 pty as a pseudo-terminal pair: it forwards
+every byte both ways unchanged, frame by frame, and records what crossed. Since the board's "Z"
+lines count the very 0x00 bytes the tap forwarded, the k-th delimiter the tap forwarded arrived
+on the board at ``console.zeros[k]``: each frame the bridge sent has a board arrival time, on
+the board's own clock.
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ class Console:
         self.rx_lost = 0                                # USART1 bytes lost to a full ring
         self.calibration: dict[int, Calibration] = {}
         self.gaits: list[tuple[int, int, int]] = []   # (board ms, gait_id, accepted count)
+        # Board ms of each poll that took a HEARTBEAT (kind 0) or a SERVO_CMD (kind 1).
+        self.taken: dict[int, list[int]] = {0: [], 1: []}
         self.jumps: list[tuple[int, int]] = []        # gait mode: (poll ms, next poll ms)
         self.malformed: list[str] = []
         self._stop = threading.Event()
@@ -89,6 +92,8 @@ class Console:
                 self.lines_dropped, self.rx_lost = numbers[2], numbers[3]
             elif fields[0] == 'G' and len(numbers) == 3:
                 self.gaits.append((numbers[0], numbers[1], numbers[2]))
+            elif fields[0] == 'T' and len(numbers) == 2 and numbers[0] in self.taken:
+                self.taken[numbers[0]].append(numbers[1])
             elif fields[0] == 'J' and len(numbers) == 2:
                 self.jumps.append((numbers[0], numbers[1]))
             elif fields[0] == 'K' and len(numbers) == 5:

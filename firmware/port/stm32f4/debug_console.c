@@ -111,9 +111,24 @@ void trace_compare(unsigned servo)
 static uint32_t accepted_seen;
 static uint32_t poll_seen_ms;
 static bool poll_seen;
+static uint32_t taken_seen_ms[2];   /* the take times of the last "T" lines, by kind */
+static bool taken_seen[2];
+
+/* A "T" line when the core's time of the last frame of ``kind`` moved: the poll that took it. */
+static void trace_taken(int32_t kind, bool heard, uint32_t taken_ms)
+{
+    if (heard && (!taken_seen[kind] || taken_ms != taken_seen_ms[kind])) {
+        taken_seen[kind] = true;
+        taken_seen_ms[kind] = taken_ms;
+        const int32_t taken[2] = {kind, (int32_t)taken_ms};
+        line('T', taken, 2u);
+    }
+}
 
 void trace_poll(const wf_app_t *app)
 {
+    trace_taken(0, app->host_seen, app->last_heartbeat_ms);
+    trace_taken(1, app->commands_applied != 0u, app->last_command_ms);
     if (app->gaits_accepted != accepted_seen) {
         accepted_seen = app->gaits_accepted;
         const int32_t gait[3] = {(int32_t)app->now_ms, (int32_t)app->gait_id,

@@ -20,6 +20,10 @@
  *                         took over from (the CPG had been stepped up to it with the old ones)
  *   "J <ms_before> <ms>"  gait mode, two polls in a row more than 1 ms apart (QEMU descheduled,
  *                         or a late SysTick): the input of the core's CPG backlog rule
+ *   "T <kind> <ms>"       a poll took a HEARTBEAT (kind 0) or a SERVO_CMD (kind 1): the poll's
+ *                         time, from which the core's timeout of that kind runs (a frame's
+ *                         "Z" says when it arrived; the core reads at most 512 bytes a poll,
+ *                         so behind a backlog it takes the frame some polls later)
  * It takes one-letter commands on its input, to make the firmware fail on purpose:
  *   "H" a HardFault (an undefined instruction with UsageFault not enabled: escalated),
  *   "W" the poll loop hangs (the watchdog resets), "S" a stack overflow (unbounded recursion).
