@@ -93,6 +93,23 @@ class Probe:
                 next_cmd += 1.0 / rate_hz
             self.executor.spin_once(timeout_sec=0.002)
 
+    def command_until_measured(self, command: list[float], timeout_s: float = 20.0,
+                               tolerance_rad: float = 1e-3) -> bool:
+        """
+        Stream ``command`` on servo_cmd until servo_state reads it back; return whether it did.
+
+        The servos slew and lag, and on a loaded machine the fish's simulated time can run
+        behind the wall clock: how long they take is not the claim, that they get there is.
+        """
+        def measured() -> bool:
+            return bool(self.servo) and all(
+                abs(got - want) <= tolerance_rad
+                for got, want in zip(self.servo[-1].position, command, strict=True))
+        deadline = time.monotonic() + timeout_s
+        while not measured() and time.monotonic() < deadline:
+            self.spin_for(0.1, command=command)
+        return measured()
+
     def statuses(self, node: str = '') -> list[DiagnosticStatus]:
         """Return the bridge statuses received so far, of ``node`` (a name prefix) if given."""
         return [s for array in self.diagnostics for s in array.status

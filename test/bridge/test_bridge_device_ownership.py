@@ -103,5 +103,5 @@ def test_a_stale_link_to_a_reused_terminal_gets_no_byte_and_a_new_fish_is_found(
     probe.spin_for(1.5, command=[0.3, -0.2])
     fake_device.read_available()
     assert fake_device.received == b''
-    assert probe.servo[-1].position.tolist() == pytest.approx([0.3, -0.2], abs=1e-3)
+    assert probe.command_until_measured([0.3, -0.2]), probe.servo[-1:]
     assert bridge.poll() is None

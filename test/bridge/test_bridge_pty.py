@@ -25,8 +25,7 @@ def test_servo_commands_reach_the_fish_and_come_back_measured(
     start_fish(link)
     start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
-    probe.spin_for(1.5, command=[0.3, -0.2])
-    assert probe.servo[-1].position.tolist() == pytest.approx([0.3, -0.2], abs=1e-3)
+    assert probe.command_until_measured([0.3, -0.2]), probe.servo[-1:]
 
 
 def test_imu_data_arrives_at_100_hz(start_fish, start_bridge, probe, tmp_path):
@@ -95,8 +94,7 @@ def test_bridge_commands_neutral_when_servo_cmd_stops(start_fish, start_bridge, 
     start_fish(link, '--command-timeout', '10')
     start_bridge(link, f'command_timeout_s:={COMMAND_TIMEOUT_S}')
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
-    probe.spin_for(1.5, command=[0.4, 0.3])
-    assert probe.servo[-1].position.tolist() == pytest.approx([0.4, 0.3], abs=1e-3)
+    assert probe.command_until_measured([0.4, 0.3]), probe.servo[-1:]
     last_command = probe.node.get_clock().now().nanoseconds * 1e-9
     probe.servo.clear()
     probe.spin_for(COMMAND_TIMEOUT_S + 1.5)
