@@ -13,9 +13,10 @@ The one ``main()`` of every wirefish node: signals, rclpy, the node, its executo
    callback at a time until a signal; a ``WIREFISH_EXECUTOR`` that names no executor ends the
    process with one FATAL line and exit code 1;
 4. the node leaves the executor (one spin lets the events executor release it) and is
-   destroyed (its threads joined), so it leaves the graph at once; then the context is shut
-   down; the process then ends with exit code 0 at once (``exit_now``),
-   without the interpreter's own finalisation.
+   destroyed (its threads joined), so it leaves the graph at once, its participant a moment
+   later (``graph_exit``: so that it stays gone); then the context is shut down; the process
+   then ends with exit code 0 at once (``exit_now``), without the interpreter's own
+   finalisation.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from wirefish_common.executors import (executor_kind, make_executor, settle,
                                        spin_until_stopped)
+from wirefish_common.graph_exit import destroy_leaving_the_graph
 from wirefish_common.parameter_table import InvalidParameters
 from wirefish_common.shutdown import begin_teardown, exit_now, SignalShutdown
 
@@ -94,7 +96,7 @@ def run_node(node_class: Callable[[], Node], args: list[str] | None = None,
             settle(executor)
         except (ExternalShutdownException, RuntimeError):  # the context is already shut down
             pass
-        node.destroy_node()
+        destroy_leaving_the_graph(node)
         # No executor.shutdown(): exit_now follows, and what it would free the exit frees. Its
         # teardown of the removed node's entities (the events executor's, with the GIL held)
         # was seen to hang: bridge_node's main thread in executor.shutdown() until the 6 s

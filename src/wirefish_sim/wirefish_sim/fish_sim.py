@@ -249,8 +249,9 @@ class GroundTruthPublisher:
             publisher.publish(msg)
 
     def close(self) -> None:
-        """Destroy the node and shut rclpy down."""
-        self.node.destroy_node()
+        """Destroy the node (it leaves the others' graphs for good) and shut rclpy down."""
+        from wirefish_common.graph_exit import destroy_leaving_the_graph
+        destroy_leaving_the_graph(self.node)
         self._rclpy.try_shutdown()
 
 

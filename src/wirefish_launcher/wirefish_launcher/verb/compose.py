@@ -61,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
     from rclpy.executors import MultiThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
     from wirefish_common.executors import executor_kind, make_executor, spin_until_stopped
+    from wirefish_common.graph_exit import destroy_leaving_the_graph
     from wirefish_common.parameter_table import InvalidParameters
     from wirefish_common.shutdown import SignalShutdown
 
@@ -106,10 +107,10 @@ def run(args: argparse.Namespace) -> int:
         if own_thread.is_alive():
             own_thread.join(5.0)
         # Nodes go before the executor: their threads are joined while it can take a task.
-        for node in reversed(nodes):
+        for node in nodes:
             if node.executor is executor:
                 executor.remove_node(node)
-            node.destroy_node()
+        destroy_leaving_the_graph(list(reversed(nodes)))
         executor.shutdown()
         rclpy.try_shutdown()
     return 0
