@@ -47,7 +47,7 @@ from rclpy.serialization import deserialize_message
 from ros_utils import stop_process
 from sensor_msgs.msg import JointState
 from wirefish_bringup.graph import default_params_file, entries, expected_rates, fish_graph
-from wirefish_common.topics import message_class
+from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC, message_class
 from wirefish_msgs.srv import RetuneGait
 import yaml
 
@@ -76,8 +76,9 @@ KILL_MARGIN_S = 1.0  # the recorder flushes every 0.5 s: a kill loses at most ab
 # The restarted recorder records again once it is up and has found the topics (it rescans the
 # graph every 0.5 s): a fresh process on the loaded machine, within this bound.
 RECORDER_BACK_S = 15.0
-# /diagnostics has a publisher per node: its numbers interleave several sequences.
-UNCHECKED_TOPICS = ('/diagnostics',)
+# /diagnostics has a publisher per node, and the clock's holds one per holding node (the
+# planner, the kinematics): their numbers interleave several sequences.
+UNCHECKED_TOPICS = ('/diagnostics', f'{NAMESPACE}/{LOCKSTEP_HOLD_TOPIC}')
 
 
 def _full(topic: str) -> str:

@@ -18,14 +18,15 @@ ORIGIN_NS = 1_000 * 1_000_000_000
 
 @pytest.fixture
 def held(ros_context) -> Iterator:
-    """Yield (executor, set_clock(ns), send_imu(ns), answers, planner) on the test's clock."""
+    """Yield (executor, set_clock(ns), send_imu(ns), answers, holders) on the test's clock."""
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
     from rclpy.qos import qos_profile_sensor_data
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import Imu
-    from wirefish_common.qos import CLOCK, RELIABLE
+    from std_msgs.msg import Header
+    from wirefish_common.qos import CLOCK, HOLD
     from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
     from wirefish_planner.planner_node import PlannerNode
 
@@ -34,9 +35,13 @@ def held(ros_context) -> Iterator:
                           parameter_overrides=[Parameter('use_sim_time', value=True)])
     peer = rclpy.create_node('clock_owner', namespace=NAMESPACE, context=ros_context)
     answers: list[int] = []
-    peer.create_subscription(Clock, LOCKSTEP_HOLD_TOPIC,
-                             lambda m: answers.append(m.clock.sec * 10**9 + m.clock.nanosec),
-                             RELIABLE)
+    holders: set[str] = set()
+
+    def on_answer(msg: Header) -> None:
+        answers.append(msg.stamp.sec * 10**9 + msg.stamp.nanosec)
+        holders.add(msg.frame_id)
+
+    peer.create_subscription(Header, LOCKSTEP_HOLD_TOPIC, on_answer, HOLD)
     clock = peer.create_publisher(Clock, 'clock', CLOCK)
     imu = peer.create_publisher(Imu, 'imu/data', qos_profile_sensor_data)
 
@@ -57,7 +62,7 @@ def held(ros_context) -> Iterator:
     executor.add_node(planner)
     executor.add_node(peer)
     try:
-        yield executor, set_clock, send_imu, answers, planner
+        yield executor, set_clock, send_imu, answers, holders
     finally:
         executor.shutdown()
         peer.destroy_node()
@@ -84,7 +89,7 @@ def _first_answer(executor, set_clock, send_imu, answers) -> int:
 
 @pytest.mark.ros
 def test_each_tick_says_the_next_one_is_due_a_control_period_later(held):
-    executor, set_clock, send_imu, answers, _ = held
+    executor, set_clock, send_imu, answers, holders = held
     due = _first_answer(executor, set_clock, send_imu, answers)
     for _ in range(3):
         send_imu(due)
@@ -92,6 +97,7 @@ def test_each_tick_says_the_next_one_is_due_a_control_period_later(held):
         assert spin_until(executor, lambda: answers[-1] > due, 5.0)
         assert answers[-1] == due + TICK_NS
         due = answers[-1]
+    assert holders == {f'{NAMESPACE}/planner_node'}  # its name: the clock keeps a hold per node
 
 
 @pytest.mark.ros

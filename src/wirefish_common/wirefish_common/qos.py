@@ -47,3 +47,7 @@ TF_STATIC_LISTENER = latched(100)
 # /clock of the simulated-time road (fish_sim): rclpy's TimeSource takes it best effort, depth 1;
 # a reliable writer serves it as well as a reader that wants every step (a test's probe).
 CLOCK = reliable(1)
+# The holding nodes' next ticks (clock_hold): several nodes answer on one fish's topic and its
+# clock waits for each one's answer, so none may push another's out before fish_sim takes it
+# (it takes them every millisecond while held; 100 is seconds of answers).
+HOLD = reliable(100)

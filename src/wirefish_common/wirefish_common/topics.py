@@ -7,9 +7,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 DIAGNOSTICS_TOPIC = '/diagnostics'
-# On the virtual fish's clock, a node that feeds the fish back on a timer (the planner) says
-# here when its next tick is due (rosgraph_msgs/Clock): fish_sim holds the clock there until
-# it answers again (wirefish_sim.lockstep).
+# On the virtual fish's clock, a node whose timer must see every period (the planner, the
+# kinematics) says here when its next tick is due (std_msgs/Header: the time, its name):
+# fish_sim holds the clock there until it answers again (clock_hold, wirefish_sim.lockstep).
 LOCKSTEP_HOLD_TOPIC = 'lockstep/next_tick'
 
 

@@ -15,13 +15,13 @@ Publishes
     ``planner_state`` (wirefish_msgs/PlannerState, reliable, depth 10) at ``control_rate_hz``;
     ``/diagnostics`` (diagnostic_msgs/DiagnosticArray) at 1 Hz.
     On simulated time (``use_sim_time``), after every control tick, ``lockstep/next_tick``
-    (rosgraph_msgs/Clock, reliable): when the next tick is due. The virtual fish's clock waits
-    there for the tick's answer, so a fast clock never makes the loops skip a period
-    (``wirefish_sim.lockstep``). A tick whose imu/data lags the clock (its newest sample more
-    than ``INPUT_FRESH_S`` older than the tick) waits for the sample first, polling on the wall
-    clock for at most ``INPUT_WAIT_S``: the clock is held meanwhile, so at ``--speed max`` a
-    starved bridge slows the graph down instead of leaving the loops without their input. After
-    a wait that ran out it waits again only once a sample has come.
+    (std_msgs/Header, reliable; ``wirefish_common.clock_hold``): when the next tick is due.
+    The virtual fish's clock waits there for the tick's answer, so a fast clock never makes
+    the loops skip a period (``wirefish_sim.lockstep``). A tick whose imu/data lags the clock
+    (its newest sample more than ``INPUT_FRESH_S`` older than the tick) waits for the sample
+    first, polling on the wall clock for at most ``INPUT_WAIT_S``: the clock is held meanwhile,
+    so at ``--speed max`` a starved bridge slows the graph down instead of leaving the loops
+    without their input. After a wait that ran out it waits again only once a sample has come.
 Drives
     cpg_node (``cpg_node_name``) by its control topic: ``cpg_command`` (wirefish_msgs/CpgCommand,
     reliable, keep last 1) in the CPG node's namespace, the whole target set at every control
@@ -53,22 +53,20 @@ from __future__ import annotations
 import math
 import time
 
-from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
 from rclpy.clock import Clock as RclClock, ClockType
 from rclpy.node import Node
 from rclpy.task import Future
 from rclpy.timer import Timer
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Trigger
 from wirefish_common.batch_intake import BatchIntake, intake_qos
 from wirefish_common.cdr_views import CdrError, read_imu
+from wirefish_common.clock_hold import ClockHold
 from wirefish_common.node_main import run_node
 from wirefish_common.parameter_table import NodeParameters
 from wirefish_common.qos import COMMAND, LATCHED, RELIABLE
-from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
 from wirefish_cpg.cpg_control import TargetSource
 from wirefish_cpg.cpg_messages import flat_message_values
 from wirefish_msgs.msg import CpgCommand, CpgParams, CpgStatus, PlannerState
@@ -102,6 +100,7 @@ class PlannerNode(Node):
     def __init__(self, **kwargs) -> None:
         """Declare the parameters, build the planner, wire topics and timers."""
         super().__init__('planner_node', **kwargs)
+        self._hold = ClockHold(self)
         self._node_parameters = NodeParameters(self, TABLE, self._apply)
         self._values = self._node_parameters.values  # live: a set is in it before _apply
         self._planner = planner_from(self._values)
@@ -125,8 +124,6 @@ class PlannerNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', RELIABLE)
         self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                 self._on_control)
-        self._hold_pub = (self.create_publisher(Clock, LOCKSTEP_HOLD_TOPIC, RELIABLE)
-                          if self.get_parameter('use_sim_time').value else None)
         self._newest_imu_s: float | None = None  # the newest imu/data stamp taken
         self._input_came = True  # a sample came since the last wait that ran out
         self._waiting: tuple[float, float] | None = None  # (tick, wall start) of a waiting tick
@@ -144,7 +141,8 @@ class PlannerNode(Node):
             self._control_timer.cancel()
             self._control_timer = self.create_timer(1.0 / self._values['control_rate_hz'],
                                                     self._on_control)
-            self._say_next_tick()  # the clock may be held at the cancelled timer's tick
+            # The clock may be held at the cancelled timer's tick.
+            self._hold.say_next_tick(self._control_timer)
             self._subscribe_imu()  # its queue holds the samples of two ticks
         if 'cpg_node_name' in names:
             self.destroy_publisher(self._command_pub)
@@ -284,7 +282,7 @@ class PlannerNode(Node):
 
     def _input_lags(self, tick: float) -> bool:
         """Return whether a tick on simulated time should wait for imu/data (see module)."""
-        return (self._hold_pub is not None and self._input_came
+        return (self._hold.on_simulated_time and self._input_came
                 and self._newest_imu_s is not None
                 and tick - self._newest_imu_s > INPUT_FRESH_S)
 
@@ -322,16 +320,7 @@ class PlannerNode(Node):
         else:
             self._send(cpg_values(out))
         self._state_pub.publish(self._state_message(out, now))
-        self._say_next_tick()
-
-    def _say_next_tick(self) -> None:
-        """On simulated time, publish when the control timer's next tick is due."""
-        until_ns = self._control_timer.time_until_next_call()
-        if self._hold_pub is None or until_ns is None:
-            return
-        due = self.get_clock().now().nanoseconds + max(0, until_ns)
-        sec, nanosec = divmod(due, 1_000_000_000)
-        self._hold_pub.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
+        self._hold.say_next_tick(self._control_timer)
 
     def _manual(self) -> bool:
         status = self._cpg_status

@@ -8,6 +8,8 @@ from wirefish_common.input_checks import parse_speed, speed_text
 from wirefish_sim.lockstep import clock_origin_ns, ENGAGE_STEPS, LockstepClock
 
 STEP_NS = 10_000_000
+PLANNER = '/fish/planner_node'  # the holding nodes, by their fully qualified names
+KINEMATICS = '/fish/kinematics_node'
 
 
 def _engaged_clock(speed: float = math.inf, fish: int = 1) -> LockstepClock:
@@ -106,21 +108,21 @@ def test_simulated_time_starts_on_a_whole_step_of_the_wall_clock():
 def test_a_holding_node_keeps_the_clock_at_its_next_tick_until_it_answers():
     clock = _engaged_clock()
     tick = clock.time_ns + 2 * STEP_NS
-    clock.on_hold(0, tick)
+    clock.on_hold(0, PLANNER, tick)
     for wall in (1.0, 1.01):  # up to the tick: the commands alone decide
         clock.on_command(0)
         assert clock.ready(wall)
         clock.advance(wall)
     assert clock.time_ns == tick
     clock.on_command(0)
-    assert clock.held_by() == [0] and not clock.ready(1.02)  # the tick's answer is owed
-    clock.on_hold(0, tick + 5 * STEP_NS)
+    assert clock.held_by() == [(0, PLANNER)] and not clock.ready(1.02)  # the tick's answer is owed
+    clock.on_hold(0, PLANNER, tick + 5 * STEP_NS)
     assert clock.held_by() == [] and clock.ready(1.02)
 
 
 def test_a_holding_node_silent_for_the_grace_is_released_until_it_answers_again():
     clock = _engaged_clock()
-    clock.on_hold(0, clock.time_ns)
+    clock.on_hold(0, PLANNER, clock.time_ns)
     clock.on_command(0)
     assert not clock.ready(10.0)
     assert clock.wait_s(10.0) == pytest.approx(2.0)
@@ -128,14 +130,47 @@ def test_a_holding_node_silent_for_the_grace_is_released_until_it_answers_again(
     assert clock.counters.hold_releases == 1 and clock.held_by() == []
     assert clock.counters.releases == 0  # the host streamed: it still holds the clock
     clock.advance(12.0)
-    clock.on_hold(0, clock.time_ns)  # back: it holds again
+    clock.on_hold(0, PLANNER, clock.time_ns)  # back: it holds again
     clock.on_command(0)
-    assert clock.held_by() == [0] and not clock.ready(12.01)
+    assert clock.held_by() == [(0, PLANNER)] and not clock.ready(12.01)
 
 
 def test_each_fish_of_a_fleet_is_held_by_its_own_node():
     clock = _engaged_clock(fish=2)
-    clock.on_hold(1, clock.time_ns)
+    clock.on_hold(1, PLANNER, clock.time_ns)
     clock.on_command(0)
     clock.on_command(1)
-    assert clock.held_by() == [1] and not clock.ready(1.0)
+    assert clock.held_by() == [(1, PLANNER)] and not clock.ready(1.0)
+
+
+def test_two_nodes_hold_one_fish_and_the_step_waits_for_the_later_answer():
+    clock = _engaged_clock()
+    clock.on_hold(0, PLANNER, clock.time_ns + 4 * STEP_NS)
+    clock.on_hold(0, KINEMATICS, clock.time_ns)
+    clock.on_command(0)
+    assert clock.held_by() == [(0, KINEMATICS)] and not clock.ready(1.0)
+    clock.on_hold(0, KINEMATICS, clock.time_ns + 2 * STEP_NS)
+    assert clock.held_by() == [] and clock.ready(1.0)
+
+
+def test_a_silent_holder_is_released_while_the_other_still_holds():
+    clock = _engaged_clock()
+    clock.on_hold(0, PLANNER, clock.time_ns)
+    clock.on_hold(0, KINEMATICS, clock.time_ns)
+    clock.on_command(0)
+    assert not clock.ready(10.0)
+    clock.on_hold(0, PLANNER, clock.time_ns + STEP_NS)  # answers; the kinematics never does
+    assert clock.ready(12.0)
+    assert clock.counters.hold_releases == 1
+    clock.advance(12.0)
+    clock.on_command(0)
+    assert clock.held_by() == [(0, PLANNER)]  # the one that answered holds at its next tick
+
+
+def test_a_restarted_holder_takes_its_predecessors_place():
+    clock = _engaged_clock()
+    clock.on_hold(0, KINEMATICS, clock.time_ns)  # then killed: its tick is owed
+    clock.on_command(0)
+    assert not clock.ready(1.0)
+    clock.on_hold(0, KINEMATICS, clock.time_ns + STEP_NS)  # the restarted node, same name
+    assert clock.ready(1.0) and clock.counters.hold_releases == 0

@@ -195,13 +195,14 @@ class GroundTruthPublisher:
         self.publishers = [self.node.create_publisher(
             Odometry, prefixed(name, 'sim/ground_truth'), RELIABLE) for name in names]
         self._clock_publisher: Any = None  # an rclpy Publisher once the clock is published
-        # Each fish's holding node (its planner) says when its next tick is due; no executor
-        # spins this node: the lockstep loop takes the answers itself (``take_holds``).
-        from rosgraph_msgs.msg import Clock
+        # Each fish's holding nodes (its planner, its kinematics) say when their next ticks are
+        # due; no executor spins this node: the lockstep loop takes the answers (``take_holds``).
+        from std_msgs.msg import Header
+        from wirefish_common.qos import HOLD
         from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
         self._holds = [
-            self.node.create_subscription(Clock, prefixed(name, LOCKSTEP_HOLD_TOPIC),
-                                          _taken_not_called, RELIABLE)
+            self.node.create_subscription(Header, prefixed(name, LOCKSTEP_HOLD_TOPIC),
+                                          _taken_not_called, HOLD)
             for name in names]
 
     def publish_clock(self, time_ns: int) -> None:
@@ -217,15 +218,14 @@ class GroundTruthPublisher:
         sec, nanosec = divmod(time_ns, 1_000_000_000)
         self._clock_publisher.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
 
-    def take_holds(self) -> list[tuple[int, int]]:
-        """Return (fish, next tick in ns) of each fish whose holding node answered since."""
+    def take_holds(self) -> list[tuple[int, str, int]]:
+        """Return (fish, holder, next tick in ns) of each answer of a holding node since."""
         answers = []
         for fish, subscription in enumerate(self._holds):
-            latest = None
             while (taken := subscription.handle.take_message(subscription.msg_type, False)):
-                latest = taken[0].clock
-            if latest is not None:
-                answers.append((fish, latest.sec * 1_000_000_000 + latest.nanosec))
+                stamp = taken[0].stamp
+                answers.append((fish, taken[0].frame_id,
+                                stamp.sec * 1_000_000_000 + stamp.nanosec))
         return answers
 
     def publish(self, school: Sequence[VirtualFish], time_ns: int | None = None) -> None:
@@ -413,8 +413,8 @@ def _run_lockstep(args: argparse.Namespace, fleet: VirtualFleet, links: Sequence
         stalled = stalls.index(elapsed) is not None
         for index in _exchange(fleet, links, closing, stalled):
             clock.on_command(index)
-        for index, next_tick_ns in ground_truth.take_holds() if ground_truth else ():
-            clock.on_hold(index, next_tick_ns)
+        for index, holder, next_tick_ns in ground_truth.take_holds() if ground_truth else ():
+            clock.on_hold(index, holder, next_tick_ns)
         now = time.monotonic()
         engaged = list(clock.engaged)  # ready() releases a fish whose host went silent
         if clock.ready(now):
