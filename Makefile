@@ -27,9 +27,12 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 	else echo "firmware: ARM build skipped: install gcc-arm-none-eabi and" \
 	  "libnewlib-arm-none-eabi (make setup does it as root)"; fi
 
-# The whole suite in two runs on both cores: every package's pure tests (src/*/test: no ROS
-# process), then the workspace tests that start nodes and graphs (test/). There a file's tests
-# stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
+# The whole suite in two runs side by side: every package's pure tests (src/*/test: no ROS
+# process) and the workspace tests that start nodes and graphs (test/). The pure tests are
+# CPU-bound and short (~100 CPU s); test/ mostly waits and left a third of both cores idle (910
+# CPU s in its 737 s), so the pure tests take that, a step lower in priority (nice 5: test/'s
+# wall-clock claims keep their share), and their output follows test/'s (PURE_LOG): two runs
+# one after the other took 57 s more. In test/ a file's tests stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
 # owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
 # files are dealt in collection order, which puts the longest first
 # (test/support/module_order.py).
@@ -41,10 +44,17 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # A crashed worker (a test hung in C code is ended so: pytest.ini) ends the run of test/: under
 # --dist loadfile xdist 3.8 gives a replacement worker the crashed test again, and a run once
 # waited on that for good (test/test_scheduling.py).
+PURE_LOG := log/pure-tests.log
 test: setup  ## the whole suite, lint included
-	@$(WFENV) python -m pytest -n $(FAST_JOBS) src $(PYTEST_ARGS)
-	@$(WFENV) python -m pytest -n $(GRAPH_JOBS) --dist loadfile --no-loadscope-reorder \
-		--max-worker-restart 0 test $(PYTEST_ARGS)
+	@mkdir -p $(dir $(PURE_LOG))
+	@echo "make test: src/*/test runs beside test/ (nice 5); its output follows ($(PURE_LOG))"
+	@$(WFENV) nice -n 5 python -m pytest -n $(FAST_JOBS) src \
+		$(filter-out --basetemp=%,$(PYTEST_ARGS)) > $(PURE_LOG) 2>&1 & pure=$$!; \
+	WIREFISH_MACHINE_SLOTS=$(GRAPH_SLOTS) $(WFENV) python -m pytest -n $(GRAPH_JOBS) \
+		--dist loadfile --no-loadscope-reorder --max-worker-restart 0 test $(PYTEST_ARGS); \
+	graphs=$$?; wait $$pure; pure=$$?; cat $(PURE_LOG); \
+	if [ $$pure -ne 0 ]; then echo "make test: src/*/test failed (above)"; fi; \
+	exit $$(( graphs != 0 ? graphs : pure ))
 
 # The quick loop: every package's pure tests and every linter (flake8, pep257, mypy, the
 # package.xml check); no ROS process is started and the paper's experiments (wirefish_analysis:
@@ -57,21 +67,26 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 	test/test_spdx.py
 
 # pytest-xdist workers, from the cores this process may use (`nproc`: `taskset -c 0` gives one):
-# one per core for the pure tests, one and a half per core for the graphs of test/ (they mostly
-# wait on the clock; see machine_share.py), rounded down: three on two cores, one on one. Two
+# one per core for the pure tests; for the graphs of test/, slots of the machine one and a half
+# per core (they mostly wait on the clock; see machine_share.py), rounded down: three on two
+# cores, one on one; and a worker more than the slots, for the modules that barely load the
+# machine (``barely_loads_machine``: they hold no slot; not on one core). Two
 # on one core put two modules on it, twice the share of the two-core run, and its wall-clock
 # claims failed beside each other (a radio drive 3.5 % off its wired reference, a bound of 3;
 # the bridge's imu/data stamps at 105 Hz; the loaded recording; the dashboard's radio cut).
-# A fourth on the 2-core reference machine gained nothing: test/ took 824 s against 806 s with
-# three (fresh clones, both green), its modules waiting 969 s in all for slots against 481 s,
-# behind the modules that load the machine (they keep all slots but one). Four ran the light
+# A fourth slot on the 2-core reference machine gained nothing: test/ took 824 s against 806 s
+# with three (fresh clones, both green), its modules waiting 969 s in all for slots against
+# 481 s, behind the modules that load the machine (they keep all slots but one); a fourth worker
+# without a slot runs what barely loads the machine beside them (19 modules, ~370 s of a run's
+# 1,734 held s at 0.03-0.25 of a core each). Four ran the light
 # modules four at a time before there were such slots: each took longer (the whole graph 46 ->
 # 78 s, the bridge's pty 67 -> 110 s) and wall-clock ones failed.
 # At most four: each worker owns a window of 20 ROS domain ids (test/conftest.py), and four fill
 # 21..100, Fast DDS's portable range.
 CORES := $(shell nproc)
 FAST_JOBS ?= $(CORES)
-GRAPH_JOBS ?= $(shell n=$$(( $(CORES) * 3 / 2 )); echo $$(( n < 4 ? n : 4 )))
+GRAPH_SLOTS ?= $(shell n=$$(( $(CORES) * 3 / 2 )); echo $$(( n < 1 ? 1 : n < 3 ? n : 3 )))
+GRAPH_JOBS ?= $(shell n=$(GRAPH_SLOTS); echo $$(( n < 2 ? 1 : n + 1 < 4 ? n + 1 : 4 )))
 
 test-fast: setup  ## cores and lint, no node processes (under a minute)
 	@$(WFENV) python -m pytest -n $(FAST_JOBS) -m "not ros" $(FAST_TESTS) $(PYTEST_ARGS)

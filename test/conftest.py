@@ -16,7 +16,7 @@ import subprocess
 import sys
 import time
 
-from machine_share import heavy_weight, machine_share, slot_count
+from machine_share import heavy_weight, machine_share, slot_count, SLOTS_VARIABLE
 from module_order import module_rank
 import pytest
 from ros_utils import domain_context, stop_process
@@ -136,11 +136,17 @@ def machine_slots(request: pytest.FixtureRequest,
     Run each module on its share of the machine (machine_share.py): all slots but one if heavy.
 
     The slots are shared by the run's workers (lock files in the run's base temp); mark a
-    module that loads the machine itself ``pytest.mark.loads_machine``.
+    module that loads the machine itself ``pytest.mark.loads_machine``, one that barely does
+    (it holds no slot) ``pytest.mark.barely_loads_machine``.
     """
     workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
-    slots = slot_count(workers)
-    weight = heavy_weight(slots) if request.node.get_closest_marker('loads_machine') else 1
+    slots = slot_count(workers, os.environ.get(SLOTS_VARIABLE))
+    if request.node.get_closest_marker('loads_machine'):
+        weight = heavy_weight(slots)
+    elif request.node.get_closest_marker('barely_loads_machine'):
+        weight = 0
+    else:
+        weight = 1
     run_directory = tmp_path_factory.getbasetemp()  # a worker's is popen-gwK in the run's
     if _WORKER:
         run_directory = run_directory.parent

@@ -15,6 +15,7 @@ import configparser
 import fcntl
 import os
 from pathlib import Path
+import re
 import subprocess
 import sys
 import threading
@@ -49,8 +50,9 @@ def _graph_run_words() -> list[str]:
     env = {k: v for k, v in os.environ.items() if k not in ('MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
     commands = subprocess.run(['make', '-n', 'test', 'PYTEST_ARGS='], cwd=WORKSPACE, env=env,
                               capture_output=True, text=True, check=True).stdout
-    return next(line for line in commands.replace('\\\n', ' ').splitlines()
-                if '--dist loadfile' in line).split()
+    # One shell line runs both pytest runs (the pure tests in the background): its commands.
+    shell_commands = re.split(r'[;&]', commands.replace('\\\n', ' '))
+    return next(command for command in shell_commands if '--dist loadfile' in command).split()
 
 
 def test_make_test_deals_files_in_collection_order():
@@ -130,9 +132,9 @@ def test_a_module_that_loads_the_machine_waits_for_two_free_slots(tmp_path):
     assert starts['late'] >= starts['heavy']
 
 
-@pytest.mark.parametrize('weight', [0, 4])
-def test_a_weight_outside_one_to_the_slots_is_refused(tmp_path, weight):
-    with pytest.raises(ValueError, match='1 to 3 of 3'):
+@pytest.mark.parametrize('weight', [-1, 4])
+def test_a_weight_outside_zero_to_the_slots_is_refused(tmp_path, weight):
+    with pytest.raises(ValueError, match='0 to 3 of 3'):
         with machine_share(tmp_path, 3, weight):
             pass
 
@@ -140,6 +142,44 @@ def test_a_weight_outside_one_to_the_slots_is_refused(tmp_path, weight):
 @pytest.mark.parametrize('slots', [2, 3, 4])
 def test_a_module_that_loads_the_machine_leaves_one_slot_to_the_rest(slots):
     assert heavy_weight(slots) == slots - 1
+
+
+def test_on_one_slot_a_module_that_loads_the_machine_holds_it():
+    assert heavy_weight(1) == 1
+
+
+def test_a_module_that_barely_loads_the_machine_runs_while_every_slot_is_held(tmp_path):
+    events: list = []
+    holders = [_hold(tmp_path, 3, 1, events, f'm{i}', 1.0) for i in range(3)]
+    _wait_for(lambda: len(events) == 3)  # every slot held for a second more
+    barely = _hold(tmp_path, 3, 0, events, 'barely', 0.0)
+    barely.join(timeout=30.0)
+    for thread in holders:
+        thread.join(timeout=30.0)
+    ran = [t for t, name, _ in events if name == 'barely']
+    freed = [t for t, name, change in events if change < 0]
+    assert len(ran) == 2 and max(ran) < min(freed)  # in and out before any slot came free
+
+
+def test_the_configured_slots_are_one_to_the_workers():
+    assert slot_count(4, '3') == 3 and slot_count(1, '1') == 1 and slot_count(3) == 3
+    with pytest.raises(ValueError, match='1 to 4 slots for 4 workers'):
+        slot_count(4, '5')
+
+
+def _make_test_words(*variables: str) -> list[str]:
+    env = {k: v for k, v in os.environ.items() if k not in ('MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
+    commands = subprocess.run(['make', '-n', 'test', 'PYTEST_ARGS=', *variables], cwd=WORKSPACE,
+                              env=env, capture_output=True, text=True, check=True).stdout
+    return commands.replace('\\\n', ' ').split()
+
+
+@pytest.mark.parametrize('slots, workers', [('3', '4'), ('2', '3'), ('1', '1')])
+def test_make_test_runs_a_worker_beyond_the_slots_for_barely_loading_modules(slots, workers):
+    words = _make_test_words(f'GRAPH_SLOTS={slots}')
+    graph_run = words.index('--dist') - 2  # ... pytest -n WORKERS --dist loadfile ...
+    assert words[graph_run:graph_run + 2] == ['-n', workers]
+    assert f'WIREFISH_MACHINE_SLOTS={slots}' in words
 
 
 HANG = """

@@ -9,6 +9,9 @@ import time
 import pytest
 from wirefish_bag.verb.play import remapped
 
+# It mostly waits (0.11 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 COUNT = 40
 

@@ -9,7 +9,8 @@ from ros_utils import PEERS
 from wirefish_bag.bagfile import read_bag
 from wirefish_bag.report import topic_stats, write_report
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.24 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 
 def test_recorded_bag_holds_every_published_message(tmp_path, spawn, python, ros_env):

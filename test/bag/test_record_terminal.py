@@ -9,6 +9,9 @@ import time
 
 import pytest
 
+# It mostly waits (0.19 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 
 @pytest.mark.ros
 def test_the_record_bar_has_no_log_lines_in_it(ros_env, talker_namespace, tmp_path):

@@ -7,6 +7,9 @@ import threading
 
 import pytest
 
+# It mostly waits (0.15 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 
 @pytest.mark.ros
 def test_a_namespace_without_topics_is_warned_about(ros_env, ros_context, talker_namespace,

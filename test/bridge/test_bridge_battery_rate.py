@@ -7,7 +7,8 @@ import time
 import pytest
 from wirefish_bridge.protocol import Telemetry
 
-pytestmark = pytest.mark.ros
+# In-process and brief, it mostly waits: no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 FRAME = Telemetry(board_time_ms=0, roll=0.0, pitch=0.0, yaw=0.0, gyro=(0.0, 0.0, 0.0),
                   accel=(0.0, 0.0, 9.8), servo_1=0.0, servo_2=0.0, battery_v=8.0, status=0)

@@ -15,7 +15,8 @@ import pytest
 from ros_utils import spin_until, stop_process
 from wirefish_bridge.protocol import Heartbeat, Role, ServoCommand
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.23 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 
 def _connected(probe, node: str = '') -> bool:

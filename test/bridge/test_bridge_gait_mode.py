@@ -19,7 +19,8 @@ from wirefish_bridge.protocol import (Ack, Gait, LinkConfig, MsgType, ServoComma
 from wirefish_common.qos import LATCHED
 from wirefish_msgs.msg import CpgParams
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.21 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 PARAMS = GaitParameters(1.2, (0.3, 0.4), (0.05, 0.05), 4.0, 4.0, -0.6, 0.6, 20.0)
 TELEMETRY = Telemetry(board_time_ms=0, roll=0.0, pitch=0.0, yaw=0.1, gyro=(0.0, 0.0, 0.0),

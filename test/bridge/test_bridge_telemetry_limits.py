@@ -7,7 +7,8 @@ import time
 import pytest
 from wirefish_bridge.protocol import Telemetry
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.19 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 VALID = Telemetry(board_time_ms=0, roll=0.0, pitch=0.1, yaw=-0.2, gyro=(0.0, 0.0, 0.3),
                   accel=(0.1, 0.0, 9.8), servo_1=0.2, servo_2=-0.1, battery_v=8.0, status=0)

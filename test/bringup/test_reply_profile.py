@@ -17,6 +17,9 @@ import pytest
 from ros_utils import spin_until
 from wirefish_bringup.dds_profile import reply_writer_names
 
+# It mostly waits (0.09 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 PROBE = Path(__file__).resolve().parents[2] / 'tools' / 'probes' / 'reply_probe.py'
 
 

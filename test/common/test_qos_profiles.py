@@ -14,7 +14,8 @@ from ros_utils import probe_node, spin_until
 from std_msgs.msg import Int32
 from wirefish_common.qos import COMMAND, LATCHED, RELIABLE, reliable, SENSOR_DATA
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.03 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 DELIVERY_S = 0.5  # how long the published samples are given to reach the reader's history
 QUIET_S = 0.5  # a reader that took nothing for this long has taken everything it kept

@@ -9,7 +9,8 @@ import pytest
 from ros_utils import spin_until, stop_process
 from std_srvs.srv import Trigger
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.21 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 
 
 def test_servo_cmd_streams_both_servos_and_converges_to_the_table1_amplitudes(spawn, probe):

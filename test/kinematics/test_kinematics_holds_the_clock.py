@@ -12,6 +12,9 @@ from collections.abc import Iterator
 import pytest
 from ros_utils import spin_until
 
+# In-process and brief, it mostly waits: no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 NAMESPACE = '/kinematics_hold'
 STEP_NS = 10_000_000  # one servo_cmd per step, as the CPG's 100 Hz
 TICK_NS = 20_000_000  # publish_rate_hz 50

@@ -12,7 +12,8 @@ from wirefish_kinematics.geometry import FishGeometry
 from wirefish_kinematics.tail_beat import estimate_speed_over
 from wirefish_kinematics.wire_coupling import bend_angles
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.11 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 G = FishGeometry()
 POSE_A = (0.3, -0.2)
 POSE_B = (-0.1, 0.4)

@@ -3,7 +3,8 @@
 
 import pytest
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.11 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 POSE = (0.3, -0.2)
 BODY_WAVES = 60  # body_wave messages to observe after the first markers
 

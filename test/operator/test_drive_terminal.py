@@ -15,6 +15,9 @@ import time
 import pytest
 from ros_utils import spin_until
 
+# It mostly waits (0.12 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 NAMESPACE = '/drive_pty'
 STEP = 0.05, 0.1  # drive's default speed and turn steps (m/s, rad/s)
 # (what is written, in pieces) -> the (speed, yaw rate) drive must send after it

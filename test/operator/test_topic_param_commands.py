@@ -10,6 +10,9 @@ import time
 
 import pytest
 
+# It mostly waits (0.18 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 NAMESPACE = '/topic_param'
 CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 

@@ -20,6 +20,9 @@ import time
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 import pytest
 
+# It mostly waits (0.25 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 NAMESPACE = '/h24_restart'
 WAIT_S = 30.0
 CONFIGURED_HZ = 1.0  # cpg_node's frequency_hz in the params file (Table 1 at 1 Hz)

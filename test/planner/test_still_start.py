@@ -15,6 +15,9 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from ros_utils import spin_until
 
+# It mostly waits (0.28 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 NAMESPACE = '/still_start'
 STILL_S = 2.0
 

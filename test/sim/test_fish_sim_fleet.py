@@ -19,7 +19,8 @@ from wirefish_bridge.codec import FrameEncoder, StreamDecoder
 from wirefish_bridge.protocol import Heartbeat, ServoCommand, Status, Telemetry
 
 BIN = Path(get_package_prefix('wirefish_sim')) / 'lib' / 'wirefish_sim'
-pytestmark = pytest.mark.ros
+# It mostly waits (0.23 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 NAMES = ('fish_1', 'fish_2', 'fish_3')
 NAMESPACE = '/sim_fleet'
 

@@ -6,11 +6,14 @@ Most of test/ waits on graphs (real-time ones, or simulated ones paced at real t
 test` runs more workers than the machine has cores; but a few modules load the machine
 themselves (busy loops beside a recording, an emulated STM32, a browser), and beside two other
 modules their real-time streams starved (seen with three workers: a failsafe of the QEMU board,
-a recording 1.8 s behind, a dashboard that never plotted). So the machine has as many slots as
-workers (at least two): a module holds one slot while it runs, a module that loads the machine
-holds all but one (``heavy_weight``: one light module runs beside it), and those modules run one
-at a time. Slots are lock files shared by the run's workers; a module takes its slots through a
-turnstile lock, so a module that needs several is not overtaken by ones that need one.
+a recording 1.8 s behind, a dashboard that never plotted). So the machine has slots (as many as
+workers, at least two, unless `make test` says how many: ``SLOTS_VARIABLE``): a module holds
+one slot while it runs, a module that loads the machine holds all but one (``heavy_weight``: one
+light module runs beside it), and those modules run one at a time. A module that barely loads
+the machine (its graph or node mostly waits: on discovery, a service, a deadline, a few
+messages; at most ~0.25 of a core in full runs) holds none: `make test` runs a worker more than
+the slots for them. Slots are lock files shared by the run's workers; a module takes its slots
+through a turnstile lock, so a module that needs several is not overtaken by ones that need one.
 """
 
 from __future__ import annotations
@@ -23,16 +26,29 @@ import time
 from typing import IO
 
 POLL_S = 0.2
+# The slots `make test` gives the machine (its workers are one more: test/conftest.py).
+SLOTS_VARIABLE = 'WIREFISH_MACHINE_SLOTS'
 
 
-def slot_count(workers: int) -> int:
-    """Return the machine's slots for a run of ``workers`` workers (at least two)."""
-    return max(2, workers)
+def slot_count(workers: int, configured: str | None = None) -> int:
+    """
+    Return the machine's slots for a run of ``workers`` workers.
+
+    ``configured`` (``SLOTS_VARIABLE``'s value, from `make test`) if given: 1 to ``workers``.
+    Else as many as the workers, at least two.
+    """
+    if configured is None:
+        return max(2, workers)
+    slots = int(configured)
+    if not 1 <= slots <= max(1, workers):
+        raise ValueError(f'{SLOTS_VARIABLE}={configured}: 1 to {max(1, workers)} slots for '
+                         f'{workers} workers')
+    return slots
 
 
 def heavy_weight(slots: int) -> int:
-    """Return the slots a module that loads the machine holds: all but one."""
-    return slots - 1
+    """Return the slots a module that loads the machine holds: all but one (one of one)."""
+    return max(1, slots - 1)
 
 
 @contextmanager
@@ -60,9 +76,12 @@ def _try_slot(path: Path, stack: ExitStack) -> bool:
 
 @contextmanager
 def machine_share(directory: Path, slots: int, weight: int) -> Iterator[None]:
-    """Hold ``weight`` of the ``slots`` slots kept in ``directory`` while inside."""
-    if not 1 <= weight <= slots:
-        raise ValueError(f'a module holds 1 to {slots} of {slots} slots, not {weight}')
+    """Hold ``weight`` of the ``slots`` slots kept in ``directory`` while inside (0: none)."""
+    if not 0 <= weight <= slots:
+        raise ValueError(f'a module holds 0 to {slots} of {slots} slots, not {weight}')
+    if weight == 0:  # a module that barely loads the machine runs beside the slots' modules
+        yield
+        return
     with ExitStack() as stack:
         if weight > 1:  # the modules that load the machine take turns
             stack.enter_context(_locked(directory / 'loads_machine.lock'))

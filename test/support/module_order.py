@@ -3,8 +3,9 @@
 The order `make test` deals test/'s modules to its workers in: the longest first.
 
 The modules below hold the machine longest (a minute or more each: the ``held_s`` of
-``machine_share.jsonl`` in a full run's base temp). `make test` runs test/ as `-n 3 --dist
-loadfile --no-loadscope-reorder`, so xdist deals the files in collection order, and conftest.py
+``machine_share.jsonl`` in a full run's base temp). `make test` runs test/ as `-n 4 --dist
+loadfile --no-loadscope-reorder` on two cores (three slots and a worker for the modules that
+barely load the machine), so xdist deals the files in collection order, and conftest.py
 collects these first. By default xdist deals the files with most tests first, so these one-test
 files came last (the drive, the mission, the two hosts and the fleet once ran after everything
 else and test/ took 9.6 min); dealt first, they run side by side while the short files fill the

@@ -19,7 +19,8 @@ from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
 from wirefish_operator.goal_sender import FEEDBACK_DEPTH, GoalSender
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.20 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 CPG_NAMES = ['frequency_hz', 'amplitude_1', 'amplitude_2', 'w12', 'w21', 'phi12', 'phi21',
              'alpha']
 

@@ -12,7 +12,8 @@ from wirefish_cpg.gait_library import load_library
 from wirefish_msgs.msg import BodyWaveSpec
 from wirefish_msgs.srv import RetuneGait
 
-pytestmark = pytest.mark.ros
+# It mostly waits (0.28 of a core in a full run): no machine slot (machine_share.py).
+pytestmark = [pytest.mark.ros, pytest.mark.barely_loads_machine]
 PAPER_RMSE_DEG = (1.7165, 1.2817)
 CPG_NAMES = ['frequency_hz', 'amplitude_1', 'amplitude_2', 'offset_1', 'offset_2', 'w12',
              'w21', 'phi12', 'phi21', 'alpha']
