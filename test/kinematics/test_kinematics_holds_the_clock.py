@@ -9,6 +9,7 @@ on ``lockstep/next_tick`` and the body_wave they let through.
 
 from collections.abc import Iterator
 
+from clock_owner import ClockOwner, on_simulated_time, stamp
 import pytest
 from ros_utils import spin_until
 
@@ -24,55 +25,31 @@ ORIGIN_NS = 1_000 * 1_000_000_000
 @pytest.fixture
 def held(ros_context) -> Iterator:
     """Yield (executor, step(ns), answers, holders, body_wave stamps) on the test's clock."""
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.parameter import Parameter
     from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
-    from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import Header
-    from wirefish_common.qos import CLOCK, HOLD
-    from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
     from wirefish_kinematics.kinematics_node import KinematicsNode
     from wirefish_msgs.msg import BodyWave
 
-    node = KinematicsNode(context=ros_context, namespace=NAMESPACE,
-                          cli_args=['--ros-args', '-r', f'/clock:={NAMESPACE}/clock'],
-                          parameter_overrides=[Parameter('use_sim_time', value=True)])
-    peer = rclpy.create_node('clock_owner', namespace=NAMESPACE, context=ros_context)
-    answers: list[int] = []
-    holders: set[str] = set()
+    node = KinematicsNode(context=ros_context, **on_simulated_time(NAMESPACE))
+    owner = ClockOwner(ros_context, NAMESPACE, node)
     body: list[int] = []
-
-    def on_answer(msg: Header) -> None:
-        answers.append(msg.stamp.sec * 10**9 + msg.stamp.nanosec)
-        holders.add(msg.frame_id)
-
-    peer.create_subscription(Header, LOCKSTEP_HOLD_TOPIC, on_answer, HOLD)
-    peer.create_subscription(
+    owner.node.create_subscription(
         BodyWave, 'body_wave',
         lambda m: body.append(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec),
         QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT))
-    clock = peer.create_publisher(Clock, 'clock', CLOCK)
-    servo = peer.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)
+    servo = owner.node.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)
 
     def step(time_ns: int) -> None:
         """Publish the servo command of the step at ``time_ns``, then the clock there."""
         msg = JointState(name=['servo_1', 'servo_2'], position=[0.1, -0.1])
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(time_ns, 10**9)
+        msg.header.stamp = stamp(time_ns)
         servo.publish(msg)
-        stamp = Clock()
-        stamp.clock.sec, stamp.clock.nanosec = divmod(time_ns, 10**9)
-        clock.publish(stamp)
+        owner.set_clock(time_ns)
 
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    executor.add_node(peer)
     try:
-        yield executor, step, answers, holders, body
+        yield owner.executor, step, owner.answers, owner.holders, body
     finally:
-        executor.shutdown()
-        peer.destroy_node()
+        owner.close()
         node.destroy_node()
 
 

@@ -8,6 +8,7 @@ reads what the planner answers on ``lockstep/next_tick`` (what fish_sim waits fo
 
 from collections.abc import Iterator
 
+from clock_owner import ClockOwner, on_simulated_time, stamp
 import pytest
 from ros_utils import spin_until
 
@@ -19,38 +20,13 @@ ORIGIN_NS = 1_000 * 1_000_000_000
 @pytest.fixture
 def held(ros_context) -> Iterator:
     """Yield (executor, set_clock(ns), send_imu(ns), answers, holders) on the test's clock."""
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.parameter import Parameter
     from rclpy.qos import qos_profile_sensor_data
-    from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import Imu
-    from std_msgs.msg import Header
-    from wirefish_common.qos import CLOCK, HOLD
-    from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
     from wirefish_planner.planner_node import PlannerNode
 
-    planner = PlannerNode(context=ros_context, namespace=NAMESPACE,
-                          cli_args=['--ros-args', '-r', f'/clock:={NAMESPACE}/clock'],
-                          parameter_overrides=[Parameter('use_sim_time', value=True)])
-    peer = rclpy.create_node('clock_owner', namespace=NAMESPACE, context=ros_context)
-    answers: list[int] = []
-    holders: set[str] = set()
-
-    def on_answer(msg: Header) -> None:
-        answers.append(msg.stamp.sec * 10**9 + msg.stamp.nanosec)
-        holders.add(msg.frame_id)
-
-    peer.create_subscription(Header, LOCKSTEP_HOLD_TOPIC, on_answer, HOLD)
-    clock = peer.create_publisher(Clock, 'clock', CLOCK)
-    imu = peer.create_publisher(Imu, 'imu/data', qos_profile_sensor_data)
-
-    def stamp(time_ns: int):
-        from builtin_interfaces.msg import Time
-        return Time(sec=time_ns // 10**9, nanosec=time_ns % 10**9)
-
-    def set_clock(time_ns: int) -> None:
-        clock.publish(Clock(clock=stamp(time_ns)))
+    planner = PlannerNode(context=ros_context, **on_simulated_time(NAMESPACE))
+    owner = ClockOwner(ros_context, NAMESPACE, planner)
+    imu = owner.node.create_publisher(Imu, 'imu/data', qos_profile_sensor_data)
 
     def send_imu(time_ns: int) -> None:
         msg = Imu()
@@ -58,14 +34,10 @@ def held(ros_context) -> Iterator:
         msg.orientation.w = 1.0
         imu.publish(msg)
 
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(planner)
-    executor.add_node(peer)
     try:
-        yield executor, set_clock, send_imu, answers, holders
+        yield owner.executor, owner.set_clock, send_imu, owner.answers, owner.holders
     finally:
-        executor.shutdown()
-        peer.destroy_node()
+        owner.close()
         planner.destroy_node()
 
 
