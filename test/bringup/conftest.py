@@ -18,15 +18,9 @@ def e2e_domain_id() -> int:
 
 @pytest.fixture(scope='module')
 def running_graph(e2e_domain_id: int, tmp_path_factory, request) -> Iterator[RunningGraph]:
-    """
-    Yield one whole graph shared by the module's observation tests; stop it afterwards.
-
-    At the module's ``GRAPH_SPEED`` (`wirefish up --speed`) if it has one, else the default.
-    """
+    """Yield one whole graph shared by the module's observation tests; stop it afterwards."""
     namespace = '/e2e_' + request.module.__name__.rsplit('.', 1)[-1]  # one per module
-    speed = getattr(request.module, 'GRAPH_SPEED', None)
-    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'),
-                        *(('--speed', speed) if speed else ()), namespace=namespace)
+    graph = start_graph(e2e_domain_id, tmp_path_factory.mktemp('e2e_run'), namespace=namespace)
     with stopped_on_exit(graph):
         yield graph
 
