@@ -6,6 +6,7 @@ import os
 import subprocess
 import time
 
+import numpy as np
 import pytest
 from ros_utils import spin_until, stop_process
 from sensor_msgs.msg import JointState
@@ -13,6 +14,7 @@ from wirefish_bridge.protocol import ServoCommand
 
 pytestmark = pytest.mark.ros
 COMMAND_TIMEOUT_S = 1.0  # the bridge's command_timeout_s in the failsafe test
+RATE_WINDOW_S = 6.0
 
 
 def _stamp(msg) -> float:
@@ -34,10 +36,15 @@ def test_imu_data_arrives_at_100_hz(start_fish, start_bridge, probe, tmp_path):
     start_bridge(link)
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     probe.imu.clear()
-    probe.spin_for(6.0)
-    stamps = [_stamp(m) for m in probe.imu]
-    rate = (len(stamps) - 1) / (stamps[-1] - stamps[0])
-    print(f'imu/data: {len(stamps)} messages, {rate:.2f} Hz')
+    probe.spin_for(RATE_WINDOW_S)
+    stamps = np.array([_stamp(m) for m in probe.imu])
+    # The stamps are the bridge's receipt times of a wall-clock fish: on a starved machine the
+    # fish writes the frames it owes in a burst, so the first and last stamps alone mislead
+    # (615 frames within 5.81 s of stamps, "105.8 Hz", beside two CPU hogs): the rate is the
+    # slope of all the stamps against their count.
+    rate = 1.0 / np.polyfit(np.arange(len(stamps)), stamps, 1)[0]
+    span = (len(stamps) - 1) / (stamps[-1] - stamps[0])
+    print(f'imu/data: {len(stamps)} messages, {rate:.2f} Hz (first to last stamp {span:.2f} Hz)')
     assert rate == pytest.approx(100.0, rel=0.05)
     assert probe.imu[-1].header.frame_id == 'imu_link'
 
