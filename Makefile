@@ -32,10 +32,10 @@ firmware:  ## the firmware: host port, and the ARM images (flash/RAM use) if arm
 # CPU-bound and short (~100 CPU s); test/ mostly waits and left a third of both cores idle (910
 # CPU s in its 737 s), so the pure tests take that, a step lower in priority (nice 5: test/'s
 # wall-clock claims keep their share), and their output follows test/'s (PURE_LOG): two runs
-# one after the other took 57 s more. In test/ a file's tests stay on one worker (--dist loadfile: a module's graph is shared by its tests) and each worker
-# owns its own window of ROS domain ids (test/conftest.py); every test its own namespace. The
-# files are dealt in collection order, which puts the longest first
-# (test/support/module_order.py).
+# one after the other took 57 s more. A file's tests stay on one worker (pytest.ini's --dist
+# loadfile: a module's graph is shared by its tests) and each worker owns its own window of ROS
+# domain ids (test/conftest.py); every test its own namespace. The files of test/ are dealt in
+# collection order, which puts the longest first (test/support/module_order.py).
 # Most of test/ waits on graphs (real-time ones, or simulated ones paced at real time), so it
 # runs on more workers than cores. A module that loads the machine itself (the loaded recording,
 # QEMU, the dashboard) would starve the real-time streams of the modules beside it, so it holds
@@ -51,7 +51,7 @@ test: setup  ## the whole suite, lint included
 	@$(WFENV) nice -n 5 python -m pytest -n $(FAST_JOBS) src \
 		$(filter-out --basetemp=%,$(PYTEST_ARGS)) > $(PURE_LOG) 2>&1 & pure=$$!; \
 	WIREFISH_MACHINE_SLOTS=$(GRAPH_SLOTS) $(WFENV) python -m pytest -n $(GRAPH_JOBS) \
-		--dist loadfile --no-loadscope-reorder --max-worker-restart 0 test $(PYTEST_ARGS); \
+		--no-loadscope-reorder --max-worker-restart 0 test $(PYTEST_ARGS); \
 	graphs=$$?; wait $$pure; pure=$$?; cat $(PURE_LOG); \
 	if [ $$pure -ne 0 ]; then echo "make test: src/*/test failed (above)"; fi; \
 	exit $$(( graphs != 0 ? graphs : pure ))

@@ -52,7 +52,8 @@ def _graph_run_words() -> list[str]:
                               capture_output=True, text=True, check=True).stdout
     # One shell line runs both pytest runs (the pure tests in the background): its commands.
     shell_commands = re.split(r'[;&]', commands.replace('\\\n', ' '))
-    return next(command for command in shell_commands if '--dist loadfile' in command).split()
+    return next(command for command in shell_commands
+                if '--no-loadscope-reorder' in command).split()
 
 
 def test_make_test_deals_files_in_collection_order():
@@ -60,6 +61,35 @@ def test_make_test_deals_files_in_collection_order():
     # one-test long modules come last whatever the collection order.
     run = _graph_run_words()
     assert '--no-loadscope-reorder' in run and 'test' in run
+
+
+MODULE_ON_ONE_WORKER = """
+import os
+from pathlib import Path
+
+import pytest
+
+
+@pytest.mark.parametrize('k', range(6))
+def test_says_its_worker(k):
+    Path(os.environ['WORKERS_SEEN'], f'{k}.txt').write_text(os.environ['PYTEST_XDIST_WORKER'])
+"""
+
+
+def test_a_modules_tests_stay_on_one_worker_under_any_n(tmp_path):
+    # A module's graph is module-scoped, under the module's namespace: on two workers it would
+    # be started twice under one name (pytest.ini's --dist loadfile, for `make test` and for a
+    # developer's `pytest -n 2 test/bringup/test_restart.py` alike).
+    (tmp_path / 'test_module.py').write_text(MODULE_ON_ONE_WORKER)
+    seen = tmp_path / 'seen'
+    seen.mkdir()
+    subprocess.run([sys.executable, '-m', 'pytest', '-c', str(WORKSPACE / 'pytest.ini'),
+                    '--rootdir', str(tmp_path), '-n', '2', '-q',
+                    str(tmp_path / 'test_module.py')],
+                   cwd=tmp_path, env={**os.environ, 'WORKERS_SEEN': str(seen)},
+                   capture_output=True, text=True, check=True, timeout=120)
+    workers = {path.read_text() for path in seen.glob('*.txt')}
+    assert len(list(seen.glob('*.txt'))) == 6 and len(workers) == 1
 
 
 def _hold(directory: Path, slots: int, weight: int, events: list, name: str,
@@ -177,7 +207,7 @@ def _make_test_words(*variables: str) -> list[str]:
 @pytest.mark.parametrize('slots, workers', [('3', '4'), ('2', '3'), ('1', '1')])
 def test_make_test_runs_a_worker_beyond_the_slots_for_barely_loading_modules(slots, workers):
     words = _make_test_words(f'GRAPH_SLOTS={slots}')
-    graph_run = words.index('--dist') - 2  # ... pytest -n WORKERS --dist loadfile ...
+    graph_run = words.index('--no-loadscope-reorder') - 2  # ... -n WORKERS --no-loadscope...
     assert words[graph_run:graph_run + 2] == ['-n', workers]
     assert f'WIREFISH_MACHINE_SLOTS={slots}' in words
 

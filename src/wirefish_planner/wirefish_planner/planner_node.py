@@ -22,6 +22,11 @@ Publishes
     first, polling on the wall clock for at most ``INPUT_WAIT_S``: the clock is held meanwhile,
     so at ``--speed max`` a starved bridge slows the graph down instead of leaving the loops
     without their input. After a wait that ran out it waits again only once a sample has come.
+    A tick that owes the CPG its start (commanded, the start not yet answered: its service not
+    yet discovered, or the call in flight) answers only once the start is answered, polling on
+    the wall clock for at most ``START_WAIT_S``: the fish starts at the command's time of the
+    graph's clock at any ``--speed``, not when discovery and the call's round trip (wall time)
+    let it. After a wait that ran out the ticks go on until that start is answered.
 Drives
     cpg_node (``cpg_node_name``) by its control topic: ``cpg_command`` (wirefish_msgs/CpgCommand,
     reliable, keep last 1) in the CPG node's namespace, the whole target set at every control
@@ -81,9 +86,15 @@ WARN_THROTTLE_S = 2.0
 # The fastest imu/data the intake's queue is sized for (twice the board's 100 Hz telemetry):
 # two control ticks' samples at that rate.
 MAX_IMU_RATE_HZ = 200.0
-# A start call that got no answer in this long (s, node clock) is made again: a request to a
-# server that has just appeared, or its reply, can be lost (start is idempotent).
+# A start call that got no answer in this long (wall s) is made again: a request to a server
+# that has just appeared, or its reply, can be lost (start is idempotent). Wall time: a tick
+# that waits for the answer holds the graph's clock.
 START_RETRY_S = 1.0
+# How long (wall s) a tick on simulated time waits for the CPG's start it owes, polling every
+# START_POLL_S: discovery of a graph just started takes seconds on a loaded machine; below the
+# clock's grace for a silent holder (wirefish_sim.lockstep.DEFAULT_GRACE_S).
+START_WAIT_S = 3.0
+START_POLL_S = 0.01
 # On simulated time, how old (s of the graph's clock) the newest imu/data sample may be at a
 # control tick: the bridge stamps a sample with the last step of the clock it heard, and one
 # sample of the 100 Hz stream may be lost (best effort).
@@ -115,7 +126,9 @@ class PlannerNode(Node):
         self._start_pending = False  # the CPG's start is due, its service not yet seen
         self._cpg_started = False  # a start call was answered (by this cpg_node or one before)
         self._cpg_was_ready: bool | None = None  # the CPG's start service at the last tick
-        self._start_call: tuple[float, Future] | None = None  # (when, its answer) in flight
+        self._start_call: tuple[float, Future] | None = None  # (wall s, answer) in flight
+        self._start_wait: tuple[float, Timer] | None = None  # (wall start, poll) of a tick
+        self._start_wait_ran_out = False  # ticks go on without the owed start until answered
         self._wire_cpg()
         self.create_subscription(Twist, 'cmd_vel', self._on_cmd_vel, RELIABLE)
         self._imu_intake: BatchIntake | None = None
@@ -207,14 +220,16 @@ class PlannerNode(Node):
             if answer.done():
                 self._start_call = None
                 self._start_pending = False
+                self._start_wait_ran_out = False
                 self._cpg_started = True
-            elif self._now_s() - sent_s >= START_RETRY_S:
+            elif time.monotonic() - sent_s >= START_RETRY_S:
                 self._start_client.remove_pending_request(answer)  # no answer: call again
                 self._start_call = None
             else:
                 return
         if self._start_pending and ready:
-            self._start_call = (self._now_s(), self._start_client.call_async(Trigger.Request()))
+            self._start_call = (time.monotonic(),
+                                self._start_client.call_async(Trigger.Request()))
 
     # --- inputs ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
@@ -271,6 +286,8 @@ class PlannerNode(Node):
     def _on_control(self) -> None:
         if self._waiting is not None:  # the clock went on without the tick (released)
             self._end_wait()
+        if self._start_wait is not None:
+            self._end_start_wait()
         now = self._now_s()
         self._take_imu(now)
         if self._input_lags(now):
@@ -320,6 +337,37 @@ class PlannerNode(Node):
         else:
             self._send(cpg_values(out))
         self._state_pub.publish(self._state_message(out, now))
+        if self._owes_start():
+            self._start_wait = (time.monotonic(), self.create_timer(
+                START_POLL_S, self._poll_start, clock=RclClock(clock_type=ClockType.STEADY_TIME)))
+            return
+        self._hold.say_next_tick(self._control_timer)
+
+    def _owes_start(self) -> bool:
+        """Return whether a tick on simulated time should wait for the CPG's start (module)."""
+        return (self._hold.on_simulated_time and self._start_pending
+                and not self._start_wait_ran_out)
+
+    def _poll_start(self) -> None:
+        assert self._start_wait is not None
+        self._start_cpg()
+        if not self._owes_start():
+            self._end_start_wait()
+        elif time.monotonic() - self._start_wait[0] > START_WAIT_S:
+            self._start_wait_ran_out = True
+            ready = self._start_client.service_is_ready()
+            self.get_logger().warn(
+                f'the CPG did not answer its start within {START_WAIT_S:g} s '
+                f'({"called" if ready else "its start service not seen"}); the ticks go on '
+                'and the start is called again until it answers',
+                throttle_duration_sec=WARN_THROTTLE_S)
+            self._end_start_wait()
+
+    def _end_start_wait(self) -> None:
+        """Answer the tick that waited for the CPG's start."""
+        assert self._start_wait is not None
+        self.destroy_timer(self._start_wait[1])
+        self._start_wait = None
         self._hold.say_next_tick(self._control_timer)
 
     def _manual(self) -> bool:
