@@ -77,10 +77,10 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 # A fourth slot on the 2-core reference machine gained nothing: test/ took 824 s against 806 s
 # with three (fresh clones, both green), its modules waiting 969 s in all for slots against
 # 481 s, behind the modules that load the machine (they keep all slots but one); a fourth worker
-# without a slot runs what barely loads the machine beside them (19 modules, ~370 s of a run's
-# 1,734 held s at 0.03-0.25 of a core each). Four ran the light
-# modules four at a time before there were such slots: each took longer (the whole graph 46 ->
-# 78 s, the bridge's pty 67 -> 110 s) and wall-clock ones failed.
+# without a slot runs what barely loads the machine beside them (``barely_loads_machine``: 0.03
+# to 0.29 of a core each in full runs; ~400 s of the 1,573 slot-s of an idle run). Four ran the
+# light modules four at a time before there were such slots: each took longer (the whole graph
+# 46 -> 78 s, the bridge's pty 67 -> 110 s) and wall-clock ones failed.
 # At most four: each worker owns a window of 20 ROS domain ids (test/conftest.py), and four fill
 # 21..100, Fast DDS's portable range.
 CORES := $(shell nproc)

@@ -15,6 +15,10 @@ import time
 
 import pytest
 
+# Short-lived processes that mostly wait on a missing graph: 0.20-0.29 of a core in full runs,
+# no timing claim; no machine slot (machine_share.py).
+pytestmark = pytest.mark.barely_loads_machine
+
 CLI = [sys.executable, '-m', 'wirefish_cli.cli']
 # command -> (exit code, what its one line says)
 REFUSED = {

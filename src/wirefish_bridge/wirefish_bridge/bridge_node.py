@@ -17,7 +17,8 @@ LINK_CONFIG (telemetry period and form, HEALTH period, link timeout, coast time:
 parameters of the same names) goes out when the fish identifies itself, again until an ACK
 accepts it, in gait mode or whenever it differs from the fish's boot defaults; until that ACK
 neither a GAIT nor a SERVO_CMD goes out (the fish rests on its failsafe meanwhile).
-Publishes (sensor-data QoS, stamped on receipt with the node clock)
+Publishes (sensor-data QoS, stamped on receipt with the node clock; on simulated time none
+before the graph's clock has started)
     ``imu/data`` (sensor_msgs/Imu, frame ``imu_frame_id``), ``attitude``
     (geometry_msgs/Vector3Stamped: roll, pitch, yaw rad), ``servo_state`` (sensor_msgs/JointState,
     the servo angles the fish reports: the board's commanded angle after its clamp, the
@@ -467,7 +468,10 @@ class BridgeNode(Node):
             (log.error if level is Level.ERROR else log.info)(text)
 
     def _publish_telemetry(self, telemetry: Telemetry) -> None:
-        stamp = self.get_clock().now().to_msg()
+        now = self.get_clock().now()
+        if now.nanoseconds == 0:  # on simulated time the graph's clock has not started:
+            return  # a stamp of 0 would place the sample nowhere (the virtual fish boots first)
+        stamp = now.to_msg()
         frame_id = prefixed(self._frame_prefix, self._values['imu_frame_id'])
         tilt = self._values['orientation_stddev_rad']
         self._imu_pub.publish(imu_message(
