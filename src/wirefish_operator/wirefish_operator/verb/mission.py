@@ -3,12 +3,14 @@
 `wirefish mission FILE`: drive the planner through timed cmd_vel legs, record, plot the path.
 
 FILE is a mission YAML (``wirefish_operator.mission_plan``) or the name of a shipped one
-(``square``). The mission keeps the virtual fish's time: the stamps of its ground truth, which
-are simulated time on `wirefish up --sim` (lockstep at its ``--speed``: a mission on
-``--speed max`` takes as little wall time as the graph needs) and the wall clock's on the
-real-time roads. The legs go to ``<namespace>/cmd_vel`` at 20 Hz of that time once the
-planner answers; the
-whole namespace is recorded into a rosbag2 (MCAP) bag (``wirefish_bag.recorder``, as
+(``square``). It starts once the graph answers: planner_state and the ground truth heard, and
+the bridge's /diagnostics saying the link is up and the fish hears the host (no
+FAILSAFE_HEARTBEAT: a bridge that has not yet heard the graph's clock sends no heartbeat, and
+the fish ignores every command meanwhile). The mission keeps the virtual fish's time: the
+stamps of its ground truth, which are simulated time on `wirefish up --sim` (lockstep at its
+``--speed``: a mission on ``--speed max`` takes as little wall time as the graph needs) and the
+wall clock's on the real-time roads. The legs go to ``<namespace>/cmd_vel`` at 20 Hz of that
+time; the whole namespace is recorded into a rosbag2 (MCAP) bag (``wirefish_bag.recorder``, as
 `wirefish record`); afterwards the report PNG (x-y path from sim/ground_truth with heading
 arrows, speed and yaw rate against the setpoints) and the closure error are written and printed.
 """
@@ -113,7 +115,8 @@ class _Run:
 
     ``turn_gain`` is the planner's own parameter, for judging the gain the run identifies
     (``turn_gain_answer``: the planner's answer to the question); ``planner_heard``: a
-    planner_state came; ``hinted``: what is waited for was said; ``progress``: the legs'
+    planner_state came; ``fish_driven``: the bridge's last status says the fish hears the host;
+    ``hinted``: what is waited for was said; ``progress``: the legs'
     progress, from the first leg's start; ``fish_now``: the last ground truth's stamp;
     ``sent_at``: when (the fish's time) the last command went.
     """
@@ -125,6 +128,7 @@ class _Run:
     turn_gain: float | None = None
     turn_gain_answer: Future | None = None
     planner_heard: bool = False
+    fish_driven: bool = False
     hinted: bool = False
     progress: Progress | None = None
     fish_now: float | None = None
@@ -150,6 +154,7 @@ def _drive(mission, namespace: str, bag_path: Path,
 
 def _drive_in(session: RosSession, signals, mission, bag_path: Path,
               wait_s: float) -> tuple[float | None, str | None, bool, float | None]:
+    from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
     from rcl_interfaces.msg import ParameterType
@@ -176,6 +181,15 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
         run.planner_heard = True
 
     node.create_subscription(PlannerState, 'planner_state', on_state, reliable)
+    bridge_status = f'{namespace.rstrip("/")}/bridge_node:'
+
+    def on_diagnostics(message: DiagnosticArray) -> None:
+        for status in message.status:
+            if status.name.startswith(bridge_status):
+                values = {pair.key: pair.value for pair in status.values}
+                run.fish_driven = fish_hears_host(values)
+
+    node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, reliable)
     speeds: deque[tuple[float, float]] = deque()  # (fish's s, |surge speed| m/s), last 1 s
 
     def on_truth(message: Odometry) -> None:
@@ -224,7 +238,7 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
         if run.rest_from is not None or run.problem is not None:
             return
         waited = time.monotonic() - started
-        if (run.planner_heard and run.fish_now is not None
+        if (run.planner_heard and run.fish_driven and run.fish_now is not None
                 and recorder.count(truth_topic) > 0):
             run.rest_from = run.fish_now
             print(f'mission {mission.name}: {len(mission.legs)} legs, '
@@ -234,14 +248,16 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
                 request = GetParameters.Request(names=['turn_gain'])
                 run.turn_gain_answer = parameters.call_async(request)
         elif waited > wait_s:
-            run.problem = (f'no planner_state and sim/ground_truth under {namespace} '
-                           f'within {wait_s:g} s: are the graph and the planner running? '
-                           f'(wirefish up --namespace {namespace}); nothing was written')
+            run.problem = (f'no {_missing(run, recorder.count(truth_topic) > 0)} under '
+                           f'{namespace} within {wait_s:g} s: are the graph and the planner '
+                           f'running? (wirefish up --namespace {namespace}); nothing was '
+                           'written')
             rclpy.try_shutdown()
         elif waited > HINT_AFTER_S and not run.hinted:
             run.hinted = True
             print(f'wirefish mission: waiting for planner_state and sim/ground_truth '
-                  f'under {namespace} (is the graph running?)', file=sys.stderr, flush=True)
+                  f'under {namespace}, and a bridge whose fish hears it (is the graph '
+                  'running?)', file=sys.stderr, flush=True)
 
     def drive(t: float) -> None:
         """Rest the fish, then send the leg of the fish's time ``t``; stop after the coast."""
@@ -274,6 +290,26 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
                        if run.t0 is not None
                        else 'interrupted (Ctrl-C) before the first leg; nothing was written')
     return run.t0, run.problem, interrupted, run.turn_gain
+
+
+def fish_hears_host(bridge_values: dict[str, str]) -> bool:
+    """
+    Return whether a bridge's /diagnostics values say its fish is driven by it.
+
+    The link is connected and the fish's status word has no FAILSAFE_HEARTBEAT (PROTOCOL.md's
+    flag names in ``fish_status``, e.g. ``0x0002 (FAILSAFE_HEARTBEAT)``).
+    """
+    status = bridge_values.get('fish_status', 'unknown')
+    return (bridge_values.get('link_state') == 'connected' and status.startswith('0x')
+            and 'FAILSAFE_HEARTBEAT' not in status)
+
+
+def _missing(run: _Run, truth_heard: bool) -> str:
+    """Return what the mission did not hear from the graph, for its one line."""
+    heard = (('planner_state', run.planner_heard), ('sim/ground_truth', truth_heard),
+             ('bridge status whose fish hears the host', run.fish_driven))
+    missing = [name for name, came in heard if not came]
+    return ', '.join(missing) or 'answer'
 
 
 def _phase(mission, t: float) -> str:
