@@ -24,6 +24,9 @@ from wirefish_common.executors import ExecutorKind, make_executor, spin_until_st
 NAMESPACE = '/h181_planner'
 YAW_DISTURBANCE_RAD_S = 0.05  # the current: 2.9 deg/s of yaw on a straight tail
 CMD_RATE_HZ = 20.0
+# How long (wall s) a module's driver waits for the bridge to say its fish hears it: discovery
+# of the graph's clock on a loaded machine.
+FISH_DRIVEN_WAIT_S = 60.0
 
 
 def executable(package: str, name: str) -> str:
@@ -127,6 +130,7 @@ class Recording:
     servo: list = field(default_factory=list)  # (stamp s, p1, p2, v1, v2)
     state: list = field(default_factory=list)  # (t, PlannerState)
     diagnostics: list = field(default_factory=list)  # (t, DiagnosticStatus) of the planner
+    bridge: dict = field(default_factory=dict)  # the bridge's last /diagnostics values
 
 
 class Driver:
@@ -232,6 +236,8 @@ class Driver:
         for status in msg.status:
             if status.name.endswith('/planner_node'):
                 self.recording.diagnostics.append((self.now(), status))
+            elif '/bridge_node:' in status.name:
+                self.recording.bridge = {pair.key: pair.value for pair in status.values}
 
     def set_parameters(self, node_name: str, **values) -> None:
         """Set parameters of a node of the graph (raises if refused)."""
@@ -288,11 +294,23 @@ def simulated_planner_graph(planner_domain_id: int, tmp_path_factory,
 
 @pytest.fixture(scope='module')
 def driver(simulated_planner_graph: PlannerGraph) -> Iterator[Driver]:
-    """Yield the module's driver node on the graph's domain and clock, in a context of its own."""
+    """
+    Yield the module's driver node on the graph's domain and clock, in a context of its own.
+
+    Once the bridge says the fish hears it (as `wirefish mission` waits): a bridge that has not
+    yet heard the graph's clock sends no heartbeat, and the fish ignores every command.
+    """
+    from wirefish_operator.verb.mission import fish_hears_host
+
     planner_graph = simulated_planner_graph
     with domain_context(planner_graph.domain_id) as context:
         probe = Driver(context, planner_graph.namespace, simulated=planner_graph.simulated)
         try:
+            deadline = time.monotonic() + FISH_DRIVEN_WAIT_S
+            while not fish_hears_host(probe.recording.bridge):
+                assert time.monotonic() < deadline, \
+                    f'the bridge never said its fish hears it: {probe.recording.bridge}'
+                time.sleep(0.1)
             yield probe
         finally:
             probe.command = None

@@ -17,8 +17,8 @@ LINK_CONFIG (telemetry period and form, HEALTH period, link timeout, coast time:
 parameters of the same names) goes out when the fish identifies itself, again until an ACK
 accepts it, in gait mode or whenever it differs from the fish's boot defaults; until that ACK
 neither a GAIT nor a SERVO_CMD goes out (the fish rests on its failsafe meanwhile).
-Publishes (sensor-data QoS, stamped on receipt with the node clock; on simulated time none
-before the graph's clock has started)
+Publishes (sensor-data QoS, stamped on receipt with the node clock; on simulated time neither
+these nor a SERVO_CMD before the node has heard the graph's clock)
     ``imu/data`` (sensor_msgs/Imu, frame ``imu_frame_id``), ``attitude``
     (geometry_msgs/Vector3Stamped: roll, pitch, yaw rad), ``servo_state`` (sensor_msgs/JointState,
     the servo angles the fish reports: the board's commanded angle after its clamp, the
@@ -467,11 +467,21 @@ class BridgeNode(Node):
             log = self.get_logger()
             (log.error if level is Level.ERROR else log.info)(text)
 
+    def _on_the_graphs_clock(self) -> bool:
+        """
+        Return False on simulated time until this node has heard the graph's clock.
+
+        Until then its timers do not run, the heartbeat among them, so the fish holds neutral
+        on its heartbeat failsafe: a SERVO_CMD relayed meanwhile would step the lockstep clock
+        with a command the fish ignores (at --speed max 6 s of simulated time went so), and a
+        telemetry sample would be stamped 0, placed nowhere.
+        """
+        return self.get_clock().now().nanoseconds != 0
+
     def _publish_telemetry(self, telemetry: Telemetry) -> None:
-        now = self.get_clock().now()
-        if now.nanoseconds == 0:  # on simulated time the graph's clock has not started:
-            return  # a stamp of 0 would place the sample nowhere (the virtual fish boots first)
-        stamp = now.to_msg()
+        if not self._on_the_graphs_clock():
+            return
+        stamp = self.get_clock().now().to_msg()
         frame_id = prefixed(self._frame_prefix, self._values['imu_frame_id'])
         tilt = self._values['orientation_stddev_rad']
         self._imu_pub.publish(imu_message(
@@ -509,7 +519,7 @@ class BridgeNode(Node):
             with self._gait_lock:
                 self._watch.add_host(self._now_s(), angles)
             return
-        if not self._streams():
+        if not self._streams() or not self._on_the_graphs_clock():
             return
         sweep = self._sweep_command()
         if sweep is not None:   # the wiring sweep's angles go instead (at servo_cmd's pace)
