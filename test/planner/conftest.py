@@ -24,8 +24,8 @@ from wirefish_common.executors import ExecutorKind, make_executor, spin_until_st
 NAMESPACE = '/h181_planner'
 YAW_DISTURBANCE_RAD_S = 0.05  # the current: 2.9 deg/s of yaw on a straight tail
 CMD_RATE_HZ = 20.0
-# How long (wall s) a module's driver waits for the bridge to say its fish hears it: discovery
-# of the graph's clock on a loaded machine.
+# How long (wall s) the driver waits on discovery: for the bridge to say its fish hears it
+# (the graph's clock found), for a node's parameter service.
 FISH_DRIVEN_WAIT_S = 60.0
 
 
@@ -245,7 +245,9 @@ class Driver:
         from rclpy.parameter import Parameter
 
         client = self.node.create_client(SetParameters, f'{node_name}/set_parameters')
-        assert client.wait_for_service(timeout_sec=10.0), f'no {client.srv_name}'
+        # Discovery: beside two CPU hogs on a slow machine 10 s was not enough.
+        assert client.wait_for_service(timeout_sec=FISH_DRIVEN_WAIT_S), \
+            f'no {client.srv_name} within {FISH_DRIVEN_WAIT_S:g} s'
         request = SetParameters.Request(parameters=[
             Parameter(k, value=v).to_parameter_msg() for k, v in values.items()])
         future = client.call_async(request)
