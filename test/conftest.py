@@ -152,7 +152,7 @@ def machine_slots(request: pytest.FixtureRequest,
         run_directory = run_directory.parent
     asked = time.monotonic()
     with machine_share(run_directory, slots, weight):
-        started = time.monotonic()
+        started, started_at = time.monotonic(), time.time()
         cpu_before = _cpu_seconds()
         try:
             yield
@@ -160,6 +160,7 @@ def machine_slots(request: pytest.FixtureRequest,
             # One line per module: what `make test`'s time is made of (waits and holds).
             with open(run_directory / 'machine_share.jsonl', 'a') as log:
                 log.write(json.dumps({'module': request.node.nodeid, 'weight': weight,
+                                      'started_at': round(started_at, 2),
                                       'waited_s': round(started - asked, 2),
                                       'held_s': round(time.monotonic() - started, 2),
                                       'cpu_s': round(_cpu_seconds() - cpu_before, 2)}) + '\n')
