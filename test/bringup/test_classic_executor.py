@@ -59,6 +59,7 @@ def test_a_fish_on_the_classic_executor_streams_at_the_registry_rates_and_stops_
             rclpy.try_shutdown(context=context)
         measured = {t: rates[_full(namespace, t)][1]
                     for t in [*EXPECTED_RATES_HZ, *EXPECTED_MIN_RATES_HZ]}
+        print({t: round(hz, 2) for t, hz in measured.items()})
         off_rate = [problem for t, nominal in EXPECTED_RATES_HZ.items()
                     if (problem := rate_problem(t, measured[t], nominal, RATE_TOLERANCE))]
         too_slow = {t: (round(measured[t], 2), least)
