@@ -80,7 +80,10 @@ FAST_TESTS := $(filter-out src/wirefish_analysis/test,$(wildcard src/*/test)) \
 # without a slot runs what barely loads the machine beside them (``barely_loads_machine``: 0.03
 # to 0.29 of a core each in full runs; ~400 s of the 1,573 slot-s of an idle run). Four ran the
 # light modules four at a time before there were such slots: each took longer (the whole graph
-# 46 -> 78 s, the bridge's pty 67 -> 110 s) and wall-clock ones failed.
+# 46 -> 78 s, the bridge's pty 67 -> 110 s) and wall-clock ones failed. Four slots with the
+# loading modules holding two (a QEMU board beside two graphs) took 707 s against 705 s with
+# three, the machine 93 % busy, and the bridge's serial timing failed: test/ is bound by its CPU
+# (the run prints it: "machine: ... CPU s"), not by how its modules are dealt.
 # At most four: each worker owns a window of 20 ROS domain ids (test/conftest.py), and four fill
 # 21..100, Fast DDS's portable range.
 CORES := $(shell nproc)

@@ -181,3 +181,25 @@ def python() -> str:
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Collect the longest modules first (module_order.py); every other test keeps its place."""
     items.sort(key=lambda item: module_rank(Path(item.fspath)))
+
+
+_RUN_STARTED = time.monotonic()
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config) -> None:
+    """
+    Say what the run cost the machine: CPU seconds of every process it reaped, against its wall.
+
+    The CPU over the cores is the least wall time any dealing of the modules could reach on this
+    machine: a run whose CPU is near it is bound by the CPU, not by its slots.
+    """
+    if _WORKER:
+        return
+    times = os.times()
+    cpu_s = times.user + times.system + times.children_user + times.children_system
+    wall_s = time.monotonic() - _RUN_STARTED
+    cores = len(os.sched_getaffinity(0))
+    terminalreporter.write_line(
+        f'machine: {cpu_s:.0f} CPU s in {wall_s:.0f} s on {cores} core(s): '
+        f'{cpu_s / max(wall_s * cores, 1e-9):.0%} of them; on these cores at least '
+        f'{cpu_s / cores:.0f} s')
