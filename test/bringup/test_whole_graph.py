@@ -66,6 +66,7 @@ def test_every_topic_arrives_at_its_rate(running_graph, graph_node):
     rates = measure_simulated_rates(node, executor, running_graph.namespace, SIM_WINDOW_S,
                                     SimulatedTime(node, running_graph.namespace),
                                     wall_timeout_s=60.0)
+    print({topic: round(hz, 2) for topic, (_, hz) in rates.items()})
     problems = [rate_problem(topic, rates[_full(running_graph.namespace, topic)][1], nominal,
                              RATE_TOLERANCE) for topic, nominal in EXPECTED_RATES_HZ.items()]
     assert not any(problems), [problem for problem in problems if problem]
