@@ -129,7 +129,8 @@ def test_a_retune_from_the_form_shows_progress_and_applies(browser, probe):
     form.find_element(By.NAME, 'k').clear()
     form.find_element(By.NAME, 'k').send_keys('6.0')
     browser.find_element(By.ID, 'retune-submit').click()
-    assert _wait_page(browser, "window.wirefish.retuneLog.some(m => m.state === 'done')", 120.0)
+    assert _wait_page(browser, "window.wirefish.retuneLog.some(m => m.state === 'done')",
+                      120.0), _live(browser, 'window.wirefish.retuneLog')
     log = _live(browser, 'window.wirefish.retuneLog')
     running = [m for m in log if m['state'] == 'running']
     assert running and running[-1]['max_iterations'] == 12
@@ -221,7 +222,7 @@ def test_after_stop_the_speed_plot_shows_no_estimate_newer_than_the_last_publish
 
 def test_after_stop_and_a_retune_the_body_wave_axis_is_the_tails(browser):
     _retune_from_form(browser, c1='0.15', k='8.0', max_iterations='5')
-    assert _wait_page(browser, DONE, 120.0)
+    assert _wait_page(browser, DONE, 120.0), _live(browser, 'window.wirefish.retune')
     time.sleep(2.0)
     scale = _live(browser, 'window.wirefish.plots.wave.scales.x')
     assert scale['min'] == 0 and 0.1 < scale['max'] < 1.0, scale  # the tail: 0.24 m
