@@ -16,6 +16,8 @@ import psutil
 from ros_utils import stop_process
 
 NAMESPACE = '/e2e'
+# Messages each stream of the rate probe keeps while the probe lags: 30 s of a 100 Hz stream.
+PROBE_DEPTH = 3000
 # `wirefish up` first listens DUPLICATE_CHECK_S (4 s) for the registry's nodes already running
 # in its namespace. A test's graph runs on a ROS domain and in a namespace of its own
 # (conftest.py), where no other graph can be found: its start skips the listen. The refusal is
@@ -169,9 +171,11 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
     falls behind on a loaded machine still counts every message of the window: it listens
     until /clock is ``LATE_S`` past the window's end and every stamped stream it heard has
     brought a stamp past the end (its queue drained up to there; within ``wall_timeout_s``),
-    and each subscription keeps 1,000 messages (10 s of the fastest stream: a queue of 100
-    overflowed beside two CPU hogs). A message without one counts at the simulated time current
-    when the probe took it. Raises AssertionError naming what it waited for if /clock does not
+    and each subscription keeps ``PROBE_DEPTH`` messages (30 s of the fastest stream: a queue of
+    100 overflowed beside two CPU hogs; with 1,000, on a host where mypy took 15.5 CPU s, every
+    100 Hz stream counted 93 % and every 50 and 10 Hz one 100 %, the mark of a queue that
+    overflowed). A message without one counts at the simulated time current when the probe
+    took it. Raises AssertionError naming what it waited for if /clock does not
     cover the window within ``wall_timeout_s`` of wall time.
     """
     from wirefish_common.cdr_views import CdrError, CdrReader
@@ -212,7 +216,7 @@ def measure_simulated_rates(node, executor, namespace: str, window_s: float,
         stamped = _stamp_place(msg_class)
         subscriptions.append(node.create_subscription(
             msg_class, topic, lambda data, topic=topic, stamped=stamped: count(
-                data, topic, stamped), matching_qos(node, topic, 1000), raw=True))
+                data, topic, stamped), matching_qos(node, topic, PROBE_DEPTH), raw=True))
     deadline = time.monotonic() + wall_timeout_s
     # Let the subscriptions match their publishers before the window opens.
     settle_until = time.monotonic() + 1.0

@@ -18,7 +18,6 @@ from pathlib import Path
 
 WORKSPACE = Path(__file__).resolve().parents[2]
 LONGEST_MODULES = (
-    'test/sim/test_rf433_virtual_fish.py',
     'test/bag/test_recorder_sigkill.py',
     'test/bringup/test_restart.py',
     'test/sim/test_rf433_qemu.py',
@@ -26,6 +25,7 @@ LONGEST_MODULES = (
     'test/launcher/test_fleet.py',
     'test/launcher/test_two_hosts.py',
     'test/firmware_qemu/test_link_in_the_loop.py',
+    'test/sim/test_rf433_virtual_fish.py',
     'test/bringup/test_whole_graph.py',
     'test/view/test_foxglove_clients.py',
     'test/bag/test_loaded_recording.py',
