@@ -332,16 +332,15 @@ class ViewNode(Node):
             return _answer(False, 'retune: a fit is already running')
         if not self._retune.wait_for_server(timeout_sec=SERVICE_WAIT_S):
             return _answer(False, 'retune: tuner_node does not offer retune_gait')
-        self._retune_busy.set()
-        self._report_retune({'state': 'sent'})
         # rclpy's ActionClient files a goal's future under its request only after sending the
         # request. Sent from this (the server's) thread, an answer the executor took in between
         # was dropped ("Ignoring unexpected goal response") and the fit never reported back.
         # The executor's own thread sends it: no answer can be taken before it is filed.
         executor = self.executor
         if executor is None:  # the node is being taken down
-            self._retune_busy.clear()
             return _answer(False, 'retune: the view is stopping')
+        self._retune_busy.set()
+        self._report_retune({'state': 'sent'})
         executor.create_task(partial(self._send_retune, goal))
         return _answer(True, 'goal sent: progress on view/retune')
 
