@@ -2,7 +2,8 @@
 """
 Small ROS peers that the cross-process tests start as separate processes.
 
-Usage: ``python ros_peers.py body_wave_talker`` or ``python ros_peers.py retune_server``.
+Usage: ``python ros_peers.py PEER`` with PEER one of body_wave_talker, imu_talker or
+retune_server.
 """
 
 import sys
@@ -10,6 +11,8 @@ import sys
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import Imu
 from wirefish_msgs.msg import BodyWave
 from wirefish_msgs.srv import RetuneGait
 
@@ -35,6 +38,24 @@ class BodyWaveTalker(Node):
         self._pub.publish(msg)
 
 
+class ImuTalker(Node):
+    """Publishes Imu at IMU_RATE_HZ as sensor streams go: best effort, so a loss is a loss."""
+
+    IMU_RATE_HZ = 200.0
+
+    def __init__(self) -> None:
+        super().__init__('imu_talker')
+        self._pub = self.create_publisher(Imu, 'imu/data', qos_profile_sensor_data)
+        self.create_timer(1.0 / self.IMU_RATE_HZ, self._tick)
+
+    def _tick(self) -> None:
+        msg = Imu()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = 'imu_link'
+        msg.orientation.w = 1.0
+        self._pub.publish(msg)
+
+
 class RetuneServer(Node):
     """Answers RetuneGait with parameters derived from the request (a trivial server)."""
 
@@ -53,7 +74,8 @@ class RetuneServer(Node):
 
 
 def main() -> None:
-    peer = {'body_wave_talker': BodyWaveTalker, 'retune_server': RetuneServer}[sys.argv[1]]
+    peer = {'body_wave_talker': BodyWaveTalker, 'imu_talker': ImuTalker,
+            'retune_server': RetuneServer}[sys.argv[1]]
     rclpy.init()
     node = peer()
     print('ready', flush=True)

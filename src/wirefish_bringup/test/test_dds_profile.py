@@ -6,7 +6,8 @@ import xml.etree.ElementTree as ElementTree
 
 import pytest
 from wirefish_bringup.dds_profile import (graph_environment, INSTALLED_NAMESPACES,
-                                          profile_path, PROFILES_VARIABLE, render_profile,
+                                          LISTEN_BUFFER_BYTES, profile_path,
+                                          PROFILES_VARIABLE, render_profile,
                                           reply_writer_names, TRANSPORTS_VARIABLE,
                                           with_profile, write_profile)
 
@@ -75,9 +76,22 @@ def test_one_side_of_a_radio_gets_a_participant_over_udp_announcing_every_ten_se
     assert lease > 10 + announce  # a 10 s radio cut never ends a lease
 
 
-def test_one_host_keeps_fast_dds_participant_defaults():
+def test_one_host_sets_only_the_listen_buffer_so_builtin_transports_still_apply():
     root = ElementTree.fromstring(render_profile(['/x']))
-    assert list(root.iter(f'{NS}participant')) == []
+    (participant,) = root.iter(f'{NS}participant')
+    assert participant.get('is_default_profile') == 'true'
+    (rtps,) = participant
+    assert [(e.tag, e.text) for e in rtps] == [
+        (f'{NS}listenSocketBufferSize', str(LISTEN_BUFFER_BYTES))]
+    assert list(root.iter(f'{NS}transport_descriptor')) == []
+
+
+@pytest.mark.parametrize('side', ({'radio': True}, {'loopback': True}))
+def test_a_participant_naming_its_transport_sets_the_buffer_on_it(side):
+    root = ElementTree.fromstring(render_profile(['/x'], **side))
+    (transport,) = root.iter(f'{NS}transport_descriptor')
+    assert transport.find(f'{NS}receiveBufferSize').text == str(LISTEN_BUFFER_BYTES)
+    assert LISTEN_BUFFER_BYTES > 212992  # the kernel's default, which a stall overflowed
 
 
 def test_a_radio_side_writes_its_own_profile_even_in_the_installed_namespace(tmp_path):

@@ -19,8 +19,8 @@ participant that announces itself every ANNOUNCE_S (lease LEASE_S) instead of Fa
 dropped by the bucket in 13 s; every 10 s: 7.5 kB/s, 0-5 dropped). A 10 s radio cut stays
 inside the lease. That participant names its UDPv4 transport itself: a default participant
 profile otherwise brings the builtin transports (shared memory) back. On one host (role all)
-there is no such participant: there a 10 s period slowed discovery (a full run: topics and an
-action not found in their tests' time).
+the participant keeps Fast DDS's announcements: there a 10 s period slowed discovery (a full
+run: topics and an action not found in their tests' time).
 
 Why no shared memory: with it, a publisher whose subscriber was SIGKILLed and restarted stalls in
 ``publish()``: the writer reopens the dead reader's shared-memory port and waits out the port's
@@ -30,6 +30,15 @@ memory its longest publish took 1001 ms (twice, and 334 ms twice), over UDP 6 ms
 that long starves the bridge past its 500 ms command timeout and the fish goes neutral; messages in
 flight to the recorder were lost with it. Loopback UDP costs a copy per reader, which the graph's
 small messages afford. A value the user already set, for either variable (even empty), is kept.
+
+Every participant's receiving sockets hold LISTEN_BUFFER_BYTES (the kernel's default is 208 KiB,
+and Linux caps a request at ``net.core.rmem_max``: a smaller cap is used as it is). A process
+whose receive thread the machine starves for a moment finds its datagrams queued in the socket,
+not dropped: a `wirefish record` stopped (SIGSTOP) for 0.6 s and 1 s beside the graph lost 126
+of each 100 Hz stream's messages at the kernel's default (912 datagrams dropped by its socket)
+and none with 4 MiB. On one host the buffer is the default participant's only setting
+(``listenSocketBufferSize``, for the builtin transports that ``FASTDDS_BUILTIN_TRANSPORTS``
+still chooses); a participant that names its UDPv4 transport sets it on that transport.
 
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` brings shared memory back whatever
 ``FASTDDS_BUILTIN_TRANSPORTS`` or a participant profile says: each process of a graph started with
@@ -72,6 +81,9 @@ PARAMETER_SERVICES = ('set_parameters', 'set_parameters_atomically', 'get_parame
                       'get_parameter_types', 'list_parameters', 'describe_parameters',
                       'get_type_description')
 REPLY_WAIT_S = 5
+# 20 s of the graph's ~400 datagrams a second (a datagram costs its socket ~1 KiB); memory is
+# taken only while datagrams wait.
+LISTEN_BUFFER_BYTES = 4 * 1024 * 1024
 LEASE_S = 30
 ANNOUNCE_S = 10
 
@@ -89,6 +101,10 @@ _HEADER = """<?xml version="1.0" encoding="UTF-8"?>
   answering that request. Only servers whose executor can afford it are listed: the tuner (a
   multi-threaded executor) and the CPG (its oscillator runs on its own loop thread). Not the
   bridge: its executor ticks the servo commands, and the fish goes neutral after 500 ms without.
+
+  Every participant's receiving sockets hold {buffer} bytes (the kernel's default is 212992;
+  net.core.rmem_max caps it): a process the machine starves for a moment finds its datagrams
+  queued, not dropped.
 
 {radio}{loopback}\
   rmw_fastrtps looks a reply writer's profile up by its topic name, rr<service name>Reply.
@@ -117,6 +133,7 @@ _TRANSPORTS = """    <transport_descriptors>
       <transport_descriptor>
         <transport_id>wirefish_udp</transport_id>
         <type>UDPv4</type>
+        <receiveBufferSize>{buffer}</receiveBufferSize>
 {whitelist}      </transport_descriptor>
     </transport_descriptors>
 """
@@ -125,6 +142,13 @@ _PARTICIPANT = """    <participant profile_name="wirefish_participant" is_defaul
         <userTransports><transport_id>wirefish_udp</transport_id></userTransports>
         <useBuiltinTransports>false</useBuiltinTransports>
 {builtin}      </rtps>
+    </participant>
+"""
+_BUFFER_PARTICIPANT = """\
+    <participant profile_name="wirefish_participant" is_default_profile="true">
+      <rtps>
+        <listenSocketBufferSize>{buffer}</listenSocketBufferSize>
+      </rtps>
     </participant>
 """
 _WHITELIST = """        <interfaceWhiteList><address>{address}</address></interfaceWhiteList>
@@ -170,7 +194,7 @@ def reply_writer_names(namespace: str) -> list[str]:
 def render_profile(namespaces: Iterable[str], radio: bool = False,
                    loopback: bool = False) -> str:
     """
-    Return the profile XML: reply writers of ``namespaces``, and a participant if needed.
+    Return the profile XML: reply writers of ``namespaces`` and the default participant.
 
     ``radio``: one side of a radio link (slow announcements); ``loopback``: one host over
     loopback UDPv4 (``on_loopback``). Either names the participant's UDPv4 transport itself.
@@ -178,15 +202,15 @@ def render_profile(namespaces: Iterable[str], radio: bool = False,
     chosen = list(dict.fromkeys(namespaces))
     writers = ''.join(_WRITER.format(name=name, wait=REPLY_WAIT_S)
                       for namespace in chosen for name in reply_writer_names(namespace))
-    participant = ''
+    participant = _BUFFER_PARTICIPANT.format(buffer=LISTEN_BUFFER_BYTES)
     if radio or loopback:
         whitelist = _WHITELIST.format(address=LOOPBACK_ADDRESS) if loopback else ''
         builtin = (_ANNOUNCEMENTS.format(lease=LEASE_S, announce=ANNOUNCE_S)
                    if radio else '')
-        participant = (_TRANSPORTS.format(whitelist=whitelist)
+        participant = (_TRANSPORTS.format(whitelist=whitelist, buffer=LISTEN_BUFFER_BYTES)
                        + _PARTICIPANT.format(builtin=builtin))
     header = _HEADER.format(
-        namespaces=', '.join(chosen), wait=REPLY_WAIT_S,
+        namespaces=', '.join(chosen), wait=REPLY_WAIT_S, buffer=LISTEN_BUFFER_BYTES,
         radio=_RADIO.format(lease=LEASE_S, announce=ANNOUNCE_S) if radio else '',
         loopback=_LOOPBACK.format(address=LOOPBACK_ADDRESS) if loopback else '')
     return header + participant + writers + _FOOTER
