@@ -6,6 +6,7 @@ import os
 import subprocess
 import time
 
+from kinematics_probe import stamp_s
 import numpy as np
 import pytest
 from ros_utils import spin_until, stop_process
@@ -164,18 +165,14 @@ def test_fish_sim_publishes_ground_truth_of_a_fish_swimming_on_bridge_commands(
     # The speed over the last second, not the last sample's: U swings within a beat, and this
     # command stream is paced by a probe that a slow host starves (one sample read 0.044 m/s
     # where the fish had swum 0.93 m in the 3 s).
-    end = _stamp_s(last)
-    recent = [m.twist.twist.linear.x for m in truth if _stamp_s(m) >= end - 1.0]
+    end = stamp_s(last)
+    recent = [m.twist.twist.linear.x for m in truth if stamp_s(m) >= end - 1.0]
     mean_u = sum(recent) / len(recent)
     print(f'ground truth after 3 s: U = {mean_u:.3f} m/s over the last second '
           f'({len(recent)} samples; the last {last.twist.twist.linear.x:.3f}), '
           f'x = {last.pose.pose.position.x:.3f} m')
     assert (last.header.frame_id, last.child_frame_id) == ('odom', 'base_link')
     assert mean_u > 0.1 and last.pose.pose.position.x > 0.1
-
-
-def _stamp_s(message) -> float:
-    return message.header.stamp.sec + 1e-9 * message.header.stamp.nanosec
 
 
 def test_dropped_frames_are_counted_as_sequence_gaps(start_fish, start_bridge, probe, tmp_path):

@@ -154,6 +154,7 @@ class Driver:
         self._twist = Twist
         from rclpy.parameter import Parameter
         from wirefish_bringup.graph import clock_topic
+        from wirefish_common.clock_hold import ClockHold
 
         self.simulated = simulated
         timed = {'cli_args': ['--ros-args', '-r', f'/clock:={clock_topic(namespace)}'],
@@ -165,6 +166,7 @@ class Driver:
         self.command: tuple[float, float] | None = None  # None: publish nothing
         self._lock = threading.Lock()
         self._pub = self.node.create_publisher(Twist, 'cmd_vel', 10)
+        self._hold = ClockHold(self.node)  # says nothing off simulated time
         self.node.create_subscription(Odometry, 'sim/ground_truth', self._on_truth, 50)
         self.node.create_subscription(JointState, 'servo_cmd', self._on_servo,
                                       qos_profile_sensor_data)
@@ -203,19 +205,47 @@ class Driver:
                 f'simulated time moved {self.now() - start:.2f} of {seconds} s')
             time.sleep(0.005)
 
+    def _publish_command(self) -> None:
+        command = self.command
+        if command is not None:
+            msg = self._twist()
+            msg.linear.x, msg.angular.z = command
+            self._pub.publish(msg)
+
     def _send_commands(self) -> None:
+        if self.simulated:
+            self._send_in_lockstep()
+            return
         period = 1.0 / CMD_RATE_HZ
-        clock = self.now if self.simulated else time.monotonic
-        due = clock()
+        due = time.monotonic()
         while not self._stopping:
-            command = self.command
-            if command is not None:
-                msg = self._twist()
-                msg.linear.x, msg.angular.z = command
-                self._pub.publish(msg)
-            due = max(due + period, clock())
-            while clock() < due and not self._stopping:  # 20 Hz of the graph's clock
-                time.sleep(0.002 if self.simulated else max(0.0, due - clock()))
+            self._publish_command()
+            due = max(due + period, time.monotonic())
+            time.sleep(max(0.0, due - time.monotonic()))
+
+    def _send_in_lockstep(self) -> None:
+        """
+        Publish cmd_vel at 20 Hz of simulated time, holding the graph's clock at each period.
+
+        At --speed max the graph runs as fast as it answers; a driver outside the lockstep fell
+        behind it whenever the loaded machine starved this process, and a second of simulated
+        time without cmd_vel made the planner rest the fish in the middle of a phase. So the
+        driver holds fish_sim's clock as the planner's own loop does (clock_hold): the clock
+        takes no step past the driver's next command until the driver has sent it.
+        """
+        clock = self.node.get_clock()
+        period_ns = round(1e9 / CMD_RATE_HZ)  # a whole number of fish_sim's 10 ms steps
+        while clock.now().nanoseconds == 0:  # no /clock heard yet
+            if self._stopping:
+                return
+            time.sleep(0.005)
+        due = clock.now().nanoseconds  # a time the clock took: the holds stay on its steps
+        while not self._stopping:
+            self._publish_command()
+            due = max(due + period_ns, clock.now().nanoseconds)
+            self._hold.say_due(due)
+            while clock.now().nanoseconds < due and not self._stopping:
+                time.sleep(0.002)
 
     def _on_truth(self, msg) -> None:
         import math

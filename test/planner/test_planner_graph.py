@@ -34,7 +34,7 @@ STOP_WITHIN_S = 5.0
 MAX_CPG_ACCELERATION = 300.0  # rad/s^2 (see the servo check)
 # As fast as the graph answers: the planner holds the clock at each control tick until its
 # imu/data has caught up with it, and the phases are counted in simulated seconds. The driver
-# is outside the lockstep: its commands switch with its own wall-clock latency.
+# holds the clock at each of its cmd_vel periods too (conftest.Driver).
 GRAPH_SPEED = 'max'
 
 

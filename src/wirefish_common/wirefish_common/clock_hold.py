@@ -40,8 +40,19 @@ class ClockHold:
         until_ns = timer.time_until_next_call()
         if self._publisher is None or until_ns is None:
             return
-        due = self._node.get_clock().now().nanoseconds + max(0, until_ns)
-        sec, nanosec = divmod(due, 1_000_000_000)
+        self.say_due(self._node.get_clock().now().nanoseconds + max(0, until_ns))
+
+    def say_due(self, due_ns: int) -> None:
+        """
+        Publish that the node's next tick is due at ``due_ns`` of simulated time.
+
+        For a node that paces itself without a timer; ``due_ns`` must be a time the clock
+        takes (a whole number of fish_sim's steps from a time it said), or the clock stops
+        short of it and waits for the node until it is released.
+        """
+        if self._publisher is None:
+            return
+        sec, nanosec = divmod(due_ns, 1_000_000_000)
         header = Header(frame_id=self._node.get_fully_qualified_name())
         header.stamp.sec, header.stamp.nanosec = sec, nanosec
         self._publisher.publish(header)
