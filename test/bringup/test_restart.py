@@ -73,6 +73,7 @@ CLOCK_OWNER = 'fish_sim'  # the graph's simulated time (wirefish up --sim: locks
 CLOCK_SILENT_S = 1.0
 COMMAND_TIMEOUT_S = 0.5  # the bridge's default command_timeout_s (config/wirefish.yaml)
 KILL_MARGIN_S = 1.0  # the recorder flushes every 0.5 s: a kill loses at most about 1 s
+JUST_WROTE_S = 0.2  # the recorder is killed this soon after a write to its file
 # The restarted recorder records again once it is up and has found the topics (it rescans the
 # graph every 0.5 s): a fresh process on the loaded machine, within this bound.
 RECORDER_BACK_S = 15.0
@@ -360,6 +361,19 @@ def _recorder_records_on(watched: WatchedGraph, kill: Kill) -> None:
         f'{newest.name} lacks {sorted(wanted - flushed_topics(newest))}'
 
 
+def _recorder_just_wrote(watched: WatchedGraph) -> bool:
+    """
+    Return whether the recorder wrote to its file within the last JUST_WROTE_S.
+
+    A recorder that the loaded machine starves writes nothing meanwhile, and killed then it
+    loses everything it could not write: a suite run on a slow host killed one that had written
+    nothing for 1.6 s. Killed right after a write, the loss measures the recorder, not the
+    machine (test_recorder_sigkill holds the recorder to its second on a quiet machine).
+    """
+    files = list(watched.bag.glob('*.mcap'))
+    return bool(files) and time.time() - max(p.stat().st_mtime for p in files) < JUST_WROTE_S
+
+
 # Checks that belong to one victim, run once it is back.
 VICTIM_CHECKS: dict[str, Callable[[WatchedGraph, Kill], None]] = {
     'cpg_node': _fish_held_neutral,
@@ -375,6 +389,9 @@ def test_a_killed_node_is_back_and_streaming_and_the_others_never_stopped(watche
         f'fish_sim not in lockstep before the kill: {_engagement_lines(watched.graph.out_dir)}'
     before = watched.pids()
     assert set(before) == set(VICTIMS), before
+    if victim == RECORDER:
+        assert _wait(lambda: _recorder_just_wrote(watched), BACK_WITHIN_S), \
+            f'the recorder wrote nothing to {watched.bag} in {BACK_WITHIN_S:g} s'
     killed_at, killed_wall = time.monotonic(), time.time()
     os.kill(before[victim], signal.SIGKILL)
 
