@@ -38,11 +38,12 @@ def _stop_for(pid: int, seconds: float) -> None:
 @pytest.mark.parametrize('range_', ('LOCALHOST', 'SUBNET'))
 def test_a_stopped_recorder_loses_nothing_of_a_best_effort_stream(
         spawn, ros_env, python, tmp_path, range_):
-    # LOCALHOST: the loopback profile (UDPv4 transport named in it); SUBNET: the installed
-    # profile (builtin transports), as `wirefish up` gives each.
-    env = with_profile({**ros_env, 'ROS_AUTOMATIC_DISCOVERY_RANGE': range_})
+    # The range as a shell sets it after tools/activate.sh: `wirefish` itself gives its
+    # participant the graph's profile (LOCALHOST: the loopback one, its UDPv4 transport named
+    # in it; SUBNET: the installed one, the builtin transports).
+    env = {**ros_env, 'ROS_AUTOMATIC_DISCOVERY_RANGE': range_}
     talker = spawn([python, PEERS, 'imu_talker', '--ros-args', '-r', f'__ns:={NAMESPACE}'],
-                   env=env)
+                   env=with_profile(env))
     assert talker.stdout.readline().strip() == 'ready'
     recorder = spawn([sys.executable, '-m', 'wirefish_cli.cli', 'record', '-o',
                       str(tmp_path / 'bag'), '--namespace', NAMESPACE, '--duration',
