@@ -366,9 +366,9 @@ def _recorder_just_wrote(watched: WatchedGraph) -> bool:
     Return whether the recorder wrote to its file within the last JUST_WROTE_S.
 
     A recorder that the loaded machine starves writes nothing meanwhile, and killed then it
-    loses everything it could not write: a suite run on a slow host killed one that had written
-    nothing for 1.6 s. Killed right after a write, the loss measures the recorder, not the
-    machine (test_recorder_sigkill holds the recorder to its second on a quiet machine).
+    loses everything it could not write, however long the starving lasted (1.6 s on a slow
+    host). Killed right after a write, the loss measures the recorder, not the machine
+    (test_recorder_sigkill holds the recorder to its second on a quiet machine).
     """
     files = list(watched.bag.glob('*.mcap'))
     return bool(files) and time.time() - max(p.stat().st_mtime for p in files) < JUST_WROTE_S
