@@ -8,6 +8,7 @@ group and torn down (SIGINT, then SIGKILL) when the test ends, so none is left b
 """
 
 from collections.abc import Callable, Iterator
+from contextlib import ExitStack
 import itertools
 import json
 import os
@@ -129,41 +130,72 @@ def spawn(ros_env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen]]:
                 stream.close()
 
 
-@pytest.fixture(scope='module', autouse=True)
-def machine_slots(request: pytest.FixtureRequest,
-                  tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+class _ModuleShare:
+    """The machine share (machine_share.py) a test/ module holds while its tests run."""
+
+    def __init__(self, module: pytest.Module, run_directory: Path) -> None:
+        workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
+        slots = slot_count(workers, os.environ.get(SLOTS_VARIABLE))
+        if module.get_closest_marker('loads_machine'):
+            self.weight = heavy_weight(slots)
+        elif module.get_closest_marker('barely_loads_machine'):
+            self.weight = 0
+        else:
+            self.weight = 1
+        self.module, self.run_directory = module, run_directory
+        self._stack = ExitStack()
+        asked = time.monotonic()
+        self._stack.enter_context(machine_share(run_directory, slots, self.weight))
+        self.started, self.started_at = time.monotonic(), time.time()
+        self.waited_s = self.started - asked
+        self.cpu_before = _cpu_seconds()
+
+    def leave(self) -> None:
+        """Give the share back; log what the module waited, held and cost (one JSON line)."""
+        # One line per module: what `make test`'s time is made of (waits and holds).
+        with open(self.run_directory / 'machine_share.jsonl', 'a') as log:
+            log.write(json.dumps({'module': self.module.nodeid, 'weight': self.weight,
+                                  'started_at': round(self.started_at, 2),
+                                  'waited_s': round(self.waited_s, 2),
+                                  'held_s': round(time.monotonic() - self.started, 2),
+                                  'cpu_s': round(_cpu_seconds() - self.cpu_before, 2)}) + '\n')
+        self._stack.close()
+
+
+_share: _ModuleShare | None = None  # the share of the module whose tests this process runs
+
+
+@pytest.hookimpl(hookwrapper=True, tryfirst=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
     """
     Run each module on its share of the machine (machine_share.py): all slots but one if heavy.
 
     The slots are shared by the run's workers (lock files in the run's base temp); mark a
     module that loads the machine itself ``pytest.mark.loads_machine``, one that barely does
-    (it holds no slot) ``pytest.mark.barely_loads_machine``.
+    (it holds no slot) ``pytest.mark.barely_loads_machine``. The share is taken before the
+    module's first test starts, outside pytest-timeout's timer (which counts setup): a wait for
+    the other workers' modules is not the test's time. It is given back once the module's last
+    test ended and its module fixtures with it.
     """
-    workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
-    slots = slot_count(workers, os.environ.get(SLOTS_VARIABLE))
-    if request.node.get_closest_marker('loads_machine'):
-        weight = heavy_weight(slots)
-    elif request.node.get_closest_marker('barely_loads_machine'):
-        weight = 0
-    else:
-        weight = 1
-    run_directory = tmp_path_factory.getbasetemp()  # a worker's is popen-gwK in the run's
-    if _WORKER:
-        run_directory = run_directory.parent
-    asked = time.monotonic()
-    with machine_share(run_directory, slots, weight):
-        started, started_at = time.monotonic(), time.time()
-        cpu_before = _cpu_seconds()
-        try:
-            yield
-        finally:
-            # One line per module: what `make test`'s time is made of (waits and holds).
-            with open(run_directory / 'machine_share.jsonl', 'a') as log:
-                log.write(json.dumps({'module': request.node.nodeid, 'weight': weight,
-                                      'started_at': round(started_at, 2),
-                                      'waited_s': round(started - asked, 2),
-                                      'held_s': round(time.monotonic() - started, 2),
-                                      'cpu_s': round(_cpu_seconds() - cpu_before, 2)}) + '\n')
+    global _share
+    module = item.getparent(pytest.Module)
+    if _share is None and module is not None:
+        # The tmp_path_factory fixture's object: a hook has no fixtures. A worker's is popen-gwK.
+        run_directory = item.config._tmp_path_factory.getbasetemp()
+        _share = _ModuleShare(module, run_directory.parent if _WORKER else run_directory)
+    yield
+    if _share is not None and (nextitem is None or nextitem.getparent(pytest.Module)
+                               is not _share.module):
+        _share.leave()
+        _share = None
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Give back the share of a module a stopped run (-x, Ctrl-C) left in the middle."""
+    global _share
+    if _share is not None:
+        _share.leave()
+        _share = None
 
 
 def _cpu_seconds() -> float:

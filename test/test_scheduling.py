@@ -13,6 +13,7 @@ a replacement worker the crashed test again, and a run once waited on that for g
 
 import configparser
 import fcntl
+import json
 import os
 from pathlib import Path
 import re
@@ -21,7 +22,7 @@ import sys
 import threading
 import time
 
-from machine_share import heavy_weight, machine_share, slot_count
+from machine_share import heavy_weight, machine_share, slot_count, SLOTS_VARIABLE
 from module_order import LONGEST_MODULES, module_rank
 import pytest
 
@@ -189,6 +190,54 @@ def test_a_module_that_barely_loads_the_machine_runs_while_every_slot_is_held(tm
     ran = [t for t, name, _ in events if name == 'barely']
     freed = [t for t, name, change in events if change < 0]
     assert len(ran) == 2 and max(ran) < min(freed)  # in and out before any slot came free
+
+
+HOLDER = """
+import threading
+import time
+
+from machine_share import machine_share
+
+
+def pytest_sessionstart(session):
+    # Every slot of the run, held by another worker's module for a while.
+    run_directory = session.config._tmp_path_factory.getbasetemp()
+    held = threading.Event()
+
+    def hold():
+        with machine_share(run_directory, 1, 1):
+            held.set()
+            time.sleep({hold_s})
+    threading.Thread(target=hold, daemon=True).start()
+    held.wait()
+"""
+QUICK = """
+def test_quick():
+    pass
+"""
+
+
+def test_a_modules_wait_for_its_slots_is_not_its_tests_time(tmp_path):
+    # A module waiting for the slots other workers' modules hold is not hung: pytest-timeout's
+    # timer (which counts a test's setup) starts once the slots are the module's.
+    timeout_s, hold_s = 2, 5
+    (tmp_path / 'slot_holder.py').write_text(HOLDER.format(hold_s=hold_s))
+    (tmp_path / 'test_quick.py').write_text(QUICK)
+    env = {k: v for k, v in os.environ.items() if not k.startswith('PYTEST_XDIST')}
+    env.update(PYTHONPATH=os.pathsep.join(
+        [str(tmp_path), str(WORKSPACE / 'test'), str(WORKSPACE / 'test' / 'support'),
+         env.get('PYTHONPATH', '')]),
+        **{SLOTS_VARIABLE: '1'})
+    # The suite's conftest as a plugin, for a module outside test/ (and a holder of the slots).
+    run = subprocess.run([sys.executable, '-m', 'pytest', '-p', 'no:cacheprovider',
+                          '-p', 'conftest', '-p', 'slot_holder', '-o', f'timeout={timeout_s}',
+                          '--basetemp', str(tmp_path / 'run'), str(tmp_path / 'test_quick.py')],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    print(run.stdout[-3000:])
+    assert run.returncode == 0
+    logged = [json.loads(line) for line in (tmp_path / 'run' / 'machine_share.jsonl').open()]
+    assert [m['module'] for m in logged] == ['test_quick.py']
+    assert logged[0]['waited_s'] > timeout_s
 
 
 def test_the_configured_slots_are_one_to_the_workers():
