@@ -81,6 +81,7 @@ class Probe:
         self.node.create_subscription(DiagnosticArray, '/diagnostics', self.diagnostics.append,
                                       10)
         self.cmd = self.node.create_publisher(JointState, 'servo_cmd', qos_profile_sensor_data)
+        self.last_command_s: float | None = None  # the node clock's time of the newest servo_cmd
         self.executor = SingleThreadedExecutor(context=context)
         self.executor.add_node(self.node)
 
@@ -90,6 +91,7 @@ class Probe:
         while time.monotonic() < deadline:
             if command is not None and time.monotonic() >= next_cmd:
                 self.cmd.publish(JointState(name=['servo_1', 'servo_2'], position=command))
+                self.last_command_s = self.node.get_clock().now().nanoseconds * 1e-9
                 next_cmd += 1.0 / rate_hz
             self.executor.spin_once(timeout_sec=0.002)
 

@@ -15,6 +15,7 @@ from wirefish_bridge.protocol import ServoCommand
 
 pytestmark = pytest.mark.ros
 COMMAND_TIMEOUT_S = 1.0  # the bridge's command_timeout_s in the failsafe test
+FISH_COMMAND_TIMEOUT_S = 10.0  # the fish's own there: long, so that neutral is the bridge's
 NEUTRAL_WAIT_S = 20.0  # wall s: a bound on a stopped bridge, not the failsafe's timing
 RATE_WINDOW_S = 6.0
 
@@ -100,11 +101,11 @@ def test_bridge_commands_neutral_when_servo_cmd_stops(start_fish, start_bridge, 
     # The firmware's own timeout is long, so neutral here comes from the bridge. Its timeout is
     # the wall clock's: 1 s, so that the probe's own commands, held up beside two CPU hogs,
     # keep it out of failsafe while they stream (at 0.3 s it went neutral mid-stream there).
-    start_fish(link, '--command-timeout', '10')
+    start_fish(link, '--command-timeout', f'{FISH_COMMAND_TIMEOUT_S:g}')
     start_bridge(link, f'command_timeout_s:={COMMAND_TIMEOUT_S}')
     assert spin_until(probe.executor, lambda: len(probe.imu) > 10, 20.0)
     assert probe.command_until_measured([0.4, 0.3]), probe.servo[-1:]
-    last_command = probe.node.get_clock().now().nanoseconds * 1e-9
+    last_command = probe.last_command_s
     probe.servo.clear()
 
     def neutral_stamps() -> list[float]:
@@ -115,11 +116,12 @@ def test_bridge_commands_neutral_when_servo_cmd_stops(start_fish, start_bridge, 
     # still judges the bridge's time, not its own.
     assert spin_until(probe.executor, lambda: neutral_stamps(), NEUTRAL_WAIT_S), \
         f'servo_state never neutral in {NEUTRAL_WAIT_S:g} s: {probe.servo[-1:]}'
-    neutral = neutral_stamps()
-    print(f'neutral measured {neutral[0] - last_command:.3f} s after the last servo_cmd')
-    # command_timeout_s, + one 10 ms tick, + the servo's travel and lag (~0.15 s), one
-    # telemetry period and scheduling on a loaded machine
-    assert neutral[0] - last_command < COMMAND_TIMEOUT_S + 0.35
+    delay = neutral_stamps()[0] - last_command
+    print(f'neutral measured {delay:.3f} s after the last servo_cmd')
+    # The claim is whose timeout it is: the bridge's, never before it, long before the fish's.
+    # How soon after it the gate commands neutral is the gate's unit test (one tick, injected
+    # time); here the servos' travel and a loaded machine's scheduling add up to half a second.
+    assert COMMAND_TIMEOUT_S <= delay < FISH_COMMAND_TIMEOUT_S / 2
     # /diagnostics comes once a second: it says so by the next one.
     assert spin_until(probe.executor, lambda: bool(probe.statuses()) and
                       probe.last_diagnostics().get('failsafe') == 'True', 5.0), \
