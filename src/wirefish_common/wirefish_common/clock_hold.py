@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.timer import Timer
 from std_msgs.msg import Header
@@ -21,14 +22,27 @@ from wirefish_common.qos import HOLD
 from wirefish_common.topics import LOCKSTEP_HOLD_TOPIC
 
 
+# A due time the clock never reaches (the last second a Time's int32 seconds can say): a hold
+# at it holds nothing, so a node that is done says it rather than wait to be released.
+RELEASED_NS = (2 ** 31 - 1) * 1_000_000_000
+RELEASE_ACK_S = 1.0  # how long a release waits for fish_sim to have it (wall s)
+
+
 class ClockHold:
     """Says a node's next tick to the clock's owner when the node runs on simulated time."""
 
-    def __init__(self, node: Node) -> None:
-        """Publish on ``node``'s ``lockstep/next_tick`` if it runs with use_sim_time."""
+    def __init__(self, node: Node, simulated: bool | None = None) -> None:
+        """
+        Publish on ``node``'s ``lockstep/next_tick`` if it runs on simulated time.
+
+        ``simulated`` None: if the node runs with use_sim_time; a node that reads the graph's
+        clock itself (`wirefish mission` hears ``<namespace>/clock``) says so.
+        """
         self._node = node
+        if simulated is None:
+            simulated = bool(node.get_parameter('use_sim_time').value)
         self._publisher: Any = (node.create_publisher(Header, LOCKSTEP_HOLD_TOPIC, HOLD)
-                                if node.get_parameter('use_sim_time').value else None)
+                                if simulated else None)
 
     @property
     def on_simulated_time(self) -> bool:
@@ -56,3 +70,9 @@ class ClockHold:
         header = Header(frame_id=self._node.get_fully_qualified_name())
         header.stamp.sec, header.stamp.nanosec = sec, nanosec
         self._publisher.publish(header)
+
+    def release(self) -> None:
+        """Say that no tick of the node is due any more: the clock runs on without it."""
+        self.say_due(RELEASED_NS)
+        if self._publisher is not None:   # before the node goes: else it holds until released
+            self._publisher.wait_for_all_acked(Duration(seconds=RELEASE_ACK_S))

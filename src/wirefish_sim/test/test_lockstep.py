@@ -4,6 +4,7 @@
 import math
 
 import pytest
+from wirefish_common.clock_hold import RELEASED_NS
 from wirefish_common.input_checks import parse_speed, speed_text
 from wirefish_sim.lockstep import clock_origin_ns, ENGAGE_STEPS, LockstepClock
 
@@ -118,6 +119,16 @@ def test_a_holding_node_keeps_the_clock_at_its_next_tick_until_it_answers():
     assert clock.held_by() == [(0, PLANNER)] and not clock.ready(1.02)  # the tick's answer is owed
     clock.on_hold(0, PLANNER, tick + 5 * STEP_NS)
     assert clock.held_by() == [] and clock.ready(1.02)
+
+
+def test_a_holding_node_that_says_it_is_done_holds_the_clock_no_more():
+    # A mission at its end (clock_hold.ClockHold.release): no wait for the grace.
+    clock = _engaged_clock()
+    clock.on_hold(0, PLANNER, clock.time_ns)
+    clock.on_command(0)
+    assert clock.held_by() == [(0, PLANNER)]
+    clock.on_hold(0, PLANNER, RELEASED_NS)
+    assert clock.held_by() == [] and clock.ready(1.0)
 
 
 def test_a_holding_node_silent_for_the_grace_is_released_until_it_answers_again():

@@ -6,13 +6,16 @@ FILE is a mission YAML (``wirefish_operator.mission_plan``) or the name of a shi
 (``square``). It starts once the graph answers: planner_state and the ground truth heard, and
 the bridge's /diagnostics saying the link is up and the fish hears the host (no
 FAILSAFE_HEARTBEAT: a bridge that has not yet heard the graph's clock sends no heartbeat, and
-the fish ignores every command meanwhile). The mission keeps the virtual fish's time: the
-stamps of its ground truth, which are simulated time on `wirefish up --sim` (lockstep at its
-``--speed``: a mission on ``--speed max`` takes as little wall time as the graph needs) and the
-wall clock's on the real-time roads. The legs go to ``<namespace>/cmd_vel`` at 20 Hz of that
-time; the whole namespace is recorded into a rosbag2 (MCAP) bag (``wirefish_bag.recorder``, as
-`wirefish record`); afterwards the report PNG (x-y path from sim/ground_truth with heading
-arrows, speed and yaw rate against the setpoints) and the closure error are written and printed.
+the fish ignores every command meanwhile). The mission keeps the virtual fish's time. On
+`wirefish up --sim` that is the graph's clock (``<namespace>/clock``, lockstep at its
+``--speed``: a mission on ``--speed max`` takes as little wall time as the graph needs), and the
+mission holds it as the planner does (``clock_hold``): no step passes its next command until
+the command went, so a mission the machine starves changes nothing. On the real-time roads it
+is the ground truth's stamps (the wall clock's). The legs go to ``<namespace>/cmd_vel`` at
+20 Hz of that time; the whole namespace is recorded into a rosbag2 (MCAP) bag
+(``wirefish_bag.recorder``, as `wirefish record`); afterwards the report PNG (x-y path from
+sim/ground_truth with heading arrows, speed and yaw rate against the setpoints) and the closure
+error are written and printed.
 """
 
 from __future__ import annotations
@@ -32,9 +35,11 @@ from wirefish_cli.ros_session import graph_namespace, ros_session, RosSession
 
 if TYPE_CHECKING:
     from rclpy.task import Future
+    from wirefish_common.clock_hold import ClockHold
     from wirefish_common.progress import Progress
 
 CMD_RATE_HZ = 20.0
+CMD_PERIOD_NS = 50_000_000  # 1 / CMD_RATE_HZ: a whole number of fish_sim's 10 ms steps
 DISCOVERY_TIMEOUT_S = 30.0
 HINT_AFTER_S = 5.0  # of waiting for the graph, before saying what is waited for
 REST_HOLD_S = 1.0  # how long the ground truth's speed stays below REST_SPEED: at rest
@@ -118,7 +123,8 @@ class _Run:
     planner_state came; ``fish_driven``: the bridge's last status says the fish hears the host;
     ``hinted``: what is waited for was said; ``progress``: the legs'
     progress, from the first leg's start; ``fish_now``: the last ground truth's stamp;
-    ``sent_at``: when (the fish's time) the last command went.
+    ``sent_at``: when (the fish's time) the last command went; ``hold``: the mission's hold on
+    the graph's clock (on simulated time), ``due_ns``: the clock's time of its next command.
     """
 
     rest_from: float | None = None
@@ -133,6 +139,8 @@ class _Run:
     progress: Progress | None = None
     fish_now: float | None = None
     sent_at: float = -math.inf
+    hold: ClockHold | None = None
+    due_ns: int | None = None
 
 
 def _drive(mission, namespace: str, bag_path: Path,
@@ -162,7 +170,10 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from rosgraph_msgs.msg import Clock
     from wirefish_bag.recorder import BagRecorder
+    from wirefish_common.clock_hold import ClockHold
+    from wirefish_common.qos import CLOCK
     from wirefish_common.progress import Progress
     from wirefish_msgs.msg import PlannerState
     from wirefish_operator.mission_report import REST_SPEED
@@ -201,11 +212,30 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
             return
         run.fish_now = t
         speeds.append((t, abs(message.twist.twist.linear.x)))
-        if run.rest_from is not None and t - run.sent_at >= 1.0 / CMD_RATE_HZ:
+        if (run.hold is None and run.rest_from is not None
+                and t - run.sent_at >= 1.0 / CMD_RATE_HZ):
             run.sent_at = t
             drive(t)
 
     node.create_subscription(Odometry, 'sim/ground_truth', on_truth, reliable)
+
+    def on_clock(message: Clock) -> None:
+        """On simulated time: send each command at its step and hold the clock until it goes."""
+        if run.hold is None:
+            run.hold = ClockHold(node, simulated=True)
+        now_ns = message.clock.sec * 1_000_000_000 + message.clock.nanosec
+        if run.rest_from is None or run.done or run.problem is not None:
+            return
+        if run.due_ns is None or now_ns >= run.due_ns:
+            drive(now_ns * 1e-9)
+            if run.done:
+                return
+            run.due_ns = now_ns + CMD_PERIOD_NS
+            run.hold.say_due(run.due_ns)
+
+    # The graph's clock on `wirefish up --sim` (fish_sim's, lockstep); none on the real-time
+    # roads, where the ground truth's stamps pace the legs.
+    node.create_subscription(Clock, 'clock', on_clock, CLOCK)
     parameters = node.create_client(GetParameters, 'planner_node/get_parameters')
     truth_topic = f'{namespace.rstrip("/")}/sim/ground_truth'
     started = time.monotonic()
@@ -274,6 +304,8 @@ def _drive_in(session: RosSession, signals, mission, bag_path: Path,
             publisher.publish(msg)
         elif t - run.t0 > mission.duration_s + mission.coast_s:
             run.done = True
+            if run.hold is not None:
+                run.hold.release()
             rclpy.try_shutdown()
 
     node.create_timer(1.0 / CMD_RATE_HZ, wait_for_graph)
