@@ -17,7 +17,7 @@ import subprocess
 import sys
 import time
 
-from machine_share import heavy_weight, machine_share, slot_count, SLOTS_VARIABLE
+from machine_share import machine_share, module_weight, Share, slot_count, SLOTS_VARIABLE
 from module_order import module_rank
 import pytest
 from ros_utils import domain_context, stop_process
@@ -136,12 +136,9 @@ class _ModuleShare:
     def __init__(self, module: pytest.Module, run_directory: Path) -> None:
         workers = int(os.environ.get('PYTEST_XDIST_WORKER_COUNT', '1'))
         slots = slot_count(workers, os.environ.get(SLOTS_VARIABLE))
-        if module.get_closest_marker('loads_machine'):
-            self.weight = heavy_weight(slots)
-        elif module.get_closest_marker('barely_loads_machine'):
-            self.weight = 0
-        else:
-            self.weight = 1
+        share = next((share for share in Share
+                      if share.value and module.get_closest_marker(share.value)), Share.ONE)
+        self.weight = module_weight(share, slots)
         self.module, self.run_directory = module, run_directory
         self._stack = ExitStack()
         asked = time.monotonic()
@@ -168,14 +165,15 @@ _share: _ModuleShare | None = None  # the share of the module whose tests this p
 @pytest.hookimpl(hookwrapper=True, tryfirst=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
     """
-    Run each module on its share of the machine (machine_share.py): all slots but one if heavy.
+    Run each module on its share of the machine (machine_share.py): its marker's slots.
 
     The slots are shared by the run's workers (lock files in the run's base temp); mark a
-    module that loads the machine itself ``pytest.mark.loads_machine``, one that barely does
-    (it holds no slot) ``pytest.mark.barely_loads_machine``. The share is taken before the
-    module's first test starts, outside pytest-timeout's timer (which counts setup): a wait for
-    the other workers' modules is not the test's time. It is given back once the module's last
-    test ended and its module fixtures with it.
+    module that loads the machine itself ``pytest.mark.loads_machine`` (all slots but one), one
+    whose claims are on a hardware stand-in's wall clock ``pytest.mark.keeps_machine`` (every
+    slot), one that barely loads it ``pytest.mark.barely_loads_machine`` (no slot). The share
+    is taken before the module's first test starts, outside pytest-timeout's timer (which
+    counts setup): a wait for the other workers' modules is not the test's time. It is given
+    back once the module's last test ended and its module fixtures with it.
     """
     global _share
     module = item.getparent(pytest.Module)

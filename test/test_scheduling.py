@@ -22,7 +22,8 @@ import sys
 import threading
 import time
 
-from machine_share import heavy_weight, machine_share, slot_count, SLOTS_VARIABLE
+from machine_share import (heavy_weight, machine_share, module_weight, Share, slot_count,
+                           SLOTS_VARIABLE)
 from module_order import LONGEST_MODULES, module_rank
 import pytest
 
@@ -173,6 +174,15 @@ def test_a_weight_outside_zero_to_the_slots_is_refused(tmp_path, weight):
 @pytest.mark.parametrize('slots', [2, 3, 4])
 def test_a_module_that_loads_the_machine_leaves_one_slot_to_the_rest(slots):
     assert heavy_weight(slots) == slots - 1
+
+
+@pytest.mark.parametrize('slots', [1, 2, 3, 4])
+def test_a_module_that_keeps_the_machine_holds_every_slot(slots):
+    assert module_weight(Share.KEEPS, slots) == slots
+
+
+def test_the_markers_weigh_every_slot_all_but_one_none_and_one():
+    assert [module_weight(share, 3) for share in Share] == [3, 2, 0, 1]
 
 
 def test_on_one_slot_a_module_that_loads_the_machine_holds_it():

@@ -9,9 +9,10 @@ barely load the machine), so xdist deals the files in collection order, and conf
 collects these first. By default xdist deals the files with most tests first, so these one-test
 files came last (the drive, the mission, the two hosts and the fleet once ran after everything
 else and test/ took 9.6 min); dealt first, they run side by side while the short files fill the
-gaps. The modules that load the machine (``loads_machine``) run one at a time, so they are
-spread among the others, none among the first three (one per worker): a worker that waits for
-its turn runs nothing, and a heavy module waiting for its slots holds the light ones back.
+gaps. The modules that load the machine (``loads_machine``, ``keeps_machine``) run one at a
+time, so they are spread among the others, none among the first three (one per worker): a
+worker that waits for its turn runs nothing, and a heavy module waiting for its slots holds
+the light ones back.
 """
 
 from pathlib import Path
@@ -20,10 +21,10 @@ WORKSPACE = Path(__file__).resolve().parents[2]
 LONGEST_MODULES = (
     'test/bag/test_recorder_sigkill.py',
     'test/bringup/test_restart.py',
-    'test/sim/test_rf433_qemu.py',
     'test/bridge/test_bridge_pty.py',
     'test/launcher/test_fleet.py',
     'test/launcher/test_two_hosts.py',
+    'test/sim/test_rf433_qemu.py',
     'test/firmware_qemu/test_link_in_the_loop.py',
     'test/sim/test_rf433_virtual_fish.py',
     'test/bringup/test_whole_graph.py',
