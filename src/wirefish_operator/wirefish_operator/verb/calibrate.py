@@ -27,8 +27,9 @@ from wirefish_cli.ros_session import ros_session, RosSession
 WAIT_S = 10.0
 SOURCES = {0: 'DEFAULTS', 1: 'STORED', 2: 'LIVE'}
 OP_READ, OP_SET, OP_SAVE, OP_FACTORY = 0, 1, 2, 3
-# The servo_trim call itself waits up to 2 s for the fish (bridge_node): a little more here.
-ANSWER_MARGIN_S = 3.0
+# The servo_trim call itself waits up to 2 s for the fish (bridge_node) and then answers either
+# way: the rest is the bridge's and DDS's time on a loaded machine (over 1 s beside the suite).
+ANSWER_MARGIN_S = 10.0
 
 
 @dataclass(frozen=True)
