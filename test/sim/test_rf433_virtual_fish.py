@@ -12,8 +12,8 @@ swam 0.1943, 0.1999 and 0.2032 m/s (5-60 s of a 60 s drive) in three runs, where
 drives swam 0.1944, 0.1947 and 0.1958 (the board integrates eq 1 itself). What it costs: ~40 + 58
 + 10 s of driving and three start-ups, ~2.5 min of one worker. Its claims are on the wall
 clock (how soon a gait change is acknowledged, the speed swum against the wire's), so it keeps
-the machine to itself (``keeps_machine``): beside two other graphs on a host where mypy took
-15.5 CPU s, acknowledgements took a median 0.37 s and the speed moved 5.8 %.
+the machine to itself (``keeps_machine``): a starved radio relay and virtual fish add their
+own delays to the link's, which a radio in water does not have.
 
 The board's side of the cut is read from what the fish sent before the radio (the relay's tap):
 its status bits say when it coasted and rested, its servo angles that it came to rest without a

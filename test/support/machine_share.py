@@ -17,8 +17,8 @@ through a turnstile lock, so a module that needs several is not overtaken by one
 A module whose claims are on the wall clock of a stand-in for hardware (the radio model, the
 board behind it: how soon a gait is acknowledged, how fast the fish swims over the radio)
 keeps the machine to itself: it holds every slot, and only modules that barely load the machine
-(and src/'s pure tests, at nice 5) run beside it. Beside another graph, on a slow host, its
-acknowledgements came a median 0.325-0.334 s after a change, 0.21-0.24 s on an idle one.
+(and src/'s pure tests, at nice 5) run beside it: the stand-ins run on the wall clock, and a
+starved one adds its own delays to those of the hardware it stands for.
 """
 
 from __future__ import annotations

@@ -28,7 +28,7 @@ WAIT_S = 10.0
 SOURCES = {0: 'DEFAULTS', 1: 'STORED', 2: 'LIVE'}
 OP_READ, OP_SET, OP_SAVE, OP_FACTORY = 0, 1, 2, 3
 # The servo_trim call itself waits up to 2 s for the fish (bridge_node) and then answers either
-# way: the rest is the bridge's and DDS's time on a loaded machine (over 1 s beside the suite).
+# way: the rest is the bridge's and DDS's time, seconds on a loaded machine.
 ANSWER_MARGIN_S = 10.0
 
 
